@@ -1,0 +1,362 @@
+/*
+ * getme.h -- GETMe adaptive mesh smoothing (libgetme), the one public header.
+ *
+ * libgetme improves the shape of the elements of a volume mesh (tetrahedra,
+ * hexahedra, prisms, pyramids, mixed) or a planar mesh (triangles, quads) by
+ * moving free nodes only; it never changes the topology.  The method is
+ * "GETMe adaptive" (Vartziotis & Wipper): geometric element transformations
+ * that make each element more regular, combined by quality-weighted node
+ * averaging and per-node relaxation that keeps every element valid.  Smart
+ * Laplace is provided as the classic baseline.
+ *
+ * Conventions
+ *  - All names are prefixed getme_ / GETME_.  No global mutable state: every
+ *    function works on the handles and buffers passed to it and is safe to
+ *    call from several threads on different handles.
+ *  - Every fallible function returns a getme_status.  Functions taking a mesh
+ *    also leave a one-line human readable message, retrievable with
+ *    getme_mesh_error(), that names the element or node concerned.  The
+ *    library never prints and never exits.
+ *  - Node and element indices are zero-based int32_t in the order the caller
+ *    supplied them.  Elements are numbered in the order of the
+ *    getme_mesh_add_elements() calls, then in order within a call.
+ *  - Node order inside an element is Gmsh's for the linear types (which is
+ *    also Abaqus' C3D4/C3D6/C3D8 and CGNS' TETRA_4/PENTA_6/HEXA_8/PYRA_5):
+ *      tet      0,1,2 counter-clockwise seen from 3
+ *      hex      0-3 bottom face, 4-7 top face (4 above 0)
+ *      prism    0,1,2 bottom triangle, 3,4,5 top (3 above 0)
+ *      pyramid  0-3 base quad, 4 apex
+ *      tri/quad counter-clockwise in the xy plane (a mesh whose elements are
+ *               all clockwise is accepted and handled as mirrored)
+ *  - Coordinates are always 3 doubles per node.  Planar meshes (dim 2) use x
+ *    and y; z is carried through untouched.
+ *  - Element quality is the mean ratio, in (0, 1] for a valid element, 1 for
+ *    the regular element; an invalid (inverted or degenerate) element has
+ *    quality 0.
+ *  - Results are bit-identical for any number of OpenMP threads.
+ */
+#ifndef GETME_H
+#define GETME_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define GETME_VERSION_MAJOR 0
+#define GETME_VERSION_MINOR 1
+#define GETME_VERSION_PATCH 0
+#define GETME_VERSION_STRING "0.1.0"
+
+#if defined(__GNUC__) && !defined(GETME_STATIC)
+#define GETME_API __attribute__((visibility("default")))
+#else
+#define GETME_API
+#endif
+
+/* ------------------------------------------------------------------------ */
+/* Status codes                                                             */
+/* ------------------------------------------------------------------------ */
+
+typedef enum getme_status {
+    GETME_OK = 0,
+    GETME_ERR_ARGUMENT = 1,     /* NULL pointer, out-of-range value, bad name */
+    GETME_ERR_NOMEM = 2,        /* an allocation failed                       */
+    GETME_ERR_INVALID_MESH = 3, /* the input has invalid (inverted) elements  */
+    GETME_ERR_TOPOLOGY = 4,     /* node index out of range, repeated node ... */
+    GETME_ERR_STATE = 5,        /* call out of order (e.g. no elements yet)   */
+    GETME_ERR_CANCELLED = 6     /* the progress callback asked to stop        */
+} getme_status;
+
+/* A static English description of a status code ("invalid mesh", ...). */
+GETME_API const char *getme_status_string(getme_status status);
+
+/* Library version string, e.g. "0.1.0". */
+GETME_API const char *getme_version(void);
+
+/* ------------------------------------------------------------------------ */
+/* Element types and single-element functions                               */
+/* ------------------------------------------------------------------------ */
+
+typedef enum getme_elem_type {
+    GETME_TET = 0,
+    GETME_HEX = 1,
+    GETME_PRISM = 2,
+    GETME_PYRAMID = 3,
+    GETME_TRI = 4,
+    GETME_QUAD = 5,
+    GETME_NUM_TYPES = 6
+} getme_elem_type;
+
+/* Nodes per element (4, 8, 6, 5, 3, 4); 0 for an unknown type. */
+GETME_API int getme_type_num_nodes(getme_elem_type type);
+/* Topological dimension (3 for volume types, 2 for tri/quad); 0 if unknown. */
+GETME_API int getme_type_dim(getme_elem_type type);
+/* Lower-case name: "tet", "hex", "prism", "pyramid", "tri", "quad". */
+GETME_API const char *getme_type_name(getme_elem_type type);
+
+/*
+ * Mean ratio quality of one element with nodes xyz[3*i..3*i+2] in the node
+ * order above.  Returns a value in (0, 1] for a valid element and 0 for an
+ * invalid one (any node simplex with a non-positive determinant, or a
+ * non-finite coordinate).  Planar types read x and y only.
+ */
+GETME_API double getme_element_quality(getme_elem_type type, const double *xyz);
+
+/*
+ * One regularizing GETMe transformation of one element with parameter sigma
+ * (the paper uses 1.5), followed by scaling about the centroid so that the
+ * sum of edge lengths is preserved.  Writes the transformed nodes to out
+ * (same layout as xyz; z of planar types is copied).  Iterating it converges
+ * to the regular element of the type.  out may not alias xyz.
+ */
+GETME_API getme_status getme_element_transform(getme_elem_type type,
+                                               const double *xyz, double sigma,
+                                               double *out);
+
+/* ------------------------------------------------------------------------ */
+/* Mesh handle                                                              */
+/* ------------------------------------------------------------------------ */
+
+typedef struct getme_mesh getme_mesh;
+
+/*
+ * Create a mesh of dimension dim (3: volume types only, 2: tri/quad only)
+ * with num_nodes nodes.  The coordinates (3 doubles per node) are copied.
+ */
+GETME_API getme_status getme_mesh_create(getme_mesh **mesh, int dim,
+                                         int32_t num_nodes,
+                                         const double *coords);
+
+GETME_API void getme_mesh_free(getme_mesh *mesh);
+
+/* The message of the last failed call on this mesh ("" if none). */
+GETME_API const char *getme_mesh_error(const getme_mesh *mesh);
+
+/*
+ * Append count elements of one type.  conn holds count * num_nodes(type)
+ * zero-based node indices (copied).  region, optional (may be NULL), gives
+ * each element a region id (Gmsh physical volume, Abaqus section, CGNS zone
+ * or family...): faces between elements of different regions are interfaces
+ * for getme_mesh_fix_boundary().  May be called several times, also for the
+ * same type; elements are numbered in call order.
+ * Fails with GETME_ERR_TOPOLOGY on a node index out of range or repeated
+ * inside an element (the message names the element).
+ */
+GETME_API getme_status getme_mesh_add_elements(getme_mesh *mesh,
+                                               getme_elem_type type,
+                                               int32_t count,
+                                               const int32_t *conn,
+                                               const int32_t *region);
+
+GETME_API int getme_mesh_dim(const getme_mesh *mesh);
+GETME_API int32_t getme_mesh_num_nodes(const getme_mesh *mesh);
+GETME_API int32_t getme_mesh_num_elements(const getme_mesh *mesh);
+/* Number of elements of one type. */
+GETME_API int32_t getme_mesh_num_elements_of_type(const getme_mesh *mesh,
+                                                  getme_elem_type type);
+
+/* Read-only view of the current coordinates (3 per node, caller's order). */
+GETME_API const double *getme_mesh_coords(const getme_mesh *mesh);
+/* Copy the current coordinates into coords (3 * num_nodes doubles). */
+GETME_API getme_status getme_mesh_get_coords(const getme_mesh *mesh,
+                                             double *coords);
+/* Replace all coordinates (3 * num_nodes doubles). */
+GETME_API getme_status getme_mesh_set_coords(getme_mesh *mesh,
+                                             const double *coords);
+
+/* ---- fixed nodes -------------------------------------------------------- */
+
+/* Flags for getme_mesh_fix_boundary(). */
+enum {
+    GETME_FIX_SKIN = 1,      /* nodes of faces (edges in 2-D) with one element */
+    GETME_FIX_INTERFACES = 2 /* nodes of faces between different regions      */
+};
+
+/* Mark every node fixed[i] != 0 as fixed (adds to the current set). */
+GETME_API getme_status getme_mesh_set_fixed_mask(getme_mesh *mesh,
+                                                 const uint8_t *fixed);
+/* Mark count nodes (zero-based indices) as fixed (adds). */
+GETME_API getme_status getme_mesh_fix_nodes(getme_mesh *mesh, int32_t count,
+                                            const int32_t *nodes);
+/* Clear all fixed marks. */
+GETME_API void getme_mesh_clear_fixed(getme_mesh *mesh);
+/*
+ * Fix skin and/or interface nodes as requested by flags.  Also fixes every
+ * node not used by any element (it has nothing to be smoothed by).
+ * *num_fixed (may be NULL) receives the total number of fixed nodes after.
+ */
+GETME_API getme_status getme_mesh_fix_boundary(getme_mesh *mesh,
+                                               unsigned flags,
+                                               int32_t *num_fixed);
+/* Copy the fixed mask (num_nodes bytes, 1 = fixed) into fixed. */
+GETME_API getme_status getme_mesh_get_fixed_mask(const getme_mesh *mesh,
+                                                 uint8_t *fixed);
+GETME_API int32_t getme_mesh_num_fixed(const getme_mesh *mesh);
+
+/* ------------------------------------------------------------------------ */
+/* Quality statistics                                                       */
+/* ------------------------------------------------------------------------ */
+
+#define GETME_HIST_BINS 10 /* bins [0,0.1), [0.1,0.2), ... [0.9,1.0]       */
+#define GETME_MAX_REPORTED_INVALID 8
+
+typedef struct getme_quality_stats {
+    int64_t num_elements;  /* elements counted                               */
+    int64_t num_invalid;   /* elements with quality 0 (inverted/degenerate)  */
+    int64_t num_free;      /* elements with at least one free node          */
+    double q_min;          /* minimum quality over all counted elements      */
+    double q_min_star;     /* minimum over elements with a free node (q*min),
+                              1 if there is none                             */
+    double q_mean;         /* arithmetic mean quality                        */
+    double q_max;
+    int64_t num_below_04;  /* elements with q <= 0.4                          */
+    int64_t num_below_01;  /* elements with q <  0.1                          */
+    int64_t histogram[GETME_HIST_BINS]; /* valid elements per 0.1 bin         */
+    int32_t num_reported_invalid;       /* entries used in first_invalid     */
+    int32_t first_invalid[GETME_MAX_REPORTED_INVALID]; /* element indices   */
+} getme_quality_stats;
+
+/*
+ * Quality statistics of the elements of one type (type in 0..5), or of all
+ * elements (type = -1).  Uses the fixed mask for q_min_star.
+ */
+GETME_API getme_status getme_mesh_quality_stats(getme_mesh *mesh, int type,
+                                                getme_quality_stats *stats);
+
+/* Quality of every element (num_elements doubles) into q. */
+GETME_API getme_status getme_mesh_element_qualities(getme_mesh *mesh,
+                                                    double *q);
+
+/* ------------------------------------------------------------------------ */
+/* Smoothing parameters                                                     */
+/* ------------------------------------------------------------------------ */
+
+typedef enum getme_method {
+    GETME_METHOD_ADAPTIVE = 0,     /* GETMe adaptive (paper Fig. 3)        */
+    GETME_METHOD_SMART_LAPLACE = 1 /* smart Laplace, parallel form          */
+} getme_method;
+
+typedef enum getme_stage {
+    GETME_STAGE_MEAN = 1,   /* q_mean oriented first stage                    */
+    GETME_STAGE_MIN = 2,    /* q*_min oriented cycles                         */
+    GETME_STAGE_LAPLACE = 3 /* smart Laplace iteration                        */
+} getme_stage;
+
+/* What the progress callback sees after every iteration. */
+typedef struct getme_progress {
+    int iteration;          /* 1-based, over both stages                     */
+    getme_stage stage;
+    int cycle;              /* q*_min cycle number (0 in the first stage)    */
+    double q_min_star;      /* after this iteration                          */
+    double q_mean;
+    double threshold;       /* transformation threshold q_t in force          */
+    int32_t num_transformed;/* elements transformed this iteration            */
+    int32_t num_relaxed;    /* nodes that needed more than one relaxation step*/
+    double elapsed;         /* seconds since getme_smooth() started           */
+} getme_progress;
+
+/* Return 0 to go on, nonzero to stop (the mesh stays valid). */
+typedef int (*getme_progress_fn)(const getme_progress *progress,
+                                 void *user_data);
+
+#define GETME_MAX_RELAX 16
+
+typedef struct getme_params {
+    getme_method method;
+    int max_iter;              /* 1000: iterations over both stages          */
+    double tol;                /* 1e-4: stop stage 1 (and Laplace) when the
+                                  q_mean gain of an iteration is below it    */
+    double sigma;              /* 1.5: transformation parameter              */
+    int num_relax_mean;        /* relaxation table of the q_mean stage       */
+    double relax_mean[GETME_MAX_RELAX]; /* (1, 1/4, 1/16, 0)                 */
+    int num_relax_min;         /* relaxation table of the q*_min stage       */
+    double relax_min[GETME_MAX_RELAX];  /* (1/2, 1/4, 1/10, 1/100, 0)        */
+    int max_no_min_improve;    /* 5: iterations without q*_min gain that end
+                                  a q*_min cycle                             */
+    double threshold_fraction; /* position of q_t among the sorted qualities
+                                  of free elements (DetermineTransformation-
+                                  Threshold), see README for the choice      */
+    int keep_best;             /* 1: end on the coordinates with the best
+                                  q*_min seen in the q*_min stage            */
+    int num_threads;           /* 0: OpenMP default                          */
+    int renumber;              /* 1: reorder internally for cache locality
+                                  (results stay bit-identical for any thread
+                                  count; they may differ in the last bits
+                                  from renumber = 0)                          */
+    getme_progress_fn progress;/* optional, called after every iteration     */
+    void *progress_data;
+} getme_params;
+
+/* Fill params with the paper's defaults (Sec. 3.1) and ours for the rest. */
+GETME_API void getme_params_init(getme_params *params);
+
+/*
+ * Set a numeric parameter by name: "method" (0 adaptive, 1 laplace),
+ * "max_iter", "tol", "sigma", "max_no_min_improve", "threshold_fraction",
+ * "keep_best", "num_threads", "renumber".  Returns GETME_ERR_ARGUMENT for
+ * an unknown name or a value out of range.  For bindings (Python, CLI).
+ */
+GETME_API getme_status getme_params_set(getme_params *params, const char *name,
+                                        double value);
+/* Set a relaxation table: stage GETME_STAGE_MEAN or GETME_STAGE_MIN; values
+   descending in [0,1], n in 1..GETME_MAX_RELAX, last value must be 0. */
+GETME_API getme_status getme_params_set_relax(getme_params *params,
+                                              getme_stage stage, int n,
+                                              const double *values);
+/* sizeof(getme_params), for bindings that allocate it themselves. */
+GETME_API size_t getme_params_sizeof(void);
+
+/* ------------------------------------------------------------------------ */
+/* Smoothing                                                                */
+/* ------------------------------------------------------------------------ */
+
+typedef enum getme_stop_reason {
+    GETME_STOP_CONVERGED = 0, /* no q*_min gain in a whole cycle / tol hit  */
+    GETME_STOP_MAX_ITER = 1,
+    GETME_STOP_CANCELLED = 2,
+    GETME_STOP_NOTHING_TO_DO = 3 /* no free node                            */
+} getme_stop_reason;
+
+typedef struct getme_result {
+    int iterations;           /* total                                        */
+    int iterations_mean;      /* first (q_mean) stage, or Laplace iterations  */
+    int iterations_min;       /* q*_min stage                                 */
+    int cycles_min;           /* q*_min cycles                                */
+    double q_min_star_initial, q_mean_initial;
+    double q_min_star, q_mean, q_min;
+    double threshold;         /* last transformation threshold q_t           */
+    double seconds;           /* wall time of getme_smooth()                  */
+    getme_stop_reason stop_reason;
+} getme_result;
+
+/*
+ * Smooth the mesh in place with params (NULL: defaults).  The mesh must be
+ * valid: otherwise GETME_ERR_INVALID_MESH, with the count and the first
+ * invalid elements in the message, and nothing moves.  Fixed nodes never
+ * move (bit for bit); the output is valid.  result may be NULL.
+ * GETME_ERR_CANCELLED is returned (with a valid, partly smoothed mesh and a
+ * filled result) when the progress callback asks to stop.
+ */
+GETME_API getme_status getme_smooth(getme_mesh *mesh,
+                                    const getme_params *params,
+                                    getme_result *result);
+
+/*
+ * Distort the mesh for tests and benchmarks: rounds of random moves of free
+ * nodes (deterministic for a seed), each move a random vector of length up to
+ * amount times the node's shortest incident edge, kept only if every
+ * incident element stays valid.  Stops after max_rounds rounds or once
+ * q_mean <= target_q_mean (pass 0 to run all rounds).  Never invalidates.
+ */
+GETME_API getme_status getme_mesh_distort(getme_mesh *mesh, uint64_t seed,
+                                          double amount, double target_q_mean,
+                                          int max_rounds);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* GETME_H */

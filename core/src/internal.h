@@ -1,0 +1,92 @@
+/*
+ * internal.h -- libgetme's private declarations: the mesh handle layout and
+ * the element kernels shared by the core's files.  Not installed.
+ *
+ * Kernel conventions (quality.c, transform_*.c):
+ *  - an element's nodes are passed as nv consecutive xyz triples
+ *    (x[3*i+0..2]), in the public node order of getme.h;
+ *  - planar types (tri, quad) read and write x, y only and copy z;
+ *  - the kernels are pure functions: no allocation, no state, no I/O, so the
+ *    smoother can call them from any OpenMP thread.
+ */
+#ifndef GETME_INTERNAL_H
+#define GETME_INTERNAL_H
+
+#include "getme.h"
+
+#include <stdint.h>
+
+#define GETME_MAX_NV 8 /* nodes of the largest element type (hex) */
+
+/* ---- element tables (quality.c) ---------------------------------------- */
+
+/* Nodes per type, indexed by getme_elem_type. */
+extern const int getme__nv[GETME_NUM_TYPES];
+
+/* ---- kernels (quality.c) ------------------------------------------------ */
+
+/* Mean ratio of one element, 0 when invalid; see getme_element_quality(). */
+double getme__quality(int type, const double *x);
+
+double getme__quality_tet(const double *x);
+double getme__quality_hex(const double *x);
+double getme__quality_prism(const double *x);
+double getme__quality_pyramid(const double *x);
+double getme__quality_tri(const double *x);
+double getme__quality_quad(const double *x);
+
+/* ---- kernels (transform_tet.c, transform_dual.c, transform_polygon.c) --- */
+
+/* Transform + scale about the centroid to keep the sum of edge lengths. */
+void getme__transform(int type, const double *x, double sigma, double *out);
+
+void getme__transform_tet(const double *x, double sigma, double *out);
+void getme__transform_hex(const double *x, double sigma, double *out);
+void getme__transform_prism(const double *x, double sigma, double *out);
+void getme__transform_pyramid(const double *x, double sigma, double *out);
+void getme__transform_tri(const double *x, double sigma, double *out);
+void getme__transform_quad(const double *x, double sigma, double *out);
+
+/* ---- the mesh handle (mesh.c) ------------------------------------------- */
+
+/* One getme_mesh_add_elements() call: a homogeneous block of elements. */
+typedef struct getme_block {
+    int type;
+    int32_t first;   /* global index of its first element */
+    int32_t count;
+    int32_t *conn;   /* count * nv node indices */
+    int32_t *region; /* count region ids, or NULL */
+} getme_block;
+
+struct getme_mesh {
+    int dim;
+    int32_t num_nodes;
+    int32_t num_elements;
+    double *coords;   /* 3 * num_nodes, caller's node order */
+    uint8_t *fixed;   /* num_nodes, 1 = fixed */
+    getme_block *blocks;
+    int num_blocks, cap_blocks;
+    int mirror;       /* planar meshes: 1 if all elements are clockwise */
+    char error[512];  /* message of the last failure */
+};
+
+/* Record a printf-style message on the mesh and return status. */
+getme_status getme__fail(getme_mesh *mesh, getme_status status,
+                         const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/* Block holding global element e, and e's offset inside it. */
+const getme_block *getme__find_block(const getme_mesh *mesh, int32_t e,
+                                     int32_t *local);
+
+/* Gather element e's node coordinates into x (nv triples); planar meshes
+   that are mirrored get y negated.  Returns the element type. */
+int getme__gather(const getme_mesh *mesh, int32_t e, double *x);
+
+/* Decide mesh->mirror for planar meshes (majority orientation). */
+void getme__detect_orientation(getme_mesh *mesh);
+
+#endif /* GETME_INTERNAL_H */
