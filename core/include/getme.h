@@ -276,6 +276,10 @@ typedef struct getme_params {
     double relax_min[GETME_MAX_RELAX];  /* (1/2, 1/4, 1/10, 1/100, 0)        */
     int max_no_min_improve;    /* 5: iterations without q*_min gain that end
                                   a q*_min cycle                             */
+    double min_tol;            /* 1e-5: a q*_min gain counts only if it is
+                                  larger than this (without it, a nearly
+                                  regular mesh creeps up by 1e-9 per
+                                  iteration until max_iter)                  */
     double threshold_fraction; /* position of q_t among the sorted qualities
                                   of free elements (DetermineTransformation-
                                   Threshold), see README for the choice      */
@@ -295,7 +299,8 @@ GETME_API void getme_params_init(getme_params *params);
 
 /*
  * Set a numeric parameter by name: "method" (0 adaptive, 1 laplace),
- * "max_iter", "tol", "sigma", "max_no_min_improve", "threshold_fraction",
+ * "max_iter", "tol", "sigma", "max_no_min_improve", "min_tol",
+ * "threshold_fraction",
  * "keep_best", "num_threads", "renumber".  Returns GETME_ERR_ARGUMENT for
  * an unknown name or a value out of range.  For bindings (Python, CLI).
  */

@@ -121,10 +121,13 @@ getme_io_status getme_doc_fail(getme_doc *doc, getme_io_status status,
 
 /* ---- helpers for adapters ----------------------------------------------- */
 
-/* A unique temporary path next to out_path ("<dir>/.<name>.tmp.<pid>.<n>")
-   into buf.  Returns 0, or -1 if buf is too small. */
+/* Create an empty file with a unique name next to out_path
+   ("<dir>/.<name>.tmp.XXXXXX") and put its path into buf; the adapter
+   overwrites it.  Returns 0, or -1 (buf too small, directory not writable:
+   errno tells). */
 int getme_io_tmp_path(const char *out_path, char *buf, size_t size);
-/* Rename tmp to out (same directory); on failure remove tmp. 0 or -1. */
+/* Rename tmp to out (same directory); on failure remove tmp. 0 or -1.
+   Adapters that fail after getme_io_tmp_path must remove(tmp) themselves. */
 int getme_io_commit(const char *tmp, const char *out);
 /* 1 if a and b name the same existing file (used to refuse -o == input). */
 int getme_io_same_file(const char *a, const char *b);

@@ -1,0 +1,62 @@
+/*
+ * cli.h -- the getme command: shared pieces of its subcommands.
+ *
+ * Exit codes (stable, for scripts): 0 success, 1 internal error, 2 usage,
+ * 3 cannot read the input, 4 malformed input, 5 unsupported content,
+ * 6 invalid (inverted) elements in the input, 7 cannot write the output.
+ * They equal getme_io_status values.
+ */
+#ifndef GETME_CLI_H
+#define GETME_CLI_H
+
+#include "getme.h"
+#include "getme_formats.h"
+
+#include <stdio.h>
+
+enum { EXIT_USAGE = 2 };
+
+/* Gmsh-style log lines: "Info    : ...", "Warning : ...", "Error   : ...".
+   Info and warnings go to stdout (as Gmsh does), errors to stderr. */
+typedef struct cli_log {
+    int quiet;   /* only errors */
+    int verbose; /* more detail */
+} cli_log;
+
+void cli_info(const cli_log *log, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+void cli_warning(const cli_log *log, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+void cli_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+
+/* Gmsh-like histogram and summary of stats, one line each. */
+void cli_print_stats(const cli_log *log, const char *title,
+                     const getme_quality_stats *s);
+
+/* Parse helpers: return 0 on success, print an error and return -1. */
+int cli_parse_int(const char *opt, const char *s, long min, long max, long *out);
+int cli_parse_double(const char *opt, const char *s, double *out);
+
+/* Mesh summary: "195070 tets, 12 prisms; 37012 nodes (8123 fixed)". */
+void cli_describe_mesh(getme_mesh *mesh, char *buf, size_t size);
+
+int cli_smooth(int argc, char **argv);
+int cli_quality(int argc, char **argv);
+int cli_distort(int argc, char **argv);
+/* `getme gmsh ...` (cmd_gmsh.c, present when the Gmsh plugin is built). */
+int getme_cli_gmsh(int argc, char **argv);
+
+/* Report JSON (report.c). */
+typedef struct cli_history {
+    getme_progress *items;
+    int count, cap;
+} cli_history;
+
+int cli_write_report(const char *path, const char *input, const char *output,
+                     const getme_params *params, getme_mesh *mesh,
+                     const getme_quality_stats *before,
+                     const getme_quality_stats *after,
+                     const getme_result *result, const cli_history *history,
+                     const char *format_name);
+
+#endif /* GETME_CLI_H */

@@ -1,0 +1,108 @@
+/*
+ * log.c -- Gmsh-style log lines and common parsing for the getme command.
+ */
+#include "cli.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void vline(FILE *f, const char *tag, const char *fmt, va_list ap)
+{
+    fputs(tag, f);
+    vfprintf(f, fmt, ap);
+    fputc('\n', f);
+    fflush(f);
+}
+
+void cli_info(const cli_log *log, const char *fmt, ...)
+{
+    if (log && log->quiet)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    vline(stdout, "Info    : ", fmt, ap);
+    va_end(ap);
+}
+
+void cli_warning(const cli_log *log, const char *fmt, ...)
+{
+    if (log && log->quiet)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    vline(stdout, "Warning : ", fmt, ap);
+    va_end(ap);
+}
+
+void cli_error(const char *fmt, ...)
+{
+    fflush(stdout);
+    va_list ap;
+    va_start(ap, fmt);
+    vline(stderr, "Error   : ", fmt, ap);
+    va_end(ap);
+}
+
+void cli_print_stats(const cli_log *log, const char *title,
+                     const getme_quality_stats *s)
+{
+    cli_info(log, "%s: q*min %.4f, qmin %.4f, qmean %.4f, %lld elements "
+                  "(%lld with q <= 0.4, %lld with q < 0.1, %lld invalid)",
+             title, s->q_min_star, s->q_min, s->q_mean,
+             (long long)s->num_elements, (long long)s->num_below_04,
+             (long long)s->num_below_01, (long long)s->num_invalid);
+    if (log && !log->verbose)
+        return;
+    for (int b = 0; b < GETME_HIST_BINS; b++)
+        cli_info(log, "%.2f < quality < %.2f : %9lld elements",
+                 b / (double)GETME_HIST_BINS, (b + 1) / (double)GETME_HIST_BINS,
+                 (long long)s->histogram[b]);
+}
+
+int cli_parse_int(const char *opt, const char *s, long min, long max, long *out)
+{
+    char *end;
+    errno = 0;
+    long v = s ? strtol(s, &end, 10) : 0;
+    if (!s || !*s || *end || errno || v < min || v > max) {
+        cli_error("%s expects an integer in [%ld, %ld], got '%s'", opt, min,
+                  max, s ? s : "");
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+int cli_parse_double(const char *opt, const char *s, double *out)
+{
+    char *end;
+    errno = 0;
+    double v = s ? strtod(s, &end) : 0.0;
+    if (!s || !*s || *end || errno || !isfinite(v)) {
+        cli_error("%s expects a number, got '%s'", opt, s ? s : "");
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+void cli_describe_mesh(getme_mesh *mesh, char *buf, size_t size)
+{
+    size_t len = 0;
+    buf[0] = '\0';
+    for (int t = 0; t < GETME_NUM_TYPES; t++) {
+        int32_t n = getme_mesh_num_elements_of_type(mesh, (getme_elem_type)t);
+        if (n && len < size)
+            len += (size_t)snprintf(buf + len, size - len, "%s%d %s%s",
+                                    len ? ", " : "", (int)n,
+                                    getme_type_name((getme_elem_type)t),
+                                    n == 1 ? "" : "s");
+    }
+    if (len < size)
+        snprintf(buf + len, size - len, "; %d nodes (%d fixed)",
+                 (int)getme_mesh_num_nodes(mesh), (int)getme_mesh_num_fixed(mesh));
+}

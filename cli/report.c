@@ -1,0 +1,106 @@
+/*
+ * report.c -- the JSON report of `getme smooth --report FILE`: what the
+ * benchmark and scripts read (statistics, iterations, per-iteration
+ * history for the paper's quality-over-time plots).
+ */
+#include "cli.h"
+
+#include <stdio.h>
+
+/* JSON string with the characters JSON requires escaped. */
+static void json_string(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; s && *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\')
+            fprintf(f, "\\%c", c);
+        else if (c < 0x20)
+            fprintf(f, "\\u%04x", c);
+        else
+            fputc(c, f);
+    }
+    fputc('"', f);
+}
+
+static void json_stats(FILE *f, const getme_quality_stats *s)
+{
+    fprintf(f, "{\"elements\": %lld, \"invalid\": %lld, \"q_min_star\": %.17g, "
+               "\"q_min\": %.17g, \"q_mean\": %.17g, \"q_max\": %.17g, "
+               "\"below_0_4\": %lld, \"below_0_1\": %lld, \"histogram\": [",
+            (long long)s->num_elements, (long long)s->num_invalid,
+            s->q_min_star, s->q_min, s->q_mean, s->q_max,
+            (long long)s->num_below_04, (long long)s->num_below_01);
+    for (int b = 0; b < GETME_HIST_BINS; b++)
+        fprintf(f, "%s%lld", b ? ", " : "", (long long)s->histogram[b]);
+    fputs("]}", f);
+}
+
+static const char *stop_name(getme_stop_reason r)
+{
+    switch (r) {
+    case GETME_STOP_CONVERGED: return "converged";
+    case GETME_STOP_MAX_ITER: return "max_iter";
+    case GETME_STOP_CANCELLED: return "cancelled";
+    case GETME_STOP_NOTHING_TO_DO: return "nothing_to_do";
+    }
+    return "unknown";
+}
+
+int cli_write_report(const char *path, const char *input, const char *output,
+                     const getme_params *p, getme_mesh *mesh,
+                     const getme_quality_stats *before,
+                     const getme_quality_stats *after, const getme_result *r,
+                     const cli_history *h, const char *format_name)
+{
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return -1;
+    fputs("{\n  \"getme_version\": ", f);
+    json_string(f, getme_version());
+    fputs(",\n  \"input\": ", f);
+    json_string(f, input);
+    fputs(",\n  \"output\": ", f);
+    json_string(f, output);
+    fputs(",\n  \"format\": ", f);
+    json_string(f, format_name);
+    fprintf(f, ",\n  \"method\": \"%s\",\n",
+            p->method == GETME_METHOD_ADAPTIVE ? "getme" : "laplace");
+    fprintf(f, "  \"params\": {\"max_iter\": %d, \"tol\": %.17g, \"sigma\": %.17g, "
+               "\"threshold_fraction\": %.17g, \"max_no_min_improve\": %d, \"min_tol\": %.17g, "
+               "\"keep_best\": %d, \"num_threads\": %d, \"renumber\": %d},\n",
+            p->max_iter, p->tol, p->sigma, p->threshold_fraction,
+            p->max_no_min_improve, p->min_tol, p->keep_best, p->num_threads, p->renumber);
+    fprintf(f, "  \"nodes\": %d,\n  \"fixed_nodes\": %d,\n  \"elements\": {",
+            (int)getme_mesh_num_nodes(mesh), (int)getme_mesh_num_fixed(mesh));
+    int first = 1;
+    for (int t = 0; t < GETME_NUM_TYPES; t++) {
+        int32_t n = getme_mesh_num_elements_of_type(mesh, (getme_elem_type)t);
+        if (!n)
+            continue;
+        fprintf(f, "%s\"%s\": %d", first ? "" : ", ",
+                getme_type_name((getme_elem_type)t), (int)n);
+        first = 0;
+    }
+    fputs("},\n  \"before\": ", f);
+    json_stats(f, before);
+    fputs(",\n  \"after\": ", f);
+    json_stats(f, after);
+    fprintf(f, ",\n  \"iterations\": {\"total\": %d, \"mean_stage\": %d, "
+               "\"min_stage\": %d, \"min_cycles\": %d},\n",
+            r->iterations, r->iterations_mean, r->iterations_min, r->cycles_min);
+    fprintf(f, "  \"seconds\": %.6f,\n  \"stop_reason\": \"%s\",\n",
+            r->seconds, stop_name(r->stop_reason));
+    fputs("  \"history\": [", f);
+    for (int i = 0; i < h->count; i++) {
+        const getme_progress *e = &h->items[i];
+        fprintf(f, "%s\n    {\"iteration\": %d, \"stage\": %d, \"cycle\": %d, "
+                   "\"q_min_star\": %.17g, \"q_mean\": %.17g, \"threshold\": %.17g, "
+                   "\"transformed\": %d, \"relaxed\": %d, \"elapsed\": %.6f}",
+                i ? "," : "", e->iteration, (int)e->stage, e->cycle,
+                e->q_min_star, e->q_mean, e->threshold, (int)e->num_transformed,
+                (int)e->num_relaxed, e->elapsed);
+    }
+    fputs("\n  ]\n}\n", f);
+    return fclose(f) == 0 ? 0 : -1;
+}

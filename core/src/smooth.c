@@ -1,0 +1,226 @@
+/*
+ * smooth.c -- getme_smooth(): check the input, build the workspace, run a
+ * method, write the coordinates back, fill the result.
+ */
+#include "smooth_internal.h"
+
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+getme_status getme__run_alloc(getme_run *run)
+{
+    const getme_ws *ws = run->ws;
+    size_t nn = (size_t)(ws->nn ? ws->nn : 1), ne = (size_t)(ws->ne ? ws->ne : 1);
+    run->q = malloc(ne * sizeof *run->q);
+    run->acc = calloc(nn * 4, sizeof *run->acc);
+    run->xnew = malloc(nn * 3 * sizeof *run->xnew);
+    run->in_t = calloc(nn, 1);
+    run->flag = calloc(nn, 1);
+    run->ridx = calloc(nn, 1);
+    run->eflag = calloc(ne, 1);
+    run->nodes = malloc(nn * sizeof *run->nodes);
+    run->elems = malloc(ne * sizeof *run->elems);
+    if (!run->q || !run->acc || !run->xnew || !run->in_t || !run->flag ||
+        !run->ridx || !run->eflag || !run->nodes || !run->elems)
+        return GETME_ERR_NOMEM;
+    memcpy(run->xnew, ws->x, (size_t)ws->nn * 3 * sizeof *run->xnew);
+    return GETME_OK;
+}
+
+void getme__run_free(getme_run *run)
+{
+    free(run->q);
+    free(run->acc);
+    free(run->xnew);
+    free(run->in_t);
+    free(run->flag);
+    free(run->ridx);
+    free(run->eflag);
+    free(run->nodes);
+    free(run->elems);
+}
+
+/* Chunked, order-preserving compaction: the same list for any thread
+   count. */
+#define COLLECT_CHUNK 16384
+
+static int32_t compact(const uint8_t *flag, int32_t n, int32_t *out, int nt)
+{
+    int32_t nc = (n + COLLECT_CHUNK - 1) / COLLECT_CHUNK;
+    int32_t *cnt = malloc(((size_t)nc + 1) * sizeof *cnt);
+    if (!cnt) { /* serial fallback gives the same list */
+        int32_t m = 0;
+        for (int32_t i = 0; i < n; i++)
+            if (flag[i])
+                out[m++] = i;
+        return m;
+    }
+#pragma omp parallel for schedule(static) num_threads(nt)
+    for (int32_t c = 0; c < nc; c++) {
+        int32_t end = (c + 1) * COLLECT_CHUNK < n ? (c + 1) * COLLECT_CHUNK : n;
+        int32_t m = 0;
+        for (int32_t i = c * COLLECT_CHUNK; i < end; i++)
+            m += flag[i] != 0;
+        cnt[c + 1] = m;
+    }
+    cnt[0] = 0;
+    for (int32_t c = 0; c < nc; c++)
+        cnt[c + 1] += cnt[c];
+#pragma omp parallel for schedule(static) num_threads(nt)
+    for (int32_t c = 0; c < nc; c++) {
+        int32_t end = (c + 1) * COLLECT_CHUNK < n ? (c + 1) * COLLECT_CHUNK : n;
+        int32_t m = cnt[c];
+        for (int32_t i = c * COLLECT_CHUNK; i < end; i++)
+            if (flag[i])
+                out[m++] = i;
+    }
+    int32_t total = cnt[nc];
+    free(cnt);
+    return total;
+}
+
+void getme__collect(getme_run *run)
+{
+    const getme_ws *ws = run->ws;
+    run->num_nodes = compact(run->in_t, ws->nn, run->nodes, ws->nt);
+#pragma omp parallel for schedule(static) num_threads(ws->nt)
+    for (int32_t e = 0; e < ws->ne; e++) {
+        int t = getme__ws_type(ws, e);
+        const int32_t *c = getme__ws_nodes(ws, t, e);
+        uint8_t f = 0;
+        for (int i = 0; i < getme__nv[t]; i++)
+            f |= run->in_t[c[i]];
+        run->eflag[e] = f;
+    }
+    run->num_elems = compact(run->eflag, ws->ne, run->elems, ws->nt);
+}
+
+void getme__reset_nodes(getme_run *run)
+{
+#pragma omp parallel for schedule(static) num_threads(run->ws->nt)
+    for (int32_t k = 0; k < run->num_nodes; k++) {
+        int32_t i = run->nodes[k];
+        run->in_t[i] = 0;
+        double *a = run->acc + 4 * (int64_t)i;
+        a[0] = a[1] = a[2] = a[3] = 0.0;
+    }
+}
+
+int getme__report(getme_run *run, int iteration, getme_stage stage, int cycle,
+                  double q_min_star, double q_mean, double threshold,
+                  int32_t num_transformed, int32_t num_relaxed)
+{
+    const getme_params *p = run->params;
+    if (!p->progress)
+        return 0;
+    getme_progress info;
+    info.iteration = iteration;
+    info.stage = stage;
+    info.cycle = cycle;
+    info.q_min_star = q_min_star;
+    info.q_mean = q_mean;
+    info.threshold = threshold;
+    info.num_transformed = num_transformed;
+    info.num_relaxed = num_relaxed;
+    info.elapsed = omp_get_wtime() - run->t0;
+    return p->progress(&info, p->progress_data);
+}
+
+/* The input must be valid: name the first invalid elements if not. */
+static getme_status check_valid(getme_mesh *mesh, const getme_ws *ws,
+                                const double *q)
+{
+    int64_t bad = 0;
+    int32_t first[GETME_MAX_REPORTED_INVALID];
+    int nfirst = 0;
+    for (int32_t e = 0; e < ws->ne; e++)
+        if (!(q[e] > 0.0))
+            bad++;
+    if (bad == 0)
+        return GETME_OK;
+    /* Report in the caller's numbering, smallest indices first. */
+    for (int32_t k = 0; k < ws->ne && nfirst < GETME_MAX_REPORTED_INVALID; k++) {
+        double x[3 * GETME_MAX_NV];
+        int t = getme__gather(mesh, k, x);
+        if (!(getme__quality(t, x) > 0.0))
+            first[nfirst++] = k;
+    }
+    char list[160] = "";
+    size_t len = 0;
+    for (int i = 0; i < nfirst && len < sizeof list; i++)
+        len += (size_t)snprintf(list + len, sizeof list - len, "%s%d",
+                                i ? ", " : "", (int)first[i]);
+    return getme__fail(mesh, GETME_ERR_INVALID_MESH,
+                       "%lld invalid (inverted or degenerate) element%s in "
+                       "the input, first: %s%s",
+                       (long long)bad, bad == 1 ? "" : "s", list,
+                       bad > nfirst ? ", ..." : "");
+}
+
+getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
+                          getme_result *result)
+{
+    getme_params defaults;
+    getme_result local;
+    if (!mesh)
+        return GETME_ERR_ARGUMENT;
+    if (!params) {
+        getme_params_init(&defaults);
+        params = &defaults;
+    }
+    if (!result)
+        result = &local;
+    memset(result, 0, sizeof *result);
+    mesh->error[0] = '\0';
+    double t0 = omp_get_wtime();
+    if (mesh->num_elements == 0)
+        return getme__fail(mesh, GETME_ERR_STATE, "the mesh has no elements");
+    const char *problem = getme__params_problem(params);
+    if (problem)
+        return getme__fail(mesh, GETME_ERR_ARGUMENT, "parameters: %s", problem);
+    int nt = params->num_threads > 0 ? params->num_threads
+                                     : omp_get_max_threads();
+
+    getme_ws ws;
+    getme_status st = getme__ws_build(&ws, mesh, params->renumber, nt);
+    if (st != GETME_OK)
+        return getme__fail(mesh, st, "out of memory building the workspace");
+    getme_run run;
+    memset(&run, 0, sizeof run);
+    run.ws = &ws;
+    run.params = params;
+    run.result = result;
+    run.t0 = t0;
+    if ((st = getme__run_alloc(&run)) != GETME_OK) {
+        getme__fail(mesh, st, "out of memory for %d nodes, %d elements",
+                    (int)ws.nn, (int)ws.ne);
+        goto done;
+    }
+    getme__ws_qualities(&ws, run.q);
+    if ((st = check_valid(mesh, &ws, run.q)) != GETME_OK)
+        goto done;
+    getme__ws_summary(&ws, run.q, &result->q_mean_initial,
+                      &result->q_min_star_initial, NULL);
+    if (ws.num_free_nodes == 0) {
+        getme__ws_summary(&ws, run.q, &result->q_mean, &result->q_min_star,
+                          &result->q_min);
+        result->stop_reason = GETME_STOP_NOTHING_TO_DO;
+        goto done;
+    }
+    st = params->method == GETME_METHOD_SMART_LAPLACE ? getme__laplace(&run)
+                                                      : getme__adaptive(&run);
+    if (st == GETME_OK || st == GETME_ERR_CANCELLED)
+        getme__ws_store(&ws, mesh);
+    if (st == GETME_ERR_CANCELLED)
+        getme__fail(mesh, st, "stopped by the progress callback after "
+                              "%d iterations", result->iterations);
+    else if (st != GETME_OK)
+        getme__fail(mesh, st, "%s", getme_status_string(st));
+done:
+    getme__run_free(&run);
+    getme__ws_free(&ws);
+    result->seconds = omp_get_wtime() - t0;
+    return st;
+}

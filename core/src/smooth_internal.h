@@ -1,0 +1,62 @@
+/*
+ * smooth_internal.h -- pieces shared by the smoothing methods
+ * (getme_adaptive.c, laplace.c) and their driver (smooth.c).
+ */
+#ifndef GETME_SMOOTH_INTERNAL_H
+#define GETME_SMOOTH_INTERNAL_H
+
+#include "workspace.h"
+
+/* Scratch arrays of one smoothing run, allocated once. */
+typedef struct getme_run {
+    getme_ws *ws;
+    const getme_params *params;
+    getme_result *result;
+    double t0;          /* omp_get_wtime() at start                        */
+    double *q;          /* ne: quality at ws->x                            */
+    double *acc;        /* 4 * nn: weighted position sums and weight sums,
+                           then (after normalising) the target p-hat        */
+    double *xnew;       /* 3 * nn: trial coordinates; equals ws->x outside
+                           the relaxation step                              */
+    uint8_t *in_t;      /* nn: node is in I_T (moves this iteration)        */
+    uint8_t *flag;      /* nn: scratch flag, all zero between uses          */
+    uint8_t *ridx;      /* nn: index into the relaxation table              */
+    uint8_t *eflag;     /* ne: scratch flag                                 */
+    int32_t *nodes;     /* nn: compacted list of I_T                        */
+    int32_t *elems;     /* ne: compacted list of elements touching I_T      */
+    int32_t num_nodes, num_elems;
+} getme_run;
+
+getme_status getme__run_alloc(getme_run *run);
+void getme__run_free(getme_run *run);
+
+/* Eq. 9 weight of element e (type t) from the qualities q. */
+double getme__weight(const getme_ws *ws, const double *q, int t, int32_t e);
+
+/* Build run->nodes from run->in_t and run->elems (elements with a node in
+   I_T), both ascending; deterministic. */
+void getme__collect(getme_run *run);
+
+/*
+ * IterativeNodeRelaxation (paper Sec. 2.2, Eq. 10): move every node of
+ * run->nodes to (1 - rho) x + rho p-hat (p-hat in run->acc, stride 4) with
+ * rho from table R, re-evaluate the elements of run->elems, and step the
+ * nodes of invalid elements down the table until no element is invalid.
+ * R's last entry is 0, so a node can always go back to where it was and the
+ * mesh stays valid.  Updates ws->x and run->q; returns how many nodes
+ * ended beyond the table's first entry.
+ */
+int32_t getme__relax(getme_run *run, const double *R, int nR);
+
+/* Clear run->in_t, run->acc for the nodes of run->nodes. */
+void getme__reset_nodes(getme_run *run);
+
+/* Report progress; returns nonzero if the callback asks to stop. */
+int getme__report(getme_run *run, int iteration, getme_stage stage, int cycle,
+                  double q_min_star, double q_mean, double threshold,
+                  int32_t num_transformed, int32_t num_relaxed);
+
+getme_status getme__adaptive(getme_run *run);
+getme_status getme__laplace(getme_run *run);
+
+#endif /* GETME_SMOOTH_INTERNAL_H */

@@ -1,0 +1,419 @@
+/*
+ * workspace.c -- build the smoother's working copy of a mesh: locality
+ * order, node stars, colour-blocks (see workspace.h for why).
+ */
+#include "workspace.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Elements per colour-block.  Small enough that a block's nodes stay in
+   cache and there are many blocks per colour; large enough that the
+   per-block overhead vanishes.  Fixed: results must not depend on it
+   changing with the thread count. */
+#define BLOCK_SIZE 512
+/* Colours available in the per-node bit masks; blocks that find all of
+   them taken go to one extra colour processed serially. */
+#define MAX_COLOURS 64
+
+void getme__ws_free(getme_ws *ws)
+{
+    free(ws->conn);
+    free(ws->elem_orig);
+    free(ws->node_orig);
+    free(ws->x);
+    free(ws->fixed);
+    free(ws->free_elem);
+    free(ws->star_ptr);
+    free(ws->star);
+    free(ws->block_start);
+    free(ws->colour_ptr);
+    free(ws->colour_blocks);
+    memset(ws, 0, sizeof *ws);
+}
+
+/* Spread the low 10 bits of v to every third bit. */
+static uint32_t spread3(uint32_t v)
+{
+    v &= 0x3ff;
+    v = (v | (v << 16)) & 0x030000ff;
+    v = (v | (v << 8)) & 0x0300f00f;
+    v = (v | (v << 4)) & 0x030c30c3;
+    v = (v | (v << 2)) & 0x09249249;
+    return v;
+}
+
+/* Stable LSD radix sort of idx[0..n) by key (two 16-bit passes). */
+static int radix_sort(uint32_t *key, int32_t *idx, int32_t n)
+{
+    uint32_t *k2 = malloc((size_t)(n ? n : 1) * sizeof *k2);
+    int32_t *i2 = malloc((size_t)(n ? n : 1) * sizeof *i2);
+    int64_t *cnt = malloc(65537 * sizeof *cnt);
+    if (!k2 || !i2 || !cnt) {
+        free(k2), free(i2), free(cnt);
+        return -1;
+    }
+    for (int shift = 0; shift < 32; shift += 16) {
+        memset(cnt, 0, 65537 * sizeof *cnt);
+        for (int32_t i = 0; i < n; i++)
+            cnt[((key[i] >> shift) & 0xffff) + 1]++;
+        for (int d = 0; d < 65536; d++)
+            cnt[d + 1] += cnt[d];
+        for (int32_t i = 0; i < n; i++) {
+            int64_t pos = cnt[(key[i] >> shift) & 0xffff]++;
+            k2[pos] = key[i];
+            i2[pos] = idx[i];
+        }
+        memcpy(key, k2, (size_t)n * sizeof *key);
+        memcpy(idx, i2, (size_t)n * sizeof *idx);
+    }
+    free(k2), free(i2), free(cnt);
+    return 0;
+}
+
+/* Fill ws->elem_orig: internal element order (grouped by type, Morton order
+   inside a type when renumber is set). */
+static getme_status order_elements(getme_ws *ws, const getme_mesh *mesh,
+                                   int renumber)
+{
+    int32_t count[GETME_NUM_TYPES] = {0};
+    for (int b = 0; b < mesh->num_blocks; b++)
+        count[mesh->blocks[b].type] += mesh->blocks[b].count;
+    ws->tstart[0] = 0;
+    for (int t = 0; t < GETME_NUM_TYPES; t++)
+        ws->tstart[t + 1] = ws->tstart[t] + count[t];
+    int32_t fill[GETME_NUM_TYPES];
+    for (int t = 0; t < GETME_NUM_TYPES; t++)
+        fill[t] = ws->tstart[t];
+    for (int b = 0; b < mesh->num_blocks; b++) {
+        const getme_block *bl = &mesh->blocks[b];
+        for (int32_t e = 0; e < bl->count; e++)
+            ws->elem_orig[fill[bl->type]++] = bl->first + e;
+    }
+    if (!renumber || ws->ne == 0)
+        return GETME_OK;
+
+    /* Morton key of each element centroid in the mesh bounding box. */
+    double lo[3] = {INFINITY, INFINITY, INFINITY};
+    double hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int32_t i = 0; i < mesh->num_nodes; i++)
+        for (int d = 0; d < 3; d++) {
+            double v = mesh->coords[3 * (int64_t)i + d];
+            lo[d] = v < lo[d] ? v : lo[d];
+            hi[d] = v > hi[d] ? v : hi[d];
+        }
+    double scale[3];
+    for (int d = 0; d < 3; d++)
+        scale[d] = hi[d] > lo[d] ? 1023.0 / (hi[d] - lo[d]) : 0.0;
+    uint32_t *key = malloc((size_t)ws->ne * sizeof *key);
+    if (!key)
+        return GETME_ERR_NOMEM;
+    for (int32_t k = 0; k < ws->ne; k++) {
+        double x[3 * GETME_MAX_NV];
+        int t = getme__gather(mesh, ws->elem_orig[k], x);
+        int nv = getme__nv[t];
+        uint32_t code = 0;
+        for (int d = 0; d < 3; d++) {
+            double c = 0.0;
+            for (int i = 0; i < nv; i++)
+                c += x[3 * i + d];
+            c = c / nv;
+            if (d == 1 && mesh->mirror == 1)
+                c = -c; /* gather mirrored y; the box is unmirrored */
+            double s = (c - lo[d]) * scale[d];
+            uint32_t q = s <= 0.0 ? 0u : s >= 1023.0 ? 1023u : (uint32_t)s;
+            code |= spread3(q) << d;
+        }
+        key[k] = code;
+    }
+    /* Sort inside each type range; stable, so ties keep the caller order. */
+    for (int t = 0; t < GETME_NUM_TYPES; t++) {
+        int32_t a = ws->tstart[t], n = ws->tstart[t + 1] - a;
+        if (n > 1 && radix_sort(key + a, ws->elem_orig + a, n) != 0) {
+            free(key);
+            return GETME_ERR_NOMEM;
+        }
+    }
+    free(key);
+    return GETME_OK;
+}
+
+/* Copy connectivity in internal element order and number the nodes. */
+static getme_status number_nodes(getme_ws *ws, const getme_mesh *mesh,
+                                 int renumber)
+{
+    int64_t total = 0;
+    for (int t = 0; t < GETME_NUM_TYPES; t++) {
+        ws->coff[t] = total;
+        total += (int64_t)(ws->tstart[t + 1] - ws->tstart[t]) * getme__nv[t];
+    }
+    ws->conn = malloc((size_t)(total ? total : 1) * sizeof *ws->conn);
+    int32_t *newid = malloc((size_t)(ws->nn ? ws->nn : 1) * sizeof *newid);
+    if (!ws->conn || !newid) {
+        free(newid);
+        return GETME_ERR_NOMEM;
+    }
+    for (int32_t i = 0; i < ws->nn; i++)
+        newid[i] = renumber ? -1 : i;
+    int32_t next = 0;
+    for (int t = 0; t < GETME_NUM_TYPES; t++) {
+        int nv = getme__nv[t];
+        for (int32_t e = ws->tstart[t]; e < ws->tstart[t + 1]; e++) {
+            int32_t local;
+            const getme_block *bl =
+                getme__find_block(mesh, ws->elem_orig[e], &local);
+            const int32_t *src = bl->conn + (int64_t)local * nv;
+            int32_t *dst = ws->conn + ws->coff[t] +
+                           (int64_t)(e - ws->tstart[t]) * nv;
+            for (int i = 0; i < nv; i++) {
+                if (newid[src[i]] < 0)
+                    newid[src[i]] = next++;
+                dst[i] = newid[src[i]];
+            }
+        }
+    }
+    if (renumber) /* nodes used by no element go last, in caller order */
+        for (int32_t i = 0; i < ws->nn; i++)
+            if (newid[i] < 0)
+                newid[i] = next++;
+    for (int32_t i = 0; i < ws->nn; i++)
+        ws->node_orig[newid[i]] = i;
+    free(newid);
+    return GETME_OK;
+}
+
+static getme_status build_stars(getme_ws *ws)
+{
+    ws->star_ptr = calloc((size_t)ws->nn + 1, sizeof *ws->star_ptr);
+    int64_t total = ws->coff[GETME_NUM_TYPES - 1] +
+                    (int64_t)(ws->tstart[GETME_NUM_TYPES] -
+                              ws->tstart[GETME_NUM_TYPES - 1]) *
+                        getme__nv[GETME_NUM_TYPES - 1];
+    ws->star = malloc((size_t)(total ? total : 1) * sizeof *ws->star);
+    if (!ws->star_ptr || !ws->star)
+        return GETME_ERR_NOMEM;
+    for (int64_t k = 0; k < total; k++)
+        ws->star_ptr[ws->conn[k] + 1]++;
+    ws->max_star = 0;
+    for (int32_t i = 0; i < ws->nn; i++) {
+        int64_t c = ws->star_ptr[i + 1];
+        if (c > ws->max_star)
+            ws->max_star = (int32_t)c;
+        ws->star_ptr[i + 1] += ws->star_ptr[i];
+    }
+    int64_t *pos = malloc((size_t)(ws->nn ? ws->nn : 1) * sizeof *pos);
+    if (!pos)
+        return GETME_ERR_NOMEM;
+    memcpy(pos, ws->star_ptr, (size_t)ws->nn * sizeof *pos);
+    /* Elements in ascending order, so every star comes out sorted. */
+    for (int t = 0; t < GETME_NUM_TYPES; t++) {
+        int nv = getme__nv[t];
+        for (int32_t e = ws->tstart[t]; e < ws->tstart[t + 1]; e++) {
+            const int32_t *c = getme__ws_nodes(ws, t, e);
+            for (int i = 0; i < nv; i++)
+                ws->star[pos[c[i]]++] = e;
+        }
+    }
+    free(pos);
+    return GETME_OK;
+}
+
+/* Cut each type range into blocks and colour them greedily in order. */
+static getme_status colour_blocks(getme_ws *ws)
+{
+    int32_t nb = 0;
+    for (int t = 0; t < GETME_NUM_TYPES; t++) {
+        int32_t n = ws->tstart[t + 1] - ws->tstart[t];
+        nb += (n + BLOCK_SIZE - 1) / BLOCK_SIZE;
+    }
+    ws->num_blocks = nb;
+    ws->block_start = malloc(((size_t)nb + 1) * sizeof *ws->block_start);
+    int32_t *colour = malloc((size_t)(nb ? nb : 1) * sizeof *colour);
+    uint64_t *mask = calloc((size_t)(ws->nn ? ws->nn : 1), sizeof *mask);
+    ws->colour_ptr = calloc(MAX_COLOURS + 2, sizeof *ws->colour_ptr);
+    ws->colour_blocks = malloc((size_t)(nb ? nb : 1) * sizeof(int32_t));
+    if (!ws->block_start || !colour || !mask || !ws->colour_ptr ||
+        !ws->colour_blocks) {
+        free(colour), free(mask);
+        return GETME_ERR_NOMEM;
+    }
+    int32_t b = 0;
+    for (int t = 0; t < GETME_NUM_TYPES; t++)
+        for (int32_t e = ws->tstart[t]; e < ws->tstart[t + 1]; e += BLOCK_SIZE)
+            ws->block_start[b++] = e;
+    ws->block_start[nb] = ws->ne;
+
+    int used_serial = 0, max_colour = -1;
+    for (b = 0; b < nb; b++) {
+        uint64_t forbidden = 0;
+        int32_t e0 = ws->block_start[b], e1 = ws->block_start[b + 1];
+        int t = getme__ws_type(ws, e0);
+        int nv = getme__nv[t];
+        for (int32_t e = e0; e < e1; e++) {
+            const int32_t *c = getme__ws_nodes(ws, t, e);
+            for (int i = 0; i < nv; i++)
+                forbidden |= mask[c[i]];
+        }
+        int col = MAX_COLOURS;
+        if (~forbidden)
+            col = __builtin_ctzll(~forbidden);
+        colour[b] = col;
+        if (col == MAX_COLOURS) {
+            used_serial = 1;
+            continue; /* serial blocks run alone: no mask bit needed */
+        }
+        if (col > max_colour)
+            max_colour = col;
+        uint64_t bit = (uint64_t)1 << col;
+        for (int32_t e = e0; e < e1; e++) {
+            const int32_t *c = getme__ws_nodes(ws, t, e);
+            for (int i = 0; i < nv; i++)
+                mask[c[i]] |= bit;
+        }
+    }
+    free(mask);
+    ws->num_colours = used_serial ? MAX_COLOURS + 1 : max_colour + 1;
+    ws->serial_colour = used_serial ? MAX_COLOURS : -1;
+    /* Bucket blocks by colour (counting sort keeps block order). */
+    for (b = 0; b < nb; b++)
+        ws->colour_ptr[colour[b] + 1]++;
+    for (int c = 0; c < ws->num_colours; c++)
+        ws->colour_ptr[c + 1] += ws->colour_ptr[c];
+    int32_t fill[MAX_COLOURS + 1];
+    for (int c = 0; c < ws->num_colours; c++)
+        fill[c] = ws->colour_ptr[c];
+    for (b = 0; b < nb; b++)
+        ws->colour_blocks[fill[colour[b]]++] = b;
+    free(colour);
+    return GETME_OK;
+}
+
+getme_status getme__ws_build(getme_ws *ws, getme_mesh *mesh, int renumber,
+                             int num_threads)
+{
+    memset(ws, 0, sizeof *ws);
+    if (mesh->mirror < 0)
+        getme__detect_orientation(mesh);
+    ws->dim = mesh->dim;
+    ws->nt = num_threads > 0 ? num_threads : 1;
+    ws->nn = mesh->num_nodes;
+    ws->ne = mesh->num_elements;
+    size_t nn = (size_t)(ws->nn ? ws->nn : 1), ne = (size_t)(ws->ne ? ws->ne : 1);
+    ws->elem_orig = malloc(ne * sizeof *ws->elem_orig);
+    ws->node_orig = malloc(nn * sizeof *ws->node_orig);
+    getme_status st = GETME_ERR_NOMEM;
+    if (!ws->elem_orig || !ws->node_orig)
+        goto fail;
+    if ((st = order_elements(ws, mesh, renumber)) != GETME_OK)
+        goto fail;
+    if ((st = number_nodes(ws, mesh, renumber)) != GETME_OK)
+        goto fail;
+    st = GETME_ERR_NOMEM;
+    ws->x = malloc(nn * 3 * sizeof *ws->x);
+    ws->fixed = malloc(nn);
+    ws->free_elem = malloc(ne);
+    if (!ws->x || !ws->fixed || !ws->free_elem)
+        goto fail;
+    double ysign = mesh->mirror == 1 ? -1.0 : 1.0;
+    for (int32_t i = 0; i < ws->nn; i++) {
+        const double *p = mesh->coords + 3 * (int64_t)ws->node_orig[i];
+        ws->x[3 * (int64_t)i] = p[0];
+        ws->x[3 * (int64_t)i + 1] = ysign * p[1];
+        ws->x[3 * (int64_t)i + 2] = p[2];
+        ws->fixed[i] = mesh->fixed[ws->node_orig[i]] != 0;
+    }
+    if ((st = build_stars(ws)) != GETME_OK)
+        goto fail;
+    ws->num_free_elem = 0;
+    for (int t = 0; t < GETME_NUM_TYPES; t++) {
+        int nv = getme__nv[t];
+        for (int32_t e = ws->tstart[t]; e < ws->tstart[t + 1]; e++) {
+            const int32_t *c = getme__ws_nodes(ws, t, e);
+            uint8_t f = 0;
+            for (int i = 0; i < nv; i++)
+                f |= !ws->fixed[c[i]];
+            ws->free_elem[e] = f;
+            ws->num_free_elem += f;
+        }
+    }
+    ws->num_free_nodes = 0;
+    for (int32_t i = 0; i < ws->nn; i++)
+        ws->num_free_nodes += !ws->fixed[i] &&
+                              ws->star_ptr[i + 1] > ws->star_ptr[i];
+    if ((st = colour_blocks(ws)) != GETME_OK)
+        goto fail;
+    return GETME_OK;
+fail:
+    getme__ws_free(ws);
+    return st;
+}
+
+void getme__ws_store(const getme_ws *ws, getme_mesh *mesh)
+{
+    double ysign = mesh->mirror == 1 ? -1.0 : 1.0;
+    for (int32_t i = 0; i < ws->nn; i++) {
+        if (ws->fixed[i])
+            continue; /* fixed nodes are never written: bit-identical */
+        double *p = mesh->coords + 3 * (int64_t)ws->node_orig[i];
+        p[0] = ws->x[3 * (int64_t)i];
+        p[1] = ysign * ws->x[3 * (int64_t)i + 1];
+        p[2] = ws->x[3 * (int64_t)i + 2];
+    }
+}
+
+void getme__ws_qualities(const getme_ws *ws, double *q)
+{
+#pragma omp parallel for schedule(static) num_threads(ws->nt)
+    for (int32_t e = 0; e < ws->ne; e++)
+        q[e] = getme__ws_quality(ws, ws->x, e);
+}
+
+/* Chunk of the deterministic sum: fixed, so partial sums do not depend on
+   how many threads there are. */
+#define SUM_CHUNK 4096
+
+double getme__det_sum(const double *v, int32_t n, int nt)
+{
+    int32_t nc = (n + SUM_CHUNK - 1) / SUM_CHUNK;
+    double small[64];
+    double *part = nc <= 64 ? small : malloc((size_t)nc * sizeof *part);
+    if (!part) { /* no memory: a serial sum is just as deterministic */
+        double s = 0.0;
+        for (int32_t i = 0; i < n; i++)
+            s += v[i];
+        return s;
+    }
+#pragma omp parallel for schedule(static) num_threads(nt)
+    for (int32_t c = 0; c < nc; c++) {
+        double s = 0.0;
+        int32_t end = (c + 1) * SUM_CHUNK < n ? (c + 1) * SUM_CHUNK : n;
+        for (int32_t i = c * SUM_CHUNK; i < end; i++)
+            s += v[i];
+        part[c] = s;
+    }
+    double s = 0.0;
+    for (int32_t c = 0; c < nc; c++)
+        s += part[c];
+    if (part != small)
+        free(part);
+    return s;
+}
+
+void getme__ws_summary(const getme_ws *ws, const double *q, double *q_mean,
+                       double *q_min_star, double *q_min)
+{
+    double mn = 1.0, mns = 1.0;
+#pragma omp parallel for schedule(static) num_threads(ws->nt) \
+    reduction(min : mn, mns)
+    for (int32_t e = 0; e < ws->ne; e++) {
+        double v = q[e];
+        mn = v < mn ? v : mn;
+        if (ws->free_elem[e])
+            mns = v < mns ? v : mns;
+    }
+    *q_mean = ws->ne ? getme__det_sum(q, ws->ne, ws->nt) / ws->ne : 1.0;
+    *q_min_star = mns;
+    if (q_min)
+        *q_min = mn;
+}

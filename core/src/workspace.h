@@ -1,0 +1,110 @@
+/*
+ * workspace.h -- the smoother's working copy of a mesh.
+ *
+ * getme_smooth() does not iterate over the caller's arrays directly.  It
+ * builds a workspace with
+ *  - elements grouped by type and, inside a type, sorted along a Morton
+ *    curve of their centroids, and nodes numbered in first-touch order of
+ *    that element order, so neighbouring elements and nodes are close in
+ *    memory (renumber = 1);
+ *  - a node -> element CSR ("stars"), each star sorted by element index;
+ *  - blocks of consecutive elements, coloured so that no two blocks of one
+ *    colour share a node.  Scattering element contributions block by block,
+ *    colour after colour, needs no atomics and adds the contributions to a
+ *    node in an order that does not depend on the thread count, which is
+ *    what makes results bit-identical for any number of threads.
+ */
+#ifndef GETME_WORKSPACE_H
+#define GETME_WORKSPACE_H
+
+#include "internal.h"
+
+#include <stdint.h>
+
+typedef struct getme_ws {
+    int dim;
+    int nt;              /* OpenMP threads to use                           */
+    int32_t nn, ne;
+    int32_t tstart[GETME_NUM_TYPES + 1]; /* elements of type t: [tstart[t],
+                                            tstart[t+1])                    */
+    int64_t coff[GETME_NUM_TYPES];       /* conn offset of type t's first  */
+    int32_t *conn;       /* internal node indices, type-grouped              */
+    int32_t *elem_orig;  /* internal -> caller element index                 */
+    int32_t *node_orig;  /* internal -> caller node index                    */
+    double *x;           /* 3 * nn internal coordinates (y negated if mirrored)
+                                                                            */
+    uint8_t *fixed;      /* nn, 1 = fixed                                    */
+    uint8_t *free_elem;  /* ne, 1 = has at least one free node              */
+    int32_t num_free_elem;
+    int32_t num_free_nodes; /* free nodes used by at least one element       */
+    int64_t *star_ptr;   /* nn + 1                                           */
+    int32_t *star;       /* incident elements of each node, ascending       */
+    int32_t max_star;    /* largest star                                     */
+    /* colour-blocks */
+    int32_t num_blocks;
+    int32_t *block_start; /* num_blocks + 1, element ranges (one type each)  */
+    int32_t num_colours;
+    int32_t *colour_ptr;  /* num_colours + 1, into colour_blocks             */
+    int32_t *colour_blocks;
+    int serial_colour;    /* colour index whose blocks must run one by one
+                             (colour overflow), or -1                        */
+} getme_ws;
+
+/* Build the workspace; renumber: 1 for locality ordering, 0 keeps the
+   caller's order.  Returns GETME_OK or GETME_ERR_NOMEM. */
+getme_status getme__ws_build(getme_ws *ws, getme_mesh *mesh, int renumber,
+                             int num_threads);
+void getme__ws_free(getme_ws *ws);
+
+/* Write the workspace coordinates back to the mesh (undoing mirror/order). */
+void getme__ws_store(const getme_ws *ws, getme_mesh *mesh);
+
+static inline int getme__ws_type(const getme_ws *ws, int32_t e)
+{
+    int t = 0;
+    while (e >= ws->tstart[t + 1])
+        t++;
+    return t;
+}
+
+static inline const int32_t *getme__ws_nodes(const getme_ws *ws, int t,
+                                             int32_t e)
+{
+    return ws->conn + ws->coff[t] + (int64_t)(e - ws->tstart[t]) * getme__nv[t];
+}
+
+/* Gather element e (type t) coordinates from coords into x. */
+static inline void getme__ws_gather(const getme_ws *ws, const double *coords,
+                                    int t, int32_t e, double *x)
+{
+    const int32_t *c = getme__ws_nodes(ws, t, e);
+    int nv = getme__nv[t];
+    for (int i = 0; i < nv; i++) {
+        const double *p = coords + 3 * (int64_t)c[i];
+        x[3 * i] = p[0];
+        x[3 * i + 1] = p[1];
+        x[3 * i + 2] = p[2];
+    }
+}
+
+/* Quality of element e at coordinates coords. */
+static inline double getme__ws_quality(const getme_ws *ws,
+                                       const double *coords, int32_t e)
+{
+    double x[3 * GETME_MAX_NV];
+    int t = getme__ws_type(ws, e);
+    getme__ws_gather(ws, coords, t, e, x);
+    return getme__quality(t, x);
+}
+
+/* Qualities of all elements at ws->x into q (parallel). */
+void getme__ws_qualities(const getme_ws *ws, double *q);
+
+/* Deterministic sum of q over [0, n) (fixed chunking, any thread count). */
+double getme__det_sum(const double *v, int32_t n, int nt);
+
+/* Count, q_mean and q*_min (over free elements) of q. */
+void getme__ws_summary(const getme_ws *ws, const double *q, double *q_mean,
+                       double *q_min_star, double *q_min);
+
+#endif /* GETME_WORKSPACE_H */
