@@ -1,0 +1,375 @@
+#!/usr/bin/python3
+"""getme benchmark: GETMe adaptive against smart Laplace, Gmsh's and Netgen's
+optimizers on generated, distorted meshes -- tables like the paper's.
+
+  /usr/bin/python3 bench/bench.py --quick
+  /usr/bin/python3 bench/bench.py --size small|medium|full [--cases tet,hex]
+  /usr/bin/python3 bench/bench.py --sweep --size medium     (threshold_fraction)
+  /usr/bin/python3 bench/bench.py --generate-only --size full
+
+Meshes are generated with the Gmsh Python API and cached (--cache, default
+bench/cache, git-ignored); distorted copies come from `getme distort` and are
+cached too.  Every method then runs in its own process under /usr/bin/time
+on the same distorted file; its output file is read back with meshio and
+measured here in numpy (quality.py, skin.py), never trusted from the tool.
+Results: tables on stdout, bench-<size>.{txt,csv,json} and PNG plots in
+--out (default bench/results/<size>).  Docs: docs/bench.md.
+
+Exit status: 0 all runs fine, 1 a run failed or gave an invalid mesh where
+it must not, 2 usage, 3 a required tool is missing.
+"""
+
+import argparse
+import os
+import shutil
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+
+import meshes  # noqa: E402
+import methods as M  # noqa: E402
+import runner  # noqa: E402
+import tables  # noqa: E402
+from meshdata import read_mesh  # noqa: E402
+from stats import mesh_stats, topology_change  # noqa: E402
+
+REPO = os.path.dirname(HERE)
+# q_mean the distortion aims at: the paper's initial meshes (0.4506 / 0.4709)
+TARGET_QMEAN = {"tet": 0.45, "hex": 0.47, "mixed": 0.47, "tri": 0.47, "quad": 0.47}
+SWEEP_FRACTIONS = (0.002, 0.005, 0.01, 0.02, 0.05)
+CASE_TITLES = {"tet": "piston, Delaunay tets", "hex": "swept flange, hexes",
+               "mixed": "block, hex/prism base + tet/pyramid cap",
+               "tri": "flange section, triangles", "quad": "flange section, quads"}
+
+
+def log(msg):
+    print(msg, file=sys.stderr, flush=True)
+
+
+def parse_args(argv):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--quick", action="store_true",
+                    help="small meshes, the whole run in about a minute (= --size quick)")
+    ap.add_argument("--size", choices=("quick", "small", "medium", "full"))
+    ap.add_argument("--cases", default=",".join(meshes.CASES),
+                    help="comma list of " + ",".join(meshes.CASES))
+    ap.add_argument("--methods", default="",
+                    help="comma list of method keys (default: all that apply)")
+    ap.add_argument("--out", help="result directory (default bench/results/SIZE)")
+    ap.add_argument("--cache", default=os.environ.get("GETME_BENCH_CACHE",
+                                                      os.path.join(HERE, "cache")))
+    ap.add_argument("--getme", help="the getme executable (default: build*/cli/getme, PATH)")
+    ap.add_argument("--seed", type=int, default=1, help="distortion seed")
+    ap.add_argument("--distort", choices=("getme", "none"), default="getme",
+                    help="'none' benchmarks the generated meshes as they are")
+    ap.add_argument("--sweep", action="store_true",
+                    help="sweep getme's threshold_fraction on the tet and hex meshes")
+    ap.add_argument("--fractions", default=",".join(str(f) for f in SWEEP_FRACTIONS))
+    ap.add_argument("--generate-only", action="store_true")
+    ap.add_argument("--keep-outputs", action="store_true",
+                    help="keep every method's output mesh (in the cache)")
+    ap.add_argument("--timeout", type=float, default=None,
+                    help="seconds per run (default: 600 quick, none otherwise)")
+    args = ap.parse_args(argv)
+    if args.quick and args.size not in (None, "quick"):
+        ap.error("--quick and --size are exclusive")
+    args.size = "quick" if args.quick or not args.size else args.size
+    args.cases = [c for c in args.cases.split(",") if c]
+    bad = [c for c in args.cases if c not in meshes.CASES]
+    if bad:
+        ap.error(f"unknown case(s) {','.join(bad)}")
+    args.methods = [m for m in args.methods.split(",") if m]
+    known = {m.key for m in M.METHODS}
+    bad = [m for m in args.methods if m not in known]
+    if bad:
+        ap.error(f"unknown method(s) {','.join(bad)}; known: {','.join(sorted(known))}")
+    args.fractions = [float(f) for f in args.fractions.split(",") if f]
+    args.out = args.out or os.path.join(HERE, "results", args.size)
+    if args.timeout is None and args.size == "quick":
+        args.timeout = 600.0
+    return args
+
+
+def find_getme(explicit):
+    if explicit:
+        return explicit if os.access(explicit, os.X_OK) else None
+    for entry in sorted(os.listdir(REPO)):
+        path = os.path.join(REPO, entry, "cli", "getme")
+        if entry.startswith("build") and os.access(path, os.X_OK):
+            return path
+    return shutil.which("getme")
+
+
+def distort(ctx, case, src):
+    """The distorted copy of src (cached), made by `getme distort`."""
+    if ctx.args.distort == "none":
+        return src
+    target = TARGET_QMEAN[case]
+    dst = src[:-4] + f"-seed{ctx.args.seed}-q{target}.msh"
+    if os.path.exists(dst):
+        return dst
+    log(f"Info    : distorting {os.path.basename(src)} (seed {ctx.args.seed}, "
+        f"target q_mean {target})")
+    tmp = dst[:-4] + ".tmp.msh"
+    r = runner.run([ctx.getme, "distort", src, "-o", tmp, "--seed", ctx.args.seed,
+                    "--target-qmean", target], timeout=ctx.args.timeout)
+    if r.returncode != 0:
+        raise RuntimeError(f"getme distort failed on {src}: {r.error_line()}")
+    os.replace(tmp, dst)
+    return dst
+
+
+def report_fields(report):
+    """Iterations, time, history and final qualities from getme's --report
+    JSON (tolerant of where the CLI puts them)."""
+    res = report.get("result", report)
+    hist = report.get("history") or report.get("progress") or []
+    return {
+        "iterations_mean": res.get("iterations_mean"),
+        "iterations_min": res.get("iterations_min"),
+        "seconds": res.get("seconds"),
+        "report_q_min_star": res.get("q_min_star"),
+        "report_q_mean": res.get("q_mean"),
+        "history": [{"elapsed": h["elapsed"], "q_min_star": h["q_min_star"],
+                     "q_mean": h["q_mean"], "stage": h.get("stage")}
+                    for h in hist if "elapsed" in h],
+    }
+
+
+def measure(row, ref, path):
+    """Read a method's output and fill the quality/topology fields of row."""
+    mesh = read_mesh(path)
+    st = mesh_stats(mesh)
+    row.update({k: st[k] for k in ("nodes", "elements", "free_nodes", "q_min",
+                                   "q_min_star", "q_mean", "n_le_04", "n_lt_01",
+                                   "invalid", "histogram")})
+    row["types"] = st["types"]
+    row["topology"] = topology_change(ref, mesh)
+
+
+def run_method(ctx, case, method, src, ref, params=(), tag=None):
+    key = method.key + (f"-{tag}" if tag else "")
+    work = os.path.join(ctx.work, f"{case}-{key}")
+    dst, report = work + ".msh", work + ".report.json"
+    row = {"size": ctx.args.size, "case": case, "method": key,
+           "label": method.label + (f" [{tag}]" if tag else ""), "status": "ok"}
+    log(f"Info    : {case}: running {row['label']}")
+    r = runner.run(M.command(method, ctx.getme, src, dst, report, params),
+                   timeout=ctx.args.timeout)
+    row["peak_gib"], row["wall"] = r.peak_gib, r.wall
+    if r.returncode != 0 or not os.path.exists(dst):
+        row["status"] = f"failed: {r.error_line()}"
+        log(f"Error   : {case}: {row['label']} failed: {r.error_line()}")
+        return row
+    if method.tool == "getme":
+        import json
+        with open(report) as f:
+            row.update(report_fields(json.load(f)))
+        im, imin = row.get("iterations_mean"), row.get("iterations_min")
+        row["iterations"] = (f"{im}/{imin}" if method.args[1] == "getme" else f"{im}")
+    else:
+        row["seconds"] = r.last_json().get("seconds")
+        row["iterations"] = "1" if method.tool == "gmsh" else "5 steps"
+    if row.get("seconds") is None:
+        row["seconds"] = r.wall
+    measure(row, ref, dst)
+    base = ctx.baseline(case, method, src)
+    row["delta_gib"] = row["peak_gib"] - base if base is not None else None
+    if not ctx.args.keep_outputs:
+        for p in (dst, report):
+            if os.path.exists(p):
+                os.remove(p)
+    return row
+
+
+class Context:
+    def __init__(self, args, getme):
+        self.args = args
+        self.getme = getme
+        self.work = os.path.join(args.cache, f"runs-{args.size}")
+        os.makedirs(self.work, exist_ok=True)
+        self._baselines = {}
+
+    def baseline(self, case, method, src):
+        """Peak GiB of loading (and writing) the mesh with the method's tool,
+        without smoothing."""
+        key = (case, M.baseline_key(method))
+        if key not in self._baselines:
+            dst = os.path.join(self.work, f"{case}-{method.tool}-load.msh")
+            r = runner.run(M.baseline_command(method, self.getme, src, dst),
+                           timeout=self.args.timeout)
+            self._baselines[key] = r.peak_gib if r.returncode == 0 else None
+            if os.path.exists(dst):
+                os.remove(dst)
+        return self._baselines[key]
+
+
+def selected_methods(args, case):
+    out = []
+    for m in M.METHODS:
+        if case not in m.cases or (args.methods and m.key not in args.methods):
+            continue
+        out.append(m)
+    return out
+
+
+def initial_row(case, size, st):
+    row = {"size": size, "case": case, "method": "initial",
+           "label": "Initial (distorted)", "status": "ok", "topology": "-"}
+    row.update({k: st[k] for k in ("nodes", "elements", "free_nodes", "q_min",
+                                   "q_min_star", "q_mean", "n_le_04", "n_lt_01",
+                                   "invalid", "histogram")})
+    return row
+
+
+def check_row(row, notes):
+    """Flag what must not happen: relocation methods changing topology or
+    leaving invalid elements, our numbers disagreeing with getme's own."""
+    bad = False
+    if row.get("status") != "ok":
+        return True
+    if row["method"].startswith(("getme", "laplace")):
+        if row["topology"] != "no" or row["invalid"]:
+            notes.append(f"  ERROR: {row['label']}: topology {row['topology']}, "
+                         f"{row['invalid']} invalid elements")
+            bad = True
+        for key in ("q_min_star", "q_mean"):
+            theirs = row.get("report_" + key)
+            if theirs is not None and abs(theirs - row[key]) > 1e-6:
+                notes.append(f"  note: {row['label']}: getme reports {key} "
+                             f"{theirs:.6f}, numpy measures {row[key]:.6f}")
+    return bad
+
+
+def bench_case(ctx, case, meta):
+    src = meshes.generate(case, ctx.args.size, ctx.args.cache, log=log)
+    gen = read_mesh(src)
+    gen_st = mesh_stats(gen)
+    dist = distort(ctx, case, src)
+    ref = read_mesh(dist) if dist != src else gen
+    init = mesh_stats(ref)
+    if topology_change(gen, ref) != "no":
+        raise RuntimeError(f"getme distort changed the topology of {src}")
+    types = ", ".join(f"{n} {t}" for t, n in init["types"].items())
+    title = (f"{case}-{ctx.args.size}: {CASE_TITLES[case]}; {types}, "
+             f"{init['nodes']} nodes ({init['free_nodes']} free)")
+    rows = [initial_row(case, ctx.args.size, init)]
+    for method in selected_methods(ctx.args, case):
+        if method.tool == "netgen" and not M.netgen_available():
+            rows.append({"size": ctx.args.size, "case": case, "method": method.key,
+                         "label": method.label,
+                         "status": "skipped (python3-netgen not installed)"})
+            continue
+        rows.append(run_method(ctx, case, method, dist, ref))
+    notes = [f"  generated: q*min {gen_st['q_min_star']:.4f}, q_mean "
+             f"{gen_st['q_mean']:.4f}; distorted (seed {ctx.args.seed}): q*min "
+             f"{init['q_min_star']:.4f}, q_mean {init['q_mean']:.4f}"]
+    failed = any(check_row(r, notes) for r in rows[1:]
+                 if not r["status"].startswith("skipped"))
+    text = tables.format_table(title, rows, notes)
+    print(text + "\n", flush=True)
+    case_out = {"title": title, "mesh": os.path.basename(src),
+                "distorted": os.path.basename(dist), "generated": gen_st,
+                "initial": init, "initial_row": rows[0], "rows": rows[1:],
+                "text": text}
+    return case_out, failed
+
+
+def write_outputs(args, meta, cases, stem):
+    import plots
+    os.makedirs(args.out, exist_ok=True)
+    all_rows = [r for c in cases.values() for r in [c["initial_row"]] + c["rows"]]
+    tables.write_csv(os.path.join(args.out, f"{stem}.csv"), all_rows)
+    tables.write_json(os.path.join(args.out, f"{stem}.json"),
+                      {"meta": meta, "cases": cases})
+    with open(os.path.join(args.out, f"{stem}.txt"), "w") as f:
+        f.write(meta["header"] + "\n\n")
+        f.write("\n\n".join(c["text"] for c in cases.values()) + "\n")
+    for case, c in cases.items():
+        plots.plot_quality_time(c, os.path.join(args.out, f"{case}-{args.size}-quality-time.png"),
+                                meta["cpu"])
+        plots.plot_histogram(c, os.path.join(args.out, f"{case}-{args.size}-histogram.png"))
+
+
+def make_meta(args, getme):
+    cpu = runner.cpu_name()
+    load = runner.load_average()
+    header = (f"getme benchmark, size {args.size}, {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}\n"
+              f"CPU: {cpu}; load average at start {load[0]:.2f} (shared machine: "
+              f"times are indicative)\n"
+              "Mem = peak RSS of the process (/usr/bin/time); dMem = minus a run of "
+              "the same tool that only loads/writes the mesh.\n"
+              "Time = the smoothing call only (getme's report, or timed inside the "
+              "Gmsh/Netgen process).  q*min: min over elements with a free node "
+              "(free = not on skin or region interface).")
+    return {"size": args.size, "cpu": cpu, "load_average": load, "header": header,
+            "getme": getme, "seed": args.seed, "generator_version": meshes.GENERATOR_VERSION}
+
+
+def sweep(ctx, meta):
+    """getme (1 thread) with each threshold_fraction on the tet and hex meshes."""
+    method = M.METHODS[0]
+    cases, failed = {}, False
+    for case in [c for c in ctx.args.cases if c in ("tet", "hex")]:
+        src = meshes.generate(case, ctx.args.size, ctx.args.cache, log=log)
+        dist = distort(ctx, case, src)
+        ref = read_mesh(dist)
+        init = mesh_stats(ref)
+        rows = []
+        for frac in ctx.args.fractions:
+            row = run_method(ctx, case, method, dist, ref,
+                             params=(("threshold_fraction", frac),), tag=f"tf={frac}")
+            row["threshold_fraction"] = frac
+            rows.append(row)
+        notes = []
+        failed |= any(check_row(r, notes) for r in rows)
+        title = f"threshold_fraction sweep, {case}-{ctx.args.size} ({init['elements']} elements)"
+        text = tables.format_table(title, [initial_row(case, ctx.args.size, init)] + rows, notes)
+        print(text + "\n", flush=True)
+        cases[case] = {"title": title, "initial": init, "initial_row": initial_row(
+            case, ctx.args.size, init), "rows": rows, "text": text}
+    os.makedirs(ctx.args.out, exist_ok=True)
+    stem = f"sweep-{ctx.args.size}"
+    all_rows = [r for c in cases.values() for r in c["rows"]]
+    tables.write_csv(os.path.join(ctx.args.out, stem + ".csv"), all_rows)
+    tables.write_json(os.path.join(ctx.args.out, stem + ".json"), {"meta": meta, "cases": cases})
+    with open(os.path.join(ctx.args.out, stem + ".txt"), "w") as f:
+        f.write(meta["header"] + "\n\n" + "\n\n".join(c["text"] for c in cases.values()) + "\n")
+    return failed
+
+
+def main(argv=None):
+    args = parse_args(sys.argv[1:] if argv is None else argv)
+    if args.generate_only:
+        for case in args.cases:
+            meshes.generate(case, args.size, args.cache, log=log)
+        return 0
+    getme = find_getme(args.getme)
+    needs_getme = args.distort == "getme" or args.sweep or any(
+        m.tool == "getme" for c in args.cases for m in selected_methods(args, c))
+    if getme is None and needs_getme:
+        log("Error   : getme executable not found: build it (cmake --build "
+            "build-... --target ...) or pass --getme PATH")
+        return 3
+    ctx = Context(args, getme)
+    meta = make_meta(args, getme)
+    print(meta["header"] + "\n", flush=True)
+    if args.sweep:
+        return 1 if sweep(ctx, meta) else 0
+    cases, failed = {}, False
+    for case in args.cases:
+        cases[case], bad = bench_case(ctx, case, meta)
+        failed |= bad
+    write_outputs(args, meta, cases, f"bench-{args.size}")
+    log(f"Info    : results written to {args.out}")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    try:
+        sys.exit(main())
+    except RuntimeError as exc:
+        log(f"Error   : {exc}")
+        sys.exit(1)
