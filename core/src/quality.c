@@ -1,0 +1,269 @@
+/*
+ * quality.c -- element type tables and the mean ratio quality kernels.
+ *
+ * Mean ratio (paper Eq. 3-5, DESIGN.md section 2): every node simplex k of
+ * an element has the matrix D_k of its three spanning edges; with the target
+ * matrix W of the type (columns: the same edges in the regular element),
+ * S_k = D_k W^-1 and
+ *
+ *     q_k = 3 det(S_k)^(2/3) / tr(S_k^T S_k),     q = mean of the q_k,
+ *
+ * and the element is invalid (q = 0) as soon as one det(S_k) <= 0.  The 2-D
+ * analogue for planar corners is q_k = 2 det(S_k) / tr(S_k^T S_k).
+ *
+ * These are the hot path of the smoother (hundreds of millions of calls), so
+ * W^-1 is applied as precomputed constants, det^(2/3) is cbrt(det)^2 (one
+ * cbrt, no pow, and no overflow before the det itself would overflow), and
+ * every kernel is straight-line code whose only decision is validity.
+ * Non-finite coordinates give a NaN det or q, which fails the "> 0" tests
+ * and so also yields 0.
+ */
+#include "internal.h"
+
+#include <math.h>
+
+const int getme__nv[GETME_NUM_TYPES] = {4, 8, 6, 5, 3, 4};
+
+static const int type_dim[GETME_NUM_TYPES] = {3, 3, 3, 3, 2, 2};
+
+static const char *const type_name[GETME_NUM_TYPES] = {
+    "tet", "hex", "prism", "pyramid", "tri", "quad"};
+
+static int known_type(getme_elem_type type)
+{
+    /* unsigned compare also rejects negative values cast to the enum */
+    return (unsigned)type < (unsigned)GETME_NUM_TYPES;
+}
+
+int getme_type_num_nodes(getme_elem_type type)
+{
+    return known_type(type) ? getme__nv[type] : 0;
+}
+
+int getme_type_dim(getme_elem_type type)
+{
+    return known_type(type) ? type_dim[type] : 0;
+}
+
+const char *getme_type_name(getme_elem_type type)
+{
+    return known_type(type) ? type_name[type] : "unknown";
+}
+
+/* ---- small vector helpers (inlined) ------------------------------------- */
+
+/* e = x[b] - x[a] for nodes a, b of the element */
+static inline void edge(const double *x, int a, int b, double e[3])
+{
+    e[0] = x[3 * b + 0] - x[3 * a + 0];
+    e[1] = x[3 * b + 1] - x[3 * a + 1];
+    e[2] = x[3 * b + 2] - x[3 * a + 2];
+}
+
+static inline double dot3(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* det of the 3x3 matrix with columns a, b, c = a . (b x c) */
+static inline double det3(const double a[3], const double b[3],
+                          const double c[3])
+{
+    return a[0] * (b[1] * c[2] - b[2] * c[1]) +
+           a[1] * (b[2] * c[0] - b[0] * c[2]) +
+           a[2] * (b[0] * c[1] - b[1] * c[0]);
+}
+
+/* 3 det^(2/3) / frob2 for one simplex; its sign is checked by the caller */
+static inline double ratio3(double det, double frob2)
+{
+    double c = cbrt(det);
+    return 3.0 * c * c / frob2;
+}
+
+/* The element's q if every det was > 0 and q is a number, else 0.  A NaN
+   from non-finite input fails "q > 0". */
+static inline double valid_or_zero(int all_positive, double q)
+{
+    return (all_positive && q > 0.0) ? q : 0.0;
+}
+
+/* ---- tetrahedron -------------------------------------------------------- */
+
+/*
+ * W_tet = [[1, 1/2, 1/2], [0, sqrt3/2, sqrt3/6], [0, 0, sqrt(2/3)]] has
+ * W^-1 = [[1, -1/sqrt3, -1/sqrt6], [0, 2/sqrt3, -1/sqrt6], [0, 0, 3/sqrt6]],
+ * so the columns of S are e1, (2 e2 - e1)/sqrt3, (3 e3 - e1 - e2)/sqrt6 and
+ * det S = det D * det W^-1 = sqrt2 det D.
+ */
+#define GETME_SQRT2 1.41421356237309504880
+#define GETME_INV_SQRT3 0.57735026918962576451
+#define GETME_INV_SQRT6 0.40824829046386301637
+
+double getme__quality_tet(const double *x)
+{
+    double e1[3], e2[3], e3[3], s2[3], s3[3];
+    edge(x, 0, 1, e1);
+    edge(x, 0, 2, e2);
+    edge(x, 0, 3, e3);
+    for (int c = 0; c < 3; c++) {
+        s2[c] = (2.0 * e2[c] - e1[c]) * GETME_INV_SQRT3;
+        s3[c] = (3.0 * e3[c] - e1[c] - e2[c]) * GETME_INV_SQRT6;
+    }
+    double det = GETME_SQRT2 * det3(e1, e2, e3);
+    double frob2 = dot3(e1, e1) + dot3(s2, s2) + dot3(s3, s3);
+    return valid_or_zero(det > 0.0, ratio3(det, frob2));
+}
+
+/* ---- hexahedron --------------------------------------------------------- */
+
+/* W = I: S_k = D_k.  One corner's q_k; its det goes to *det. */
+static inline double hex_corner(const double *x, int a, int b, int c, int d,
+                                double *det)
+{
+    double e1[3], e2[3], e3[3];
+    edge(x, a, b, e1);
+    edge(x, a, c, e2);
+    edge(x, a, d, e3);
+    *det = det3(e1, e2, e3);
+    return ratio3(*det, dot3(e1, e1) + dot3(e2, e2) + dot3(e3, e3));
+}
+
+/* The paper's N^hex, zero-based; det = +1 on the unit cube in Gmsh order. */
+double getme__quality_hex(const double *x)
+{
+    double d0, d1, d2, d3, d4, d5, d6, d7;
+    double s = hex_corner(x, 0, 3, 4, 1, &d0) + hex_corner(x, 1, 0, 5, 2, &d1) +
+               hex_corner(x, 2, 1, 6, 3, &d2) + hex_corner(x, 3, 2, 7, 0, &d3) +
+               hex_corner(x, 4, 7, 5, 0, &d4) + hex_corner(x, 5, 4, 6, 1, &d5) +
+               hex_corner(x, 6, 5, 7, 2, &d6) + hex_corner(x, 7, 6, 4, 3, &d7);
+    int ok = (d0 > 0.0) & (d1 > 0.0) & (d2 > 0.0) & (d3 > 0.0) & (d4 > 0.0) &
+             (d5 > 0.0) & (d6 > 0.0) & (d7 > 0.0);
+    return valid_or_zero(ok, 0.125 * s);
+}
+
+/* ---- prism -------------------------------------------------------------- */
+
+/*
+ * W_prism = [[1, 1/2, 0], [0, sqrt3/2, 0], [0, 0, 1]] (two triangle edges and
+ * the vertical edge of a corner of the unit regular prism); W^-1 gives the
+ * columns e1, (2 e2 - e1)/sqrt3, e3 and det S = (2/sqrt3) det D.
+ */
+static inline double prism_corner(const double *x, int a, int b, int c, int d,
+                                  double *det)
+{
+    double e1[3], e2[3], e3[3], s2[3];
+    edge(x, a, b, e1);
+    edge(x, a, c, e2);
+    edge(x, a, d, e3);
+    for (int k = 0; k < 3; k++)
+        s2[k] = (2.0 * e2[k] - e1[k]) * GETME_INV_SQRT3;
+    *det = 2.0 * GETME_INV_SQRT3 * det3(e1, e2, e3);
+    return ratio3(*det, dot3(e1, e1) + dot3(s2, s2) + dot3(e3, e3));
+}
+
+double getme__quality_prism(const double *x)
+{
+    double d0, d1, d2, d3, d4, d5;
+    double s = prism_corner(x, 0, 1, 2, 3, &d0) + prism_corner(x, 1, 2, 0, 4, &d1) +
+               prism_corner(x, 2, 0, 1, 5, &d2) + prism_corner(x, 3, 5, 4, 0, &d3) +
+               prism_corner(x, 4, 3, 5, 1, &d4) + prism_corner(x, 5, 4, 3, 2, &d5);
+    int ok = (d0 > 0.0) & (d1 > 0.0) & (d2 > 0.0) & (d3 > 0.0) & (d4 > 0.0) &
+             (d5 > 0.0);
+    return valid_or_zero(ok, s * (1.0 / 6.0));
+}
+
+/* ---- pyramid ------------------------------------------------------------ */
+
+/*
+ * W_pyr = [[1, 0, 1/2], [0, 1, 1/2], [0, 0, 1/sqrt2]] (two base edges and the
+ * edge to the apex of the pyramid with all edges 1); W^-1 gives the columns
+ * e1, e2, sqrt2 (e3 - (e1 + e2)/2) and det S = sqrt2 det D.  The apex itself
+ * has no simplex of its own (its four edges do not span a simplex), as in
+ * DESIGN.md: the four base corners see every edge of the pyramid.
+ */
+static inline double pyramid_corner(const double *x, int a, int b, int c,
+                                    double *det)
+{
+    double e1[3], e2[3], e3[3], s3[3];
+    edge(x, a, b, e1);
+    edge(x, a, c, e2);
+    edge(x, a, 4, e3);
+    for (int k = 0; k < 3; k++)
+        s3[k] = GETME_SQRT2 * (e3[k] - 0.5 * (e1[k] + e2[k]));
+    *det = GETME_SQRT2 * det3(e1, e2, e3);
+    return ratio3(*det, dot3(e1, e1) + dot3(e2, e2) + dot3(s3, s3));
+}
+
+double getme__quality_pyramid(const double *x)
+{
+    double d0, d1, d2, d3;
+    double s = pyramid_corner(x, 0, 1, 3, &d0) + pyramid_corner(x, 1, 2, 0, &d1) +
+               pyramid_corner(x, 2, 3, 1, &d2) + pyramid_corner(x, 3, 0, 2, &d3);
+    int ok = (d0 > 0.0) & (d1 > 0.0) & (d2 > 0.0) & (d3 > 0.0);
+    return valid_or_zero(ok, 0.25 * s);
+}
+
+/* ---- planar types (x, y only) ------------------------------------------- */
+
+/* z of the cross product of the xy edges a->b and a->c */
+static inline double cross2(const double *x, int a, int b, int c)
+{
+    return (x[3 * b] - x[3 * a]) * (x[3 * c + 1] - x[3 * a + 1]) -
+           (x[3 * b + 1] - x[3 * a + 1]) * (x[3 * c] - x[3 * a]);
+}
+
+static inline double len2_xy(const double *x, int a, int b)
+{
+    double dx = x[3 * b] - x[3 * a], dy = x[3 * b + 1] - x[3 * a + 1];
+    return dx * dx + dy * dy;
+}
+
+/* q = 4 sqrt3 A / sum |e|^2 with 2A = cross2: 1 for the equilateral one. */
+double getme__quality_tri(const double *x)
+{
+    double twice_area = cross2(x, 0, 1, 2);
+    double sum = len2_xy(x, 0, 1) + len2_xy(x, 1, 2) + len2_xy(x, 2, 0);
+    double q = 2.0 * 1.73205080756887729353 * twice_area / sum;
+    return valid_or_zero(twice_area > 0.0, q);
+}
+
+/* W = I: corner k with e1 = x_{k+1} - x_k, e2 = x_{k-1} - x_k has
+   q_k = 2 det(e1, e2) / (|e1|^2 + |e2|^2). */
+static inline double quad_corner(const double *x, int k, int next, int prev,
+                                 double *det)
+{
+    *det = cross2(x, k, next, prev);
+    return 2.0 * *det / (len2_xy(x, k, next) + len2_xy(x, k, prev));
+}
+
+double getme__quality_quad(const double *x)
+{
+    double d0, d1, d2, d3;
+    double s = quad_corner(x, 0, 1, 3, &d0) + quad_corner(x, 1, 2, 0, &d1) +
+               quad_corner(x, 2, 3, 1, &d2) + quad_corner(x, 3, 0, 2, &d3);
+    int ok = (d0 > 0.0) & (d1 > 0.0) & (d2 > 0.0) & (d3 > 0.0);
+    return valid_or_zero(ok, 0.25 * s);
+}
+
+/* ---- dispatch ----------------------------------------------------------- */
+
+double getme__quality(int type, const double *x)
+{
+    switch (type) {
+    case GETME_TET: return getme__quality_tet(x);
+    case GETME_HEX: return getme__quality_hex(x);
+    case GETME_PRISM: return getme__quality_prism(x);
+    case GETME_PYRAMID: return getme__quality_pyramid(x);
+    case GETME_TRI: return getme__quality_tri(x);
+    case GETME_QUAD: return getme__quality_quad(x);
+    default: return 0.0;
+    }
+}
+
+double getme_element_quality(getme_elem_type type, const double *xyz)
+{
+    if (xyz == NULL)
+        return 0.0;
+    return getme__quality((int)type, xyz);
+}

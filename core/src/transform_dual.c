@@ -1,0 +1,225 @@
+/*
+ * transform_dual.c -- the dual element transformation of hexahedra, prisms
+ * and pyramids (paper ref. [28, 32]; DESIGN.md section 3), with the
+ * per-type calibration that makes prisms and pyramids converge to their
+ * regular element (docs/kernels.md explains and measures it).
+ *
+ * For node p_i: the centroids c_1..c_k of its k incident faces, ordered
+ * around p_i, span a small "dual" polygon with mean m_i and vector area
+ *
+ *     n_i = 1/2 sum_j (c_j - m_i) x (c_{j+1} - m_i),
+ *
+ * oriented away from the element, towards p_i.  The new node is
+ *
+ *     p_i' = m_i + sigma * n_i / sqrt|n_i|,
+ *
+ * then the element is scaled about its centroid to keep its edge-length sum
+ * and put back on the input centroid (transform_scale.h says why).
+ *
+ * Calibration.  For hexahedra the iteration converges to the cube.  For
+ * prisms and pyramids the plain construction converges to a flattened prism
+ * (q ~ 0.93) and a too tall pyramid (q ~ 0.84): it has no reason to know the
+ * height of the regular element.  On the symmetric elements of these types
+ * a step changes only the ratio height : edge, so one scalar per type fixes
+ * the fixed point, derived in closed form below:
+ *  - prism: after the dual step the element is stretched along its axis
+ *    (the mean triangle normal), about its centroid, by kappa(sigma), the
+ *    factor that maps the step's image of the regular prism back onto it.
+ *    The stretch is affine with kappa > 0, so it never inverts a simplex.
+ *  - pyramid: the apex is moved with its own parameter sigma_apex = 1/6
+ *    instead of sigma.  That makes the regular pyramid a fixed point for
+ *    every sigma (the base nodes' part cancels exactly, see below) and,
+ *    unlike an axial stretch, keeps the step well contracting up to
+ *    sigma = 2 (docs/kernels.md has the measurements of both variants).
+ * The regular element is an exact fixed point up to similarity.
+ */
+#include "internal.h"
+#include "transform_scale.h"
+
+#include <math.h>
+
+/* Topology of one type: faces (outward, Gmsh order), and for every node its
+   incident faces in the order that orients n_i towards the node. */
+typedef struct dual_topology {
+    int nv, nf, ne;
+    unsigned char face_size[6];
+    unsigned char face[6][4];
+    unsigned char node_faces[8];   /* k of every node */
+    unsigned char around[8][4];    /* its faces, ordered */
+    unsigned char edges[12][2];
+} dual_topology;
+
+static const dual_topology hex_topo = {
+    8, 6, 12,
+    {4, 4, 4, 4, 4, 4},
+    {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6},
+     {0, 4, 7, 3}},
+    {3, 3, 3, 3, 3, 3, 3, 3},
+    {{0, 2, 5}, {0, 3, 2}, {0, 4, 3}, {0, 5, 4}, {1, 5, 2}, {1, 2, 3},
+     {1, 3, 4}, {1, 4, 5}},
+    {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6}, {6, 7}, {7, 4}, {0, 4},
+     {1, 5}, {2, 6}, {3, 7}}};
+
+static const dual_topology prism_topo = {
+    6, 5, 9,
+    {3, 3, 4, 4, 4},
+    {{0, 2, 1}, {3, 4, 5}, {0, 1, 4, 3}, {1, 2, 5, 4}, {2, 0, 3, 5}},
+    {3, 3, 3, 3, 3, 3},
+    {{0, 2, 4}, {0, 3, 2}, {0, 4, 3}, {1, 4, 2}, {1, 2, 3}, {1, 3, 4}},
+    {{0, 1}, {1, 2}, {2, 0}, {3, 4}, {4, 5}, {5, 3}, {0, 3}, {1, 4}, {2, 5}}};
+
+static const dual_topology pyramid_topo = {
+    5, 5, 8,
+    {4, 3, 3, 3, 3},
+    {{0, 3, 2, 1}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}},
+    {3, 3, 3, 3, 4},
+    {{0, 1, 4}, {0, 2, 1}, {0, 3, 2}, {0, 4, 3}, {1, 2, 3, 4}},
+    {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {0, 4}, {1, 4}, {2, 4}, {3, 4}}};
+
+static inline void face_centroids(const dual_topology *t, const double *x,
+                                  double c[6][3])
+{
+    for (int f = 0; f < t->nf; f++) {
+        double s[3] = {0.0, 0.0, 0.0};
+        for (int j = 0; j < t->face_size[f]; j++)
+            for (int d = 0; d < 3; d++)
+                s[d] += x[3 * t->face[f][j] + d];
+        for (int d = 0; d < 3; d++)
+            c[f][d] = s[d] / t->face_size[f];
+    }
+}
+
+/* The raw dual step (no scaling) of every node into out; the last node
+   uses sigma_last (the pyramid's apex), all others sigma. */
+static inline void dual_step(const dual_topology *t, const double *x,
+                             double sigma, double sigma_last, double *out)
+{
+    double c[6][3];
+    face_centroids(t, x, c);
+    for (int i = 0; i < t->nv; i++) {
+        int k = t->node_faces[i];
+        double m[3] = {0.0, 0.0, 0.0}, n[3] = {0.0, 0.0, 0.0};
+        for (int j = 0; j < k; j++)
+            for (int d = 0; d < 3; d++)
+                m[d] += c[t->around[i][j]][d];
+        for (int d = 0; d < 3; d++)
+            m[d] /= k;
+        for (int j = 0; j < k; j++) {
+            const double *a = c[t->around[i][j]];
+            const double *b = c[t->around[i][(j + 1) % k]];
+            double u[3] = {a[0] - m[0], a[1] - m[1], a[2] - m[2]};
+            double v[3] = {b[0] - m[0], b[1] - m[1], b[2] - m[2]};
+            n[0] += 0.5 * (u[1] * v[2] - u[2] * v[1]);
+            n[1] += 0.5 * (u[2] * v[0] - u[0] * v[2]);
+            n[2] += 0.5 * (u[0] * v[1] - u[1] * v[0]);
+        }
+        double f = (i == t->nv - 1 ? sigma_last : sigma) *
+                   getme__inv_sqrt_norm(n);
+        for (int d = 0; d < 3; d++)
+            out[3 * i + d] = m[d] + f * n[d];
+    }
+}
+
+/* Stretch the nv nodes of out by kappa along the direction axis (any
+   length), about their centroid. */
+static inline void stretch_along(double *out, int nv, const double axis[3],
+                                 double kappa)
+{
+    double a[3] = {axis[0], axis[1], axis[2]};
+    double inv = 1.0 / fmax(sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]),
+                            DBL_MIN);
+    double c[3] = {0.0, 0.0, 0.0};
+    for (int d = 0; d < 3; d++)
+        a[d] *= inv;
+    for (int i = 0; i < nv; i++)
+        for (int d = 0; d < 3; d++)
+            c[d] += out[3 * i + d];
+    for (int d = 0; d < 3; d++)
+        c[d] /= nv;
+    for (int i = 0; i < nv; i++) {
+        double *p = out + 3 * i;
+        double h = (kappa - 1.0) * ((p[0] - c[0]) * a[0] +
+                                    (p[1] - c[1]) * a[1] +
+                                    (p[2] - c[2]) * a[2]);
+        for (int d = 0; d < 3; d++)
+            p[d] += h * a[d];
+    }
+}
+
+/* (b - a) x (c - a) for nodes a, b, c of x, added to n */
+static inline void add_cross(const double *x, int ia, int ib, int ic,
+                             double n[3])
+{
+    const double *a = x + 3 * ia, *b = x + 3 * ib, *c = x + 3 * ic;
+    double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    n[0] += u[1] * v[2] - u[2] * v[1];
+    n[1] += u[2] * v[0] - u[0] * v[2];
+    n[2] += u[0] * v[1] - u[1] * v[0];
+}
+
+/* ---- hexahedron --------------------------------------------------------- */
+
+void getme__transform_hex(const double *x, double sigma, double *out)
+{
+    const dual_topology *t = &hex_topo;
+    dual_step(t, x, sigma, sigma, out);
+    getme__rescale3(out, x, t->nv, t->ne, t->edges);
+}
+
+/* ---- prism -------------------------------------------------------------- */
+
+/*
+ * kappa for the prism.  On the regular prism (edge 1, height 1) node 0's
+ * faces have centroids on the axis at height -1/2 (its triangle) and at the
+ * midpoints of its two triangle edges at height 0, at distance r = 1/(2
+ * sqrt3) from the axis.  Hence m_0 lies r/3 from the axis at height -1/6,
+ * n_0 = (1/8, 0, -r/8) in (radial, axial) parts, |n_0| = sqrt(1 + r^2)/8,
+ * and with s = sigma / (8 sqrt|n_0|) the new node is r/3 + s from the axis
+ * at height -(1/6 + r s).  The image is a right prism with triangle edge
+ * sqrt3 (r/3 + s) and height 2 (1/6 + r s); kappa = edge / height.
+ */
+static double prism_kappa(double sigma)
+{
+    const double r = 0.5 / 1.73205080756887729353;
+    /* 1 / (8 sqrt|n_0|) with |n_0| = sqrt(13/12) / 8 */
+    const double inv8sqrtn = 0.34654886430893894;
+    double s = sigma * inv8sqrtn;
+    return 1.73205080756887729353 * (r / 3.0 + s) / (2.0 * (1.0 / 6.0 + r * s));
+}
+
+void getme__transform_prism(const double *x, double sigma, double *out)
+{
+    const dual_topology *t = &prism_topo;
+    dual_step(t, x, sigma, sigma, out);
+    /* axis: the mean of the two triangles' upward normals */
+    double axis[3] = {0.0, 0.0, 0.0};
+    add_cross(out, 0, 1, 2, axis);
+    add_cross(out, 3, 4, 5, axis);
+    stretch_along(out, t->nv, axis, prism_kappa(sigma));
+    getme__rescale3(out, x, t->nv, t->ne, t->edges);
+}
+
+/* ---- pyramid ------------------------------------------------------------ */
+
+/*
+ * sigma_apex.  Take the pyramid with unit base centred at the origin and
+ * apex height h, h^2 = 1/2 for the regular one (all edges 1).  Base node 0 =
+ * (-1/2,-1/2,0) sees the base centroid (0,0,0) and the centroids
+ * (0,-1/3,h/3), (-1/3,0,h/3) of its two triangles: m_0 = (-1/9,-1/9,2h/9),
+ * n_0 = (-h,-h,-1)/18, so with t = sigma / (18 sqrt|n_0|) it goes to height
+ * 2h/9 - t and the base edge becomes 2 (1/9 + t h).  The apex sees the four
+ * triangle centroids, a square of area 2/9 at height h/3, and goes to
+ * h/3 + sigma_apex sqrt(2)/3.  The image is regular iff
+ * height = h * edge:  h/9 + sigma_apex sqrt2/3 + t = 2h/9 + 2 t h^2, and as
+ * 2 h^2 = 1 the t terms cancel: sigma_apex = h / (3 sqrt2) = 1/6 whatever
+ * sigma is.
+ */
+#define PYRAMID_APEX_SIGMA (1.0 / 6.0)
+
+void getme__transform_pyramid(const double *x, double sigma, double *out)
+{
+    const dual_topology *t = &pyramid_topo;
+    dual_step(t, x, sigma, PYRAMID_APEX_SIGMA, out);
+    getme__rescale3(out, x, t->nv, t->ne, t->edges);
+}

@@ -1,0 +1,98 @@
+/*
+ * transform_scale.h -- the step every GETMe transformation ends with: scale
+ * the transformed element about its own centroid so that the sum of its
+ * edge lengths equals the original one (paper Sec. 2.2).  Without it the
+ * transformations blow elements up (they add normals to the nodes), and
+ * the smoother's node averaging would drag neighbours outwards.
+ *
+ * Private to the transform_*.c kernels; static inline so each kernel gets a
+ * copy specialised to its constant edge table.
+ */
+#ifndef GETME_TRANSFORM_SCALE_H
+#define GETME_TRANSFORM_SCALE_H
+
+#include <float.h>
+#include <math.h>
+
+/* Sum of the lengths of the ne edges (node pairs) of a volume element. */
+static inline double getme__edge_sum3(const double *x, int ne,
+                                      const unsigned char (*edges)[2])
+{
+    double sum = 0.0;
+    for (int k = 0; k < ne; k++) {
+        const double *a = x + 3 * edges[k][0], *b = x + 3 * edges[k][1];
+        double dx = b[0] - a[0], dy = b[1] - a[1], dz = b[2] - a[2];
+        sum += sqrt(dx * dx + dy * dy + dz * dz);
+    }
+    return sum;
+}
+
+/*
+ * Scale the nv nodes of out about their centroid by (the edge sum of x) /
+ * (their edge sum) and move that centroid onto x's.  fmax keeps a collapsed
+ * output (edge sum 0, only possible from a collapsed input) finite: it then
+ * stays collapsed instead of becoming NaN.
+ */
+static inline void getme__rescale3(double *out, const double *x, int nv,
+                                   int ne, const unsigned char (*edges)[2])
+{
+    double c[3] = {0.0, 0.0, 0.0}, c0[3] = {0.0, 0.0, 0.0};
+    for (int i = 0; i < nv; i++)
+        for (int d = 0; d < 3; d++) {
+            c[d] += out[3 * i + d];
+            c0[d] += x[3 * i + d];
+        }
+    for (int d = 0; d < 3; d++) {
+        c[d] /= nv;
+        c0[d] /= nv;
+    }
+    double f = getme__edge_sum3(x, ne, edges) /
+               fmax(getme__edge_sum3(out, ne, edges), DBL_MIN);
+    for (int i = 0; i < nv; i++)
+        for (int d = 0; d < 3; d++)
+            out[3 * i + d] = c0[d] + f * (out[3 * i + d] - c[d]);
+}
+
+/* The same for a planar polygon of n nodes: perimeter and centroid in xy;
+   z is left as it is. */
+static inline double getme__perimeter_xy(const double *x, int n)
+{
+    double sum = 0.0;
+    for (int i = 0; i < n; i++) {
+        int j = (i + 1) % n;
+        double dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1];
+        sum += sqrt(dx * dx + dy * dy);
+    }
+    return sum;
+}
+
+static inline void getme__rescale_xy(double *out, const double *x, int n)
+{
+    double cx = 0.0, cy = 0.0, cx0 = 0.0, cy0 = 0.0;
+    for (int i = 0; i < n; i++) {
+        cx += out[3 * i];
+        cy += out[3 * i + 1];
+        cx0 += x[3 * i];
+        cy0 += x[3 * i + 1];
+    }
+    cx /= n;
+    cy /= n;
+    cx0 /= n;
+    cy0 /= n;
+    double f = getme__perimeter_xy(x, n) /
+               fmax(getme__perimeter_xy(out, n), DBL_MIN);
+    for (int i = 0; i < n; i++) {
+        out[3 * i] = cx0 + f * (out[3 * i] - cx);
+        out[3 * i + 1] = cy0 + f * (out[3 * i + 1] - cy);
+    }
+}
+
+/* n / sqrt|n|: the paper's normal scaling, which makes the displacement
+   scale like an edge length.  A zero normal (degenerate face) gives 0. */
+static inline double getme__inv_sqrt_norm(const double n[3])
+{
+    double nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+    return 1.0 / sqrt(sqrt(fmax(nn, DBL_MIN)));
+}
+
+#endif /* GETME_TRANSFORM_SCALE_H */
