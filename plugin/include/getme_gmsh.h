@@ -1,0 +1,209 @@
+/*
+ * getme_gmsh.h -- GETMe adaptive smoothing of the live Gmsh model
+ * (libgetme_gmsh).
+ *
+ * Works on the current model of the calling process through Gmsh's public C
+ * API (gmshc.h): after gmshModelMeshGenerate() or gmshOpen() of a mesh file,
+ *
+ *   getme_gmsh_options *opt = getme_gmsh_options_new();
+ *   getme_gmsh_options_set(opt, "sigma", 1.5);
+ *   getme_gmsh_options_add_fixed_group(opt, "clamp");     // physical name
+ *   getme_gmsh_report rep;
+ *   if (getme_gmsh_optimize(0, NULL, 0, opt, &rep) != GETME_OK)
+ *       ... rep.message says why; the model is unchanged ...
+ *   getme_gmsh_options_free(opt);
+ *
+ * The call mirrors gmshModelMeshOptimize(method, force, niter, dimTags): an
+ * empty dimTags list means every entity of the highest mesh dimension.
+ *
+ * What is smoothed: linear tetrahedra, hexahedra, prisms and pyramids of
+ * volumes (dim 3, mixed types and several volumes in one call), or linear
+ * triangles and quadrangles of planar surfaces (dim 2).  Planar surfaces in
+ * any orientation are accepted: they are rotated into the xy plane, smoothed
+ * there and rotated back; surfaces that are not planar, or selected surfaces
+ * that do not lie in one common plane, are refused.
+ *
+ * Which nodes move (DESIGN.md section 5): only nodes classified on the
+ * smoothed entities themselves.  Nodes classified on entities of lower
+ * dimension (geometric boundaries, interfaces, embedded points, curves and
+ * surfaces) are fixed, so are the nodes of the physical groups named in the
+ * options, and, defensively, every node on the mesh skin or on a face between
+ * entities of different physical groups (a mesh read from MSH 2.2 keeps no
+ * classification).  Moved nodes are written back with gmshModelMeshSetNode();
+ * node and element tags, topology and every fixed node stay bit-identical.
+ *
+ * Errors (no mesh, an entity without elements, second-order or unsupported
+ * elements, an inverted element, an unknown group name, ...) are logged
+ * through Gmsh's logger as "Error   : ..." (when logging is on), returned as
+ * a nonzero getme_status with a one-line message in the report, and leave the
+ * model unchanged.  The library never prints by itself and never exits.
+ *
+ * Gmsh is process-global state: every function here acts on the current
+ * model of the Gmsh instance loaded in this process (the same libgmsh.so the
+ * gmsh Python module loads).  Calls must not run concurrently with other
+ * Gmsh API calls.
+ */
+#ifndef GETME_GMSH_H
+#define GETME_GMSH_H
+
+#include "getme.h"
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#if defined(__GNUC__)
+#define GETME_GMSH_API __attribute__((visibility("default")))
+#else
+#define GETME_GMSH_API
+#endif
+
+/* ------------------------------------------------------------------------ */
+/* Options                                                                  */
+/* ------------------------------------------------------------------------ */
+
+typedef struct getme_gmsh_options getme_gmsh_options;
+
+/* Defaults: GETMe adaptive with getme_params_init() values, log level 2,
+   skin and interfaces fixed, no named groups.  NULL if out of memory. */
+GETME_GMSH_API getme_gmsh_options *getme_gmsh_options_new(void);
+GETME_GMSH_API void getme_gmsh_options_free(getme_gmsh_options *options);
+
+/*
+ * Set a number by name: every name of getme_params_set() ("max_iter",
+ * "sigma", "threshold_fraction", "num_threads", ...), plus
+ *   "log"            0 silent, 1 start/end lines and quality histograms,
+ *                    2 (default) also one line per iteration
+ *   "fix_skin"       1 (default): also fix every node on the mesh skin
+ *   "fix_interfaces" 1 (default): also fix nodes on faces between entities
+ *                    of different physical groups
+ * GETME_ERR_ARGUMENT for an unknown name or a value out of range (the
+ * reason is in getme_gmsh_options_error()).
+ */
+GETME_GMSH_API getme_status getme_gmsh_options_set(getme_gmsh_options *options,
+                                                   const char *name,
+                                                   double value);
+/* "getme" (or "adaptive") or "laplace" (smart Laplace, the baseline). */
+GETME_GMSH_API getme_status
+getme_gmsh_options_set_method(getme_gmsh_options *options, const char *method);
+/* Add a physical group whose nodes stay fixed: its name, or "dim:tag". */
+GETME_GMSH_API getme_status
+getme_gmsh_options_add_fixed_group(getme_gmsh_options *options,
+                                   const char *group);
+/* The GETMe parameters inside (for C callers: relaxation tables, progress
+   callback...).  Never NULL for a valid handle. */
+GETME_GMSH_API getme_params *
+getme_gmsh_options_params(getme_gmsh_options *options);
+/* Message of the last failed setter ("" if none). */
+GETME_GMSH_API const char *
+getme_gmsh_options_error(const getme_gmsh_options *options);
+
+/* ------------------------------------------------------------------------ */
+/* Optimizing the current model                                             */
+/* ------------------------------------------------------------------------ */
+
+typedef struct getme_gmsh_report {
+    int dim;                    /* 3 or 2: dimension smoothed                */
+    int num_entities;           /* entities smoothed together                */
+    int32_t num_nodes;          /* nodes of the selected elements            */
+    int32_t num_elements;
+    int32_t num_fixed;          /* of num_nodes                              */
+    int32_t num_moved;          /* nodes written back with SetNode           */
+    getme_quality_stats before; /* mean-ratio statistics before and after    */
+    getme_quality_stats after;
+    getme_result result;        /* iterations per stage, stop reason ...     */
+    double wall;                /* seconds for the whole call (wall, CPU)    */
+    double cpu;
+    char message[512];          /* "" on success, else the error             */
+} getme_gmsh_report;
+
+/*
+ * Smooth the mesh of the current Gmsh model.
+ *   niter      maximum number of GETMe (or Laplace) iterations; <= 0 keeps
+ *              the options' max_iter (default 1000)
+ *   dim_tags   dim_tags_n / 2 pairs (dim, tag) of entities of one dimension
+ *              (3, or 2 for planar surfaces); NULL / 0: all entities of the
+ *              highest dimension that has mesh elements
+ *   options    NULL: defaults
+ *   report     may be NULL
+ * Returns GETME_OK, or: GETME_ERR_STATE (Gmsh not initialized, no mesh),
+ * GETME_ERR_ARGUMENT (bad entity, unknown group), GETME_ERR_TOPOLOGY
+ * (unsupported or second-order elements, non-planar surface),
+ * GETME_ERR_INVALID_MESH (inverted elements), GETME_ERR_NOMEM.  On error
+ * the model is unchanged.
+ */
+GETME_GMSH_API getme_status getme_gmsh_optimize(
+    int niter, const int *dim_tags, size_t dim_tags_n,
+    const getme_gmsh_options *options, getme_gmsh_report *report);
+
+/*
+ * Mean-ratio statistics of the current model's elements (same selection
+ * rules and fixed nodes as getme_gmsh_optimize()) into report->before (and
+ * a copy in report->after); nothing is smoothed, nothing is logged.
+ */
+GETME_GMSH_API getme_status getme_gmsh_quality(
+    const int *dim_tags, size_t dim_tags_n, const getme_gmsh_options *options,
+    getme_gmsh_report *report);
+
+/* A report value by name, for bindings: "dim", "num_entities", "num_nodes",
+   "num_elements", "num_fixed", "num_moved", "wall", "cpu", "iterations",
+   "iterations_mean", "iterations_min", "cycles_min", "stop_reason",
+   "threshold", "seconds", "<before|after>_<q_min_star|q_min|q_mean|q_max|
+   num_invalid|num_below_04|num_below_01|num_elements|num_free>",
+   "<before|after>_hist<0..9>".  NaN for an unknown name. */
+GETME_GMSH_API double getme_gmsh_report_value(const getme_gmsh_report *report,
+                                              const char *name);
+GETME_GMSH_API size_t getme_gmsh_report_sizeof(void);
+
+/* ------------------------------------------------------------------------ */
+/* Model extraction (used by the MSH file adapter; usable on its own)        */
+/* ------------------------------------------------------------------------ */
+
+typedef struct getme_gmsh_model getme_gmsh_model;
+
+/*
+ * Build a getme_mesh from the current Gmsh model (selection as in
+ * getme_gmsh_optimize), with the fixed nodes marked.  On failure *model is
+ * NULL and message (if not NULL) receives the reason.  Does not log.
+ */
+GETME_GMSH_API getme_status getme_gmsh_model_read(
+    getme_gmsh_model **model, const int *dim_tags, size_t dim_tags_n,
+    const getme_gmsh_options *options, char *message, size_t message_size);
+GETME_GMSH_API void getme_gmsh_model_free(getme_gmsh_model *model);
+
+/* The mesh (owned by the model until taken; then the caller frees it). */
+GETME_GMSH_API getme_mesh *getme_gmsh_model_mesh(getme_gmsh_model *model);
+GETME_GMSH_API getme_mesh *getme_gmsh_model_take_mesh(getme_gmsh_model *model);
+
+GETME_GMSH_API int getme_gmsh_model_dim(const getme_gmsh_model *model);
+GETME_GMSH_API int getme_gmsh_model_num_entities(const getme_gmsh_model *model);
+GETME_GMSH_API int32_t getme_gmsh_model_num_nodes(const getme_gmsh_model *model);
+GETME_GMSH_API int32_t
+getme_gmsh_model_num_elements(const getme_gmsh_model *model);
+/* Gmsh node tag of mesh node i / element tag of mesh element e. */
+GETME_GMSH_API const size_t *
+getme_gmsh_model_node_tags(const getme_gmsh_model *model);
+GETME_GMSH_API const size_t *
+getme_gmsh_model_element_tags(const getme_gmsh_model *model);
+/* Describe mesh element e for messages: "tetrahedron 1234 in volume 2". */
+GETME_GMSH_API void getme_gmsh_model_describe_element(
+    const getme_gmsh_model *model, int32_t e, char *buf, size_t size);
+
+/*
+ * Write coordinates back into the current Gmsh model: coords holds 3 doubles
+ * per mesh node in the mesh's frame (as getme_mesh_coords() gives them).
+ * Only free nodes whose coordinates differ from those read are set.
+ * *num_moved (may be NULL) receives their number.
+ */
+GETME_GMSH_API getme_status getme_gmsh_model_apply(
+    const getme_gmsh_model *model, const double *coords, int32_t *num_moved,
+    char *message, size_t message_size);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* GETME_GMSH_H */

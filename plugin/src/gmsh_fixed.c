@@ -1,0 +1,148 @@
+/*
+ * gmsh_fixed.c -- which nodes of a Gmsh model must not move.
+ *
+ * DESIGN.md section 5 for Gmsh models: a node may move only if it is
+ * classified on one of the entities being smoothed.  Nodes classified on
+ * lower-dimensional entities (bounding surfaces, interfaces between
+ * volumes, curves, points, embedded entities) carry the geometry and stay
+ * put, as do the nodes of the physical groups the user names.
+ */
+#include "gmsh_internal.h"
+
+#include <gmshc.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+getme_status gg_fix_classified(const getme_gmsh_model *model,
+                               const gg_nodemap *local, uint8_t *fixed,
+                               gg_msg *msg)
+{
+    uint8_t *own = calloc(model->num_nodes ? (size_t)model->num_nodes : 1, 1);
+    if (!own)
+        return gg_fail(msg, GETME_ERR_NOMEM, "Out of memory");
+    for (int e = 0; e < model->num_entities; e++) {
+        size_t *tags = NULL, nt = 0, nc = 0, np = 0;
+        double *coord = NULL, *param = NULL;
+        int ierr = 0;
+        gmshModelMeshGetNodes(&tags, &nt, &coord, &nc, &param, &np,
+                              model->entities[2 * e],
+                              model->entities[2 * e + 1], 0, 0, &ierr);
+        for (size_t i = 0; !ierr && i < nt; i++) {
+            int32_t k = gg_nodemap_find(local, tags[i]);
+            if (k >= 0)
+                own[k] = 1;
+        }
+        gmshFree(tags);
+        gmshFree(coord);
+        gmshFree(param);
+    }
+    for (int32_t i = 0; i < model->num_nodes; i++)
+        if (!own[i])
+            fixed[i] = 1;
+    free(own);
+    return GETME_OK;
+}
+
+/* All physical groups as (dim, tag) pairs (gmsh-allocated). */
+static void list_groups(int **dt, size_t *n)
+{
+    int ierr = 0;
+    *dt = NULL;
+    *n = 0;
+    gmshModelGetPhysicalGroups(dt, n, -1, &ierr);
+    if (ierr) {
+        gmshFree(*dt);
+        *dt = NULL;
+        *n = 0;
+    }
+}
+
+static int group_name_is(int dim, int tag, const char *want)
+{
+    char *name = NULL;
+    int ierr = 0;
+    gmshModelGetPhysicalName(dim, tag, &name, &ierr);
+    int same = !ierr && name && strcmp(name, want) == 0;
+    gmshFree(name);
+    return same;
+}
+
+/* "a" (3:1), "b" (2:5)... for the error message. */
+static void describe_groups(const int *dt, size_t n, char *buf, size_t size)
+{
+    size_t used = 0;
+    buf[0] = 0;
+    for (size_t i = 0; i + 1 < n && used + 1 < size; i += 2) {
+        char *name = NULL;
+        int ierr = 0;
+        gmshModelGetPhysicalName(dt[i], dt[i + 1], &name, &ierr);
+        int w = snprintf(buf + used, size - used, "%s\"%s\" (%d:%d)",
+                         i ? ", " : "", name ? name : "", dt[i], dt[i + 1]);
+        gmshFree(name);
+        if (w < 0)
+            break;
+        used += (size_t)w;
+    }
+    if (!n)
+        snprintf(buf, size, "the model has no physical groups");
+}
+
+static void fix_group_nodes(int dim, int tag, const gg_nodemap *local,
+                            uint8_t *fixed)
+{
+    size_t *tags = NULL, nt = 0, nc = 0;
+    double *coord = NULL;
+    int ierr = 0;
+    gmshModelMeshGetNodesForPhysicalGroup(dim, tag, &tags, &nt, &coord, &nc,
+                                          &ierr);
+    for (size_t i = 0; !ierr && i < nt; i++) {
+        int32_t k = gg_nodemap_find(local, tags[i]);
+        if (k >= 0)
+            fixed[k] = 1;
+    }
+    gmshFree(tags);
+    gmshFree(coord);
+}
+
+/* Fix the groups matching one user word; 0 if none matched. */
+static int fix_one(const char *word, const int *dt, size_t n,
+                   const gg_nodemap *local, uint8_t *fixed)
+{
+    int dim, tag, used = 0, found = 0;
+    int by_tag = sscanf(word, "%d:%d%n", &dim, &tag, &used) == 2 &&
+                 word[used] == 0;
+    for (size_t i = 0; i + 1 < n; i += 2) {
+        int match = by_tag ? (dt[i] == dim && dt[i + 1] == tag)
+                           : group_name_is(dt[i], dt[i + 1], word);
+        if (match) {
+            fix_group_nodes(dt[i], dt[i + 1], local, fixed);
+            found++;
+        }
+    }
+    return found;
+}
+
+getme_status gg_fix_groups(const getme_gmsh_options *opt,
+                           const gg_nodemap *local, uint8_t *fixed,
+                           gg_msg *msg)
+{
+    if (!opt || opt->num_fix == 0)
+        return GETME_OK;
+    int *dt = NULL;
+    size_t n = 0;
+    list_groups(&dt, &n);
+    getme_status st = GETME_OK;
+    for (int g = 0; g < opt->num_fix && st == GETME_OK; g++) {
+        if (fix_one(opt->fix[g], dt, n, local, fixed))
+            continue;
+        char known[300];
+        describe_groups(dt, n, known, sizeof known);
+        st = gg_fail(msg, GETME_ERR_ARGUMENT,
+                     "Unknown physical group '%s' to fix (%s)", opt->fix[g],
+                     known);
+    }
+    gmshFree(dt);
+    return st;
+}

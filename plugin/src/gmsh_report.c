@@ -1,0 +1,72 @@
+/*
+ * gmsh_report.c -- report values by name, so bindings (ctypes) need not
+ * mirror the C struct layout.
+ */
+#include "gmsh_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+size_t getme_gmsh_report_sizeof(void) { return sizeof(getme_gmsh_report); }
+
+static double stats_value(const getme_quality_stats *s, const char *name)
+{
+    int bin;
+    char rest;
+    if (sscanf(name, "hist%d%c", &bin, &rest) == 1 && bin >= 0 &&
+        bin < GETME_HIST_BINS)
+        return (double)s->histogram[bin];
+    static const char *const names[] = {
+        "q_min_star", "q_min", "q_mean", "q_max", "num_invalid",
+        "num_below_04", "num_below_01", "num_elements", "num_free"};
+    const double values[] = {s->q_min_star,
+                             s->q_min,
+                             s->q_mean,
+                             s->q_max,
+                             (double)s->num_invalid,
+                             (double)s->num_below_04,
+                             (double)s->num_below_01,
+                             (double)s->num_elements,
+                             (double)s->num_free};
+    for (size_t i = 0; i < sizeof names / sizeof *names; i++)
+        if (strcmp(name, names[i]) == 0)
+            return values[i];
+    return NAN;
+}
+
+double getme_gmsh_report_value(const getme_gmsh_report *r, const char *name)
+{
+    if (!r || !name)
+        return NAN;
+    if (strncmp(name, "before_", 7) == 0)
+        return stats_value(&r->before, name + 7);
+    if (strncmp(name, "after_", 6) == 0)
+        return stats_value(&r->after, name + 6);
+    const getme_result *res = &r->result;
+    static const char *const names[] = {
+        "dim", "num_entities", "num_nodes", "num_elements", "num_fixed",
+        "num_moved", "wall", "cpu", "iterations", "iterations_mean",
+        "iterations_min", "cycles_min", "stop_reason", "threshold",
+        "seconds"};
+    const double values[] = {r->dim,
+                             r->num_entities,
+                             r->num_nodes,
+                             r->num_elements,
+                             r->num_fixed,
+                             r->num_moved,
+                             r->wall,
+                             r->cpu,
+                             res->iterations,
+                             res->iterations_mean,
+                             res->iterations_min,
+                             res->cycles_min,
+                             (double)res->stop_reason,
+                             res->threshold,
+                             res->seconds};
+    for (size_t i = 0; i < sizeof names / sizeof *names; i++)
+        if (strcmp(name, names[i]) == 0)
+            return values[i];
+    return NAN;
+}
