@@ -25,6 +25,7 @@
  */
 #include "smooth_internal.h"
 
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -34,6 +35,7 @@ enum { MEAN_RUNNING, MIN_START, MIN_RUNNING };
 static int32_t add_transformed(getme_run *run, int32_t e0, int32_t e1,
                                double qt, double sigma)
 {
+    getme_stamp *st = &run->stamps[omp_get_thread_num()];
     const getme_ws *ws = run->ws;
     int t = getme__ws_type(ws, e0), nv = getme__nv[t];
     int32_t count = 0;
@@ -41,7 +43,7 @@ static int32_t add_transformed(getme_run *run, int32_t e0, int32_t e1,
         if (!ws->free_elem[e] || run->q[e] > qt)
             continue;
         double x[3 * GETME_MAX_NV], y[3 * GETME_MAX_NV];
-        double w = getme__weight(ws, run->q, t, e);
+        double w = getme__weight(ws, run->q, t, e, st);
         getme__ws_gather(ws, ws->x, t, e, x);
         getme__transform(t, x, sigma, y);
         const int32_t *c = getme__ws_nodes(ws, t, e);
@@ -65,6 +67,7 @@ static int32_t add_transformed(getme_run *run, int32_t e0, int32_t e1,
 static void add_untransformed(getme_run *run, int32_t e0, int32_t e1,
                               double qt)
 {
+    getme_stamp *st = &run->stamps[omp_get_thread_num()];
     const getme_ws *ws = run->ws;
     int t = getme__ws_type(ws, e0), nv = getme__nv[t];
     for (int32_t e = e0; e < e1; e++) {
@@ -76,7 +79,7 @@ static void add_untransformed(getme_run *run, int32_t e0, int32_t e1,
             any |= run->in_t[c[i]];
         if (!any)
             continue;
-        double w = getme__weight(ws, run->q, t, e);
+        double w = getme__weight(ws, run->q, t, e, st);
         for (int i = 0; i < nv; i++) {
             int32_t n = c[i];
             if (!run->in_t[n])

@@ -7,6 +7,12 @@
 
 #include "workspace.h"
 
+/* Per-thread dedupe marks for the Eq. 9 neighbour sums (weights.c). */
+typedef struct getme_stamp {
+    uint32_t *mark; /* ne entries */
+    uint32_t now;
+} getme_stamp;
+
 /* Scratch arrays of one smoothing run, allocated once. */
 typedef struct getme_run {
     getme_ws *ws;
@@ -25,13 +31,15 @@ typedef struct getme_run {
     int32_t *nodes;     /* nn: compacted list of I_T                        */
     int32_t *elems;     /* ne: compacted list of elements touching I_T      */
     int32_t num_nodes, num_elems;
+    getme_stamp *stamps;/* one per thread                                   */
 } getme_run;
 
 getme_status getme__run_alloc(getme_run *run);
 void getme__run_free(getme_run *run);
 
 /* Eq. 9 weight of element e (type t) from the qualities q. */
-double getme__weight(const getme_ws *ws, const double *q, int t, int32_t e);
+double getme__weight(const getme_ws *ws, const double *q, int t, int32_t e,
+                     getme_stamp *stamp);
 
 /* Build run->nodes from run->in_t and run->elems (elements with a node in
    I_T), both ascending; deterministic. */
