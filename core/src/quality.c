@@ -12,15 +12,18 @@
  * analogue for planar corners is q_k = 2 det(S_k) / tr(S_k^T S_k).
  *
  * These are the hot path of the smoother (hundreds of millions of calls), so
- * W^-1 is applied as precomputed constants, det^(2/3) is cbrt(det)^2 (one
- * cbrt, no pow, and no overflow before the det itself would overflow), and
- * every kernel is straight-line code whose only decision is validity.
+ * W^-1 is applied as precomputed constants, det^(2/3) is c^2 with c the cube
+ * root of det (no pow), and every kernel is straight-line code whose only
+ * decision is validity.  The cube root is our own (cube_root() below):
+ * glibc's cbrt() took two thirds of the time of a hex quality.
  * Non-finite coordinates give a NaN det or q, which fails the "> 0" tests
  * and so also yields 0.
  */
 #include "internal.h"
 
 #include <math.h>
+#include <stdint.h>
+#include <string.h>
 
 const int getme__nv[GETME_NUM_TYPES] = {4, 8, 6, 5, 3, 4};
 
@@ -74,10 +77,36 @@ static inline double det3(const double a[3], const double b[3],
            a[2] * (b[0] * c[1] - b[1] * c[0]);
 }
 
+/*
+ * Cube root of x > 0, branch-free, within 4 ulp (6.7e-16 relative, measured
+ * against cbrt() on 2e7 random x in 2^-1000..2^1000) and exact for cubes of
+ * small integers (1 and 8 give 1 and 2, so regular elements give q = 1):
+ * an initial guess from the exponent bits (bits/3 + a bias that makes the
+ * guess good to a few per cent), two Halley steps (error cubed each) and a
+ * Newton step (error squared, and it cleans the last rounding).  The
+ * Halley steps divide before multiplying so nothing overflows below
+ * x ~ 1e307.  Valid range: normal x up to 1e307, i.e. element edges between
+ * ~1e-100 and ~1e100; x <= 0 or non-finite gives garbage or NaN, which the
+ * callers' validity tests discard.  2-3x faster than glibc's cbrt().
+ */
+static inline double cube_root(double x)
+{
+    uint64_t bits;
+    double y;
+    memcpy(&bits, &x, sizeof bits);
+    bits = bits / 3u + UINT64_C(0x2A9F7893782DA1CE);
+    memcpy(&y, &bits, sizeof y);
+    double y3 = y * y * y;
+    y += y * ((x - y3) / (2.0 * y3 + x));
+    y3 = y * y * y;
+    y += y * ((x - y3) / (2.0 * y3 + x));
+    return y + (x / (y * y) - y) * (1.0 / 3.0);
+}
+
 /* 3 det^(2/3) / frob2 for one simplex; its sign is checked by the caller */
 static inline double ratio3(double det, double frob2)
 {
-    double c = cbrt(det);
+    double c = cube_root(det);
     return 3.0 * c * c / frob2;
 }
 

@@ -90,34 +90,39 @@ static inline void face_centroids(const dual_topology *t, const double *x,
 }
 
 /* The raw dual step (no scaling) of every node into out; the last node
-   uses sigma_last (the pyramid's apex), all others sigma. */
+   uses sigma_last (the pyramid's apex), all others sigma.  Done in phases
+   over small arrays so that the 2 square roots and the division of each
+   node run side by side instead of as one long dependency chain. */
 static inline void dual_step(const dual_topology *t, const double *x,
                              double sigma, double sigma_last, double *out)
 {
-    double c[6][3];
+    double c[6][3], m[8][3], n[8][3], f[8];
     face_centroids(t, x, c);
     for (int i = 0; i < t->nv; i++) {
         int k = t->node_faces[i];
-        double m[3] = {0.0, 0.0, 0.0}, n[3] = {0.0, 0.0, 0.0};
+        for (int d = 0; d < 3; d++)
+            m[i][d] = n[i][d] = 0.0;
         for (int j = 0; j < k; j++)
             for (int d = 0; d < 3; d++)
-                m[d] += c[t->around[i][j]][d];
+                m[i][d] += c[t->around[i][j]][d];
         for (int d = 0; d < 3; d++)
-            m[d] /= k;
+            m[i][d] /= k;
         for (int j = 0; j < k; j++) {
             const double *a = c[t->around[i][j]];
             const double *b = c[t->around[i][(j + 1) % k]];
-            double u[3] = {a[0] - m[0], a[1] - m[1], a[2] - m[2]};
-            double v[3] = {b[0] - m[0], b[1] - m[1], b[2] - m[2]};
-            n[0] += 0.5 * (u[1] * v[2] - u[2] * v[1]);
-            n[1] += 0.5 * (u[2] * v[0] - u[0] * v[2]);
-            n[2] += 0.5 * (u[0] * v[1] - u[1] * v[0]);
+            double u[3] = {a[0] - m[i][0], a[1] - m[i][1], a[2] - m[i][2]};
+            double v[3] = {b[0] - m[i][0], b[1] - m[i][1], b[2] - m[i][2]};
+            n[i][0] += 0.5 * (u[1] * v[2] - u[2] * v[1]);
+            n[i][1] += 0.5 * (u[2] * v[0] - u[0] * v[2]);
+            n[i][2] += 0.5 * (u[0] * v[1] - u[1] * v[0]);
         }
-        double f = (i == t->nv - 1 ? sigma_last : sigma) *
-                   getme__inv_sqrt_norm(n);
-        for (int d = 0; d < 3; d++)
-            out[3 * i + d] = m[d] + f * n[d];
     }
+    for (int i = 0; i < t->nv; i++)
+        f[i] = (i == t->nv - 1 ? sigma_last : sigma) *
+               getme__inv_sqrt_norm(n[i]);
+    for (int i = 0; i < t->nv; i++)
+        for (int d = 0; d < 3; d++)
+            out[3 * i + d] = m[i][d] + f[i] * n[i][d];
 }
 
 /* Stretch the nv nodes of out by kappa along the direction axis (any
@@ -126,8 +131,8 @@ static inline void stretch_along(double *out, int nv, const double axis[3],
                                  double kappa)
 {
     double a[3] = {axis[0], axis[1], axis[2]};
-    double inv = 1.0 / fmax(sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]),
-                            DBL_MIN);
+    double inv = 1.0 / getme__at_least(
+                           sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]), DBL_MIN);
     double c[3] = {0.0, 0.0, 0.0};
     for (int d = 0; d < 3; d++)
         a[d] *= inv;

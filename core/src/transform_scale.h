@@ -14,16 +14,26 @@
 #include <float.h>
 #include <math.h>
 
-/* Sum of the lengths of the ne edges (node pairs) of a volume element. */
+/* a if a > lo, else lo: like fmax for our non-NaN use, but a single
+   instruction (fmax stays a libm call without -ffast-math). */
+static inline double getme__at_least(double a, double lo)
+{
+    return a > lo ? a : lo;
+}
+
+/* Sum of the lengths of the ne edges (node pairs) of a volume element.  The
+   squared lengths are gathered first so the square roots vectorise. */
 static inline double getme__edge_sum3(const double *x, int ne,
                                       const unsigned char (*edges)[2])
 {
-    double sum = 0.0;
+    double l2[12], sum = 0.0;
     for (int k = 0; k < ne; k++) {
         const double *a = x + 3 * edges[k][0], *b = x + 3 * edges[k][1];
         double dx = b[0] - a[0], dy = b[1] - a[1], dz = b[2] - a[2];
-        sum += sqrt(dx * dx + dy * dy + dz * dz);
+        l2[k] = dx * dx + dy * dy + dz * dz;
     }
+    for (int k = 0; k < ne; k++)
+        sum += sqrt(l2[k]);
     return sum;
 }
 
@@ -47,7 +57,7 @@ static inline void getme__rescale3(double *out, const double *x, int nv,
         c0[d] /= nv;
     }
     double f = getme__edge_sum3(x, ne, edges) /
-               fmax(getme__edge_sum3(out, ne, edges), DBL_MIN);
+               getme__at_least(getme__edge_sum3(out, ne, edges), DBL_MIN);
     for (int i = 0; i < nv; i++)
         for (int d = 0; d < 3; d++)
             out[3 * i + d] = c0[d] + f * (out[3 * i + d] - c[d]);
@@ -80,19 +90,20 @@ static inline void getme__rescale_xy(double *out, const double *x, int n)
     cx0 /= n;
     cy0 /= n;
     double f = getme__perimeter_xy(x, n) /
-               fmax(getme__perimeter_xy(out, n), DBL_MIN);
+               getme__at_least(getme__perimeter_xy(out, n), DBL_MIN);
     for (int i = 0; i < n; i++) {
         out[3 * i] = cx0 + f * (out[3 * i] - cx);
         out[3 * i + 1] = cy0 + f * (out[3 * i + 1] - cy);
     }
 }
 
-/* n / sqrt|n|: the paper's normal scaling, which makes the displacement
-   scale like an edge length.  A zero normal (degenerate face) gives 0. */
+/* 1 / sqrt|n|: the paper's normal scaling, which makes the displacement
+   n / sqrt|n| scale like an edge length.  A zero normal (degenerate face)
+   gets a finite factor, so its displacement is 0, not NaN. */
 static inline double getme__inv_sqrt_norm(const double n[3])
 {
     double nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
-    return 1.0 / sqrt(sqrt(fmax(nn, DBL_MIN)));
+    return 1.0 / sqrt(sqrt(getme__at_least(nn, DBL_MIN)));
 }
 
 #endif /* GETME_TRANSFORM_SCALE_H */

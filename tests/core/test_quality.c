@@ -164,10 +164,12 @@ static void test_affine_images(void)
     }
 }
 
-/* Translation, rotation and uniform scaling leave q unchanged. */
+/* Translation, rotation and uniform scaling leave q unchanged (sizes far
+   outside any mesh unit, 1e-60 and 1e60, included: the kernels are meant
+   for edges between ~1e-100 and ~1e100). */
 static void test_invariance(void)
 {
-    static const double scales[] = {1e-3, 0.1, 7.5, 1e3};
+    static const double scales[] = {1e-60, 1e-3, 0.1, 7.5, 1e3, 1e60};
     for (int t = 0; t < GETME_NUM_TYPES; t++) {
         int nv = getme_type_num_nodes((getme_elem_type)t);
         for (int trial = 0; trial < 50; trial++) {
@@ -182,7 +184,7 @@ static void test_invariance(void)
             random_rotation(is_planar(t), R);
             affine(x, nv, R, zero, y);
             CHECK_NEAR(getme_element_quality((getme_elem_type)t, y), q, TOL * q);
-            for (int s = 0; s < 4; s++) {
+            for (int s = 0; s < 6; s++) {
                 double S[9] = {scales[s], 0, 0, 0, scales[s], 0, 0, 0, scales[s]};
                 affine(x, nv, S, zero, y);
                 CHECK_NEAR(getme_element_quality((getme_elem_type)t, y), q, TOL * q);
