@@ -1,0 +1,218 @@
+/*
+ * inp_lines.c -- streaming line reader and data-line fields of the INP
+ * adapter.  One buffer per open file, reused for every line: a deck of any
+ * size is read with constant memory for its text.
+ */
+#include "inp_internal.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define CHUNK (1 << 16)
+
+int inp_lines_open(inp_lines *r, const char *path)
+{
+    memset(r, 0, sizeof *r);
+    r->fp = fopen(path, "rb");
+    if (!r->fp)
+        return -1;
+    r->cap = 4 * CHUNK;
+    r->buf = malloc(r->cap + 1);
+    if (!r->buf) {
+        fclose(r->fp);
+        r->fp = NULL;
+        errno = ENOMEM;
+        return -1;
+    }
+    return 0;
+}
+
+void inp_lines_close(inp_lines *r)
+{
+    if (r->fp)
+        fclose(r->fp);
+    free(r->buf);
+    memset(r, 0, sizeof *r);
+}
+
+/* Move the unread bytes to the front and read more; grow the buffer only
+   when one line does not fit.  0, -1 read error, -2 line too long. */
+static int refill(inp_lines *r)
+{
+    if (r->beg > 0) {
+        memmove(r->buf, r->buf + r->beg, r->end - r->beg);
+        r->end -= r->beg;
+        r->beg = 0;
+    }
+    if (r->end == r->cap) {
+        if (r->cap > INP_MAX_LINE)
+            return -2;
+        char *b = realloc(r->buf, 2 * r->cap + 1);
+        if (!b)
+            return -1;
+        r->buf = b;
+        r->cap *= 2;
+    }
+    size_t got = fread(r->buf + r->end, 1, r->cap - r->end, r->fp);
+    if (got == 0) {
+        if (ferror(r->fp))
+            return -1;
+        r->eof = 1;
+    }
+    r->end += got;
+    return 0;
+}
+
+int inp_lines_next(inp_lines *r)
+{
+    char *nl;
+    for (;;) {
+        nl = memchr(r->buf + r->beg, '\n', r->end - r->beg);
+        if (nl || r->eof)
+            break;
+        int rc = refill(r);
+        if (rc)
+            return rc;
+    }
+    if (!nl && r->beg == r->end)
+        return 0;
+    char *start = r->buf + r->beg;
+    size_t len = nl ? (size_t)(nl - start) : r->end - r->beg;
+    size_t used = nl ? len + 1 : len;
+    r->term = nl ? "\n" : "";
+    if (nl && len > 0 && start[len - 1] == '\r') {
+        len--;
+        r->term = "\r\n";
+    }
+    if (len > INP_MAX_LINE)
+        return -2;
+    /* The terminator byte (or the spare byte after the buffer) becomes the
+       NUL, so callers get a C string without copying. */
+    start[len] = '\0';
+    r->text = start;
+    r->len = len;
+    r->offset = r->next_offset;
+    r->next_offset += (int64_t)used;
+    r->beg += used;
+    r->lineno++;
+    return 1;
+}
+
+static int is_blank(int c) { return c == ' ' || c == '\t' || c == '\r'; }
+
+int inp_line_kind(const char *text, size_t len)
+{
+    size_t i = 0;
+    while (i < len && is_blank((unsigned char)text[i]))
+        i++;
+    if (i == len)
+        return INP_LINE_BLANK;
+    if (text[i] == '*')
+        return i + 1 < len && text[i + 1] == '*' ? INP_LINE_COMMENT
+                                                 : INP_LINE_KEYWORD;
+    return INP_LINE_DATA;
+}
+
+int inp_next_field(const char **p, const char *end, inp_field *f, int *last)
+{
+    const char *s = *p;
+    if (!s || s > end)
+        return 0;
+    const char *c = memchr(s, ',', (size_t)(end - s));
+    const char *e = c ? c : end;
+    while (s < e && is_blank((unsigned char)*s))
+        s++;
+    const char *t = e;
+    while (t > s && is_blank((unsigned char)t[-1]))
+        t--;
+    f->s = s;
+    f->n = (size_t)(t - s);
+    *last = c == NULL;
+    /* After the last field *p is past the end, so the next call says 0. */
+    *p = c ? c + 1 : end + 1;
+    return 1;
+}
+
+int inp_parse_int(const inp_field *f, int64_t *v)
+{
+    size_t i = 0;
+    int neg = 0;
+    if (f->n == 0)
+        return -1;
+    if (f->s[0] == '+' || f->s[0] == '-') {
+        neg = f->s[0] == '-';
+        i = 1;
+    }
+    if (i == f->n)
+        return -1;
+    int64_t x = 0;
+    for (; i < f->n; i++) {
+        int c = (unsigned char)f->s[i];
+        if (c < '0' || c > '9')
+            return -1;
+        if (x > (INT64_MAX - 9) / 10)
+            return -1;
+        x = 10 * x + (c - '0');
+    }
+    *v = neg ? -x : x;
+    return 0;
+}
+
+int inp_parse_real(const inp_field *f, double *v)
+{
+    char tmp[INP_MAX_TOKEN];
+    if (f->n == 0) {
+        *v = 0.0;
+        return 0;
+    }
+    if (f->n >= sizeof tmp)
+        return -1;
+    int c0 = (unsigned char)f->s[0];
+    /* strtod would also take "nan", "inf" and hex floats: not numbers in
+       an input deck. */
+    if (!(c0 == '+' || c0 == '-' || c0 == '.' || (c0 >= '0' && c0 <= '9')))
+        return -1;
+    for (size_t i = 0; i < f->n; i++) {
+        int c = (unsigned char)f->s[i];
+        if (c == 'x' || c == 'X')
+            return -1;
+        /* Fortran double-precision exponents: 1.5D+03. */
+        tmp[i] = (char)(c == 'd' || c == 'D' ? 'e' : c);
+    }
+    tmp[f->n] = '\0';
+    char *endp;
+    errno = 0;
+    double x = strtod(tmp, &endp);
+    if (endp != tmp + f->n || !isfinite(x))
+        return -1;
+    *v = x;
+    return 0;
+}
+
+int inp_is_label(const inp_field *f)
+{
+    if (f->n == 0)
+        return 0;
+    int c = (unsigned char)f->s[0];
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_' ||
+           c == '"';
+}
+
+int inp_format_real(double v, char *buf)
+{
+    /* Abaqus reads at most 20 characters per real field; within that,
+       prefer the shortest text that reads back to the same double. */
+    for (int prec = 15; prec <= 17; prec++) {
+        int n = snprintf(buf, 32, "%.*g", prec, v);
+        if (n <= 20 && strtod(buf, NULL) == v)
+            return n;
+    }
+    for (int prec = 17; prec > 1; prec--) {
+        int n = snprintf(buf, 32, "%.*g", prec, v);
+        if (n <= 20)
+            return n;
+    }
+    return snprintf(buf, 32, "%.1g", v);
+}

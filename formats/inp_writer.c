@@ -1,0 +1,329 @@
+/*
+ * inp_writer.c -- write the deck back with the smoothed coordinates.
+ *
+ * Every file (the deck and each *INCLUDE occurrence) is re-read and copied
+ * line by line, byte for byte, with its own line endings.  Two kinds of
+ * lines change:
+ *  - a *NODE data line whose node moved: the coordinate fields get the new
+ *    values, everything else on the line (node number, spacing, extra
+ *    fields) stays; a node that did not move keeps its original text, so
+ *    fixed nodes stay bit-identical;
+ *  - an *INCLUDE line: its INPUT= value names the written copy of the
+ *    included file, "<output stem>.<included file name>" next to the
+ *    output (a "-2", "-3"... before the extension if two included files
+ *    share a name).
+ * Everything goes to temporary files that are renamed only once all are
+ * complete: no partial output, the input is never touched.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "inp_internal.h"
+
+#include <errno.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+
+#define PATH_BUF 4096
+
+typedef struct writer {
+    getme_doc *doc;
+    const inp_doc *st;
+    const double *xyz;
+    int dim;
+    char (*out)[PATH_BUF]; /* final name per file occurrence        */
+    char (*tmp)[PATH_BUF]; /* temporary name per file occurrence    */
+    int32_t moved;         /* node lines rewritten                  */
+} writer;
+
+static const char *base_name(const char *p)
+{
+    const char *s = strrchr(p, '/');
+    return s ? s + 1 : p;
+}
+
+/* Output names: the deck to out_path, includes next to it. */
+static getme_io_status name_outputs(writer *w, const char *out_path)
+{
+    const inp_doc *st = w->st;
+    const char *base = base_name(out_path);
+    size_t dirlen = (size_t)(base - out_path);
+    const char *dot = strrchr(base, '.');
+    size_t stemlen = dot && dot != base ? (size_t)(dot - base) : strlen(base);
+    if (strlen(out_path) >= PATH_BUF - 64)
+        return getme_doc_fail(w->doc, GETME_IO_ERR_WRITE, "%s: path too long",
+                              out_path);
+    snprintf(w->out[0], PATH_BUF, "%s", out_path);
+    for (size_t i = 1; i < st->nfiles; i++) {
+        const char *inc = base_name(st->files[i].path);
+        const char *idot = strrchr(inc, '.');
+        size_t ilen = idot && idot != inc ? (size_t)(idot - inc) : strlen(inc);
+        const char *ext = idot && idot != inc ? idot : "";
+        for (int n = 1;; n++) {
+            char suffix[16] = "";
+            if (n > 1)
+                snprintf(suffix, sizeof suffix, "-%d", n);
+            int len = snprintf(w->out[i], PATH_BUF, "%.*s%.*s.%.*s%s%s",
+                               (int)dirlen, out_path, (int)stemlen, base,
+                               (int)ilen, inc, suffix, ext);
+            if (len < 0 || len >= PATH_BUF)
+                return getme_doc_fail(w->doc, GETME_IO_ERR_WRITE,
+                                      "%s: path too long", out_path);
+            int clash = 0;
+            for (size_t j = 0; j < i && !clash; j++)
+                clash = strcmp(w->out[j], w->out[i]) == 0;
+            if (!clash)
+                break;
+        }
+    }
+    /* Never overwrite any file of the input deck. */
+    for (size_t i = 0; i < st->nfiles; i++)
+        for (size_t j = 0; j < st->nfiles; j++)
+            if (getme_io_same_file(w->out[i], st->files[j].path))
+                return getme_doc_fail(w->doc, GETME_IO_ERR_USAGE,
+                                      "output '%s' would overwrite input '%s'",
+                                      w->out[i], st->files[j].path);
+    return GETME_IO_OK;
+}
+
+/* ---- one node line ---------------------------------------------------------- */
+
+static int same_bits(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
+
+static int put(FILE *out, const char *s, size_t n)
+{
+    return n && fwrite(s, 1, n, out) != n ? -1 : 0;
+}
+
+static int put_real(FILE *out, double v)
+{
+    char buf[32];
+    int n = inp_format_real(v, buf);
+    return put(out, buf, (size_t)n);
+}
+
+/* 1: the line is not node `id` (the file changed); -1: write error. */
+static int node_line(writer *w, FILE *out, const inp_lines *in, int32_t node)
+{
+    const char *p = in->text, *end = in->text + in->len;
+    inp_field f[4];
+    int last = 0, nf = 0;
+    while (nf < 4 && !last && inp_next_field(&p, end, &f[nf], &last))
+        nf++;
+    int64_t id;
+    if (nf < 1 || inp_parse_int(&f[0], &id) || id != w->st->node_id[node])
+        return 1;
+    const double *x = w->xyz + 3 * (size_t)node;
+    double old[3] = {0, 0, 0};
+    int moved = 0, ncoord = nf - 1;
+    for (int k = 0; k < 3; k++) {
+        if (k < ncoord && inp_parse_real(&f[k + 1], &old[k]))
+            return 1;
+        moved |= !same_bits(old[k], x[k]);
+    }
+    if (!moved)
+        return put(out, in->text, in->len);
+    w->moved++;
+    /* Replace the number of each coordinate field in place. */
+    const char *cur = in->text;
+    for (int k = 0; k < ncoord; k++) {
+        if (put(out, cur, (size_t)(f[k + 1].s - cur)) || put_real(out, x[k]))
+            return -1;
+        cur = f[k + 1].s + f[k + 1].n;
+    }
+    /* Coordinates the line left out (0 in Abaqus) that are not 0 now. */
+    int need = ncoord;
+    for (int k = ncoord; k < 3; k++)
+        if (!same_bits(x[k], 0.0))
+            need = k + 1;
+    if (need > ncoord && put(out, cur, (size_t)(end - cur)))
+        return -1;
+    for (int k = ncoord; k < need; k++)
+        if (put(out, ", ", 2) || put_real(out, x[k]))
+            return -1;
+    return need > ncoord ? 0 : put(out, cur, (size_t)(end - cur));
+}
+
+/* ---- one file --------------------------------------------------------------- */
+
+static int include_line(writer *w, FILE *out, const inp_lines *in,
+                        const inp_include *inc)
+{
+    if (inc->col < 0 || (size_t)(inc->col + inc->len) > in->len)
+        return 1;
+    const char *name = base_name(w->out[inc->child]);
+    int quoted = inc->len > 0 && in->text[inc->col] == '"';
+    if (put(out, in->text, (size_t)inc->col) || (quoted && put(out, "\"", 1)) ||
+        put(out, name, strlen(name)) || (quoted && put(out, "\"", 1)) ||
+        put(out, in->text + inc->col + inc->len,
+            in->len - (size_t)(inc->col + inc->len)))
+        return -1;
+    return 0;
+}
+
+static getme_io_status changed(writer *w, int file)
+{
+    return getme_doc_fail(w->doc, GETME_IO_ERR_WRITE,
+                          "'%s' changed since it was read: not writing",
+                          w->st->files[file].path);
+}
+
+static int unchanged(const inp_file *f)
+{
+    struct stat sb;
+    return stat(f->path, &sb) == 0 && (int64_t)sb.st_size == f->size &&
+           (int64_t)sb.st_mtim.tv_sec == f->mtime_sec &&
+           (int64_t)sb.st_mtim.tv_nsec == f->mtime_nsec;
+}
+
+typedef struct cursor {
+    size_t nb, inc;        /* next node block / include of this file   */
+    int32_t node, remain;  /* inside a node block                      */
+} cursor;
+
+static size_t next_nblock(const inp_doc *st, size_t k, int file)
+{
+    while (k < st->nnblocks && st->nblocks[k].file != file)
+        k++;
+    return k;
+}
+
+static size_t next_inc(const inp_doc *st, size_t k, int file)
+{
+    while (k < st->nincs && st->incs[k].file != file)
+        k++;
+    return k;
+}
+
+/* Copy one line, patched if needed: 0 ok, 1 file changed, -1 write error. */
+static int copy_line(writer *w, FILE *out, const inp_lines *in, int file,
+                     cursor *c)
+{
+    const inp_doc *st = w->st;
+    int rc;
+    if (c->inc < st->nincs && st->incs[c->inc].offset == in->offset) {
+        rc = include_line(w, out, in, &st->incs[c->inc]);
+        c->inc = next_inc(st, c->inc + 1, file);
+    } else if (c->remain == 0 && c->nb < st->nnblocks &&
+               st->nblocks[c->nb].offset == in->offset) {
+        c->node = st->nblocks[c->nb].first;
+        c->remain = st->nblocks[c->nb].count;
+        c->nb = next_nblock(st, c->nb + 1, file);
+        rc = node_line(w, out, in, c->node++);
+        c->remain--;
+    } else if (c->remain > 0) {
+        int kind = inp_line_kind(in->text, in->len);
+        if (kind == INP_LINE_KEYWORD)
+            return 1;
+        if (kind == INP_LINE_DATA) {
+            rc = node_line(w, out, in, c->node++);
+            c->remain--;
+        } else {
+            rc = put(out, in->text, in->len);
+        }
+    } else {
+        rc = put(out, in->text, in->len);
+    }
+    if (rc)
+        return rc;
+    return put(out, in->term, strlen(in->term));
+}
+
+static getme_io_status write_file(writer *w, int file)
+{
+    const inp_doc *st = w->st;
+    const char *path = st->files[file].path;
+    if (!unchanged(&st->files[file]))
+        return changed(w, file);
+    inp_lines in;
+    if (inp_lines_open(&in, path))
+        return getme_doc_fail(w->doc, GETME_IO_ERR_OPEN, "cannot reopen '%s': %s",
+                              path, strerror(errno));
+    FILE *out = fopen(w->tmp[file], "wb");
+    if (!out) {
+        int e = errno;
+        inp_lines_close(&in);
+        return getme_doc_fail(w->doc, GETME_IO_ERR_WRITE, "cannot write '%s': %s",
+                              w->out[file], strerror(e));
+    }
+    static const size_t outbuf = 1 << 20;
+    setvbuf(out, NULL, _IOFBF, outbuf);
+    cursor c = {next_nblock(st, 0, file), next_inc(st, 0, file), 0, 0};
+    int rc = 0, r;
+    while (rc == 0 && (r = inp_lines_next(&in)) == 1)
+        rc = copy_line(w, out, &in, file, &c);
+    if (rc == 0 && (r < 0 || c.remain > 0 || c.nb < st->nnblocks))
+        rc = 1;
+    int werr = rc < 0 || ferror(out);
+    if (fclose(out) != 0)
+        werr = 1;
+    inp_lines_close(&in);
+    if (werr)
+        return getme_doc_fail(w->doc, GETME_IO_ERR_WRITE, "cannot write '%s': %s",
+                              w->out[file], strerror(errno ? errno : EIO));
+    if (rc)
+        return changed(w, file);
+    return GETME_IO_OK;
+}
+
+static getme_io_status write_all(writer *w, const char *out_path)
+{
+    const inp_doc *st = w->st;
+    getme_io_status s = name_outputs(w, out_path);
+    if (s)
+        return s;
+    size_t made = 0;
+    for (; made < st->nfiles && !s; made++)
+        if (getme_io_tmp_path(w->out[made], w->tmp[made], PATH_BUF))
+            s = getme_doc_fail(w->doc, GETME_IO_ERR_WRITE,
+                               "cannot create a temporary file next to '%s': %s",
+                               w->out[made], strerror(errno));
+    if (s)
+        made--; /* the failed one created nothing */
+    for (size_t i = 0; i < st->nfiles && !s; i++)
+        s = write_file(w, (int)i);
+    if (s) {
+        for (size_t i = 0; i < made; i++)
+            remove(w->tmp[i]);
+        return s;
+    }
+    /* Includes first, the deck last: a reader of the output never sees a
+       deck whose includes are missing. */
+    for (size_t i = st->nfiles; i-- > 0;)
+        if (getme_io_commit(w->tmp[i], w->out[i])) {
+            int e = errno;
+            for (size_t j = 0; j < i; j++)
+                remove(w->tmp[j]);
+            return getme_doc_fail(w->doc, GETME_IO_ERR_WRITE,
+                                  "cannot write '%s': %s", w->out[i],
+                                  strerror(e));
+        }
+    return GETME_IO_OK;
+}
+
+getme_io_status inp_write(getme_doc *doc, const inp_doc *st,
+                          const char *out_path)
+{
+    if (!st || !doc->mesh)
+        return getme_doc_fail(doc, GETME_IO_ERR_INTERNAL, "document not open");
+    if (getme_mesh_num_nodes(doc->mesh) != st->nnodes)
+        return getme_doc_fail(doc, GETME_IO_ERR_INTERNAL,
+                              "mesh and deck differ in node count");
+    writer w;
+    memset(&w, 0, sizeof w);
+    w.doc = doc;
+    w.st = st;
+    w.xyz = getme_mesh_coords(doc->mesh);
+    w.dim = getme_mesh_dim(doc->mesh);
+    w.out = malloc(st->nfiles * sizeof *w.out);
+    w.tmp = malloc(st->nfiles * sizeof *w.tmp);
+    getme_io_status s = w.out && w.tmp
+                            ? write_all(&w, out_path)
+                            : getme_doc_fail(doc, GETME_IO_ERR_INTERNAL,
+                                             "out of memory");
+    free(w.out);
+    free(w.tmp);
+    return s;
+}
