@@ -157,6 +157,9 @@ GETME_GMSH_API getme_status getme_gmsh_quality(
 GETME_GMSH_API double getme_gmsh_report_value(const getme_gmsh_report *report,
                                               const char *name);
 GETME_GMSH_API size_t getme_gmsh_report_sizeof(void);
+/* report->message, for bindings. */
+GETME_GMSH_API const char *
+getme_gmsh_report_message(const getme_gmsh_report *report);
 
 /* ------------------------------------------------------------------------ */
 /* Model extraction (used by the MSH file adapter; usable on its own)        */

@@ -11,6 +11,11 @@
 
 size_t getme_gmsh_report_sizeof(void) { return sizeof(getme_gmsh_report); }
 
+const char *getme_gmsh_report_message(const getme_gmsh_report *r)
+{
+    return r ? r->message : "";
+}
+
 static double stats_value(const getme_quality_stats *s, const char *name)
 {
     int bin;

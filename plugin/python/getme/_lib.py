@@ -1,0 +1,85 @@
+"""Loading libgetme / libgetme_gmsh and their ctypes signatures.
+
+The library paths come from _paths.py, written by the build (build tree) or
+by `cmake --install` (installed tree).  libgetme_gmsh.so is linked against
+libgmsh.so.4.8 by its soname, so the dynamic loader hands it the copy the
+gmsh module already loaded: one Gmsh instance, one current model.
+"""
+import ctypes
+from ctypes import (POINTER, c_char_p, c_double, c_int, c_int32, c_int64,
+                    c_size_t, c_void_p)
+
+from ._paths import LIBGETME, LIBGETME_GMSH
+
+core = ctypes.CDLL(LIBGETME)
+plugin = ctypes.CDLL(LIBGETME_GMSH)
+
+STATUS = {0: "ok", 1: "bad argument", 2: "out of memory", 3: "invalid mesh",
+          4: "topology", 5: "state", 6: "cancelled"}
+
+
+class GetmeError(Exception):
+    """A libgetme / libgetme_gmsh failure; .status is the getme_status."""
+
+    def __init__(self, message, status=1):
+        super().__init__(message)
+        self.status = status
+
+
+HIST_BINS = 10
+MAX_REPORTED_INVALID = 8
+
+
+class QualityStats(ctypes.Structure):
+    """getme_quality_stats from getme.h (public, stable layout)."""
+    _fields_ = [("num_elements", c_int64), ("num_invalid", c_int64),
+                ("num_free", c_int64), ("q_min", c_double),
+                ("q_min_star", c_double), ("q_mean", c_double),
+                ("q_max", c_double), ("num_below_04", c_int64),
+                ("num_below_01", c_int64),
+                ("histogram", c_int64 * HIST_BINS),
+                ("num_reported_invalid", c_int32),
+                ("first_invalid", c_int32 * MAX_REPORTED_INVALID)]
+
+
+def _sig(lib, name, restype, *argtypes):
+    f = getattr(lib, name)
+    f.restype = restype
+    f.argtypes = list(argtypes)
+
+
+_sig(core, "getme_version", c_char_p)
+_sig(core, "getme_status_string", c_char_p, c_int)
+_sig(core, "getme_mesh_create", c_int, POINTER(c_void_p), c_int, c_int32,
+     POINTER(c_double))
+_sig(core, "getme_mesh_free", None, c_void_p)
+_sig(core, "getme_mesh_error", c_char_p, c_void_p)
+_sig(core, "getme_mesh_add_elements", c_int, c_void_p, c_int, c_int32,
+     POINTER(c_int32), POINTER(c_int32))
+_sig(core, "getme_mesh_num_elements", c_int32, c_void_p)
+_sig(core, "getme_mesh_quality_stats", c_int, c_void_p, c_int,
+     POINTER(QualityStats))
+_sig(core, "getme_mesh_element_qualities", c_int, c_void_p,
+     POINTER(c_double))
+
+_sig(plugin, "getme_gmsh_options_new", c_void_p)
+_sig(plugin, "getme_gmsh_options_free", None, c_void_p)
+_sig(plugin, "getme_gmsh_options_set", c_int, c_void_p, c_char_p, c_double)
+_sig(plugin, "getme_gmsh_options_set_method", c_int, c_void_p, c_char_p)
+_sig(plugin, "getme_gmsh_options_add_fixed_group", c_int, c_void_p, c_char_p)
+_sig(plugin, "getme_gmsh_options_error", c_char_p, c_void_p)
+_sig(plugin, "getme_gmsh_optimize", c_int, c_int, POINTER(c_int), c_size_t,
+     c_void_p, c_void_p)
+_sig(plugin, "getme_gmsh_quality", c_int, POINTER(c_int), c_size_t,
+     c_void_p, c_void_p)
+_sig(plugin, "getme_gmsh_report_sizeof", c_size_t)
+_sig(plugin, "getme_gmsh_report_value", c_double, c_void_p, c_char_p)
+_sig(plugin, "getme_gmsh_report_message", c_char_p, c_void_p)
+
+
+def version():
+    return core.getme_version().decode()
+
+
+def status_text(status):
+    return core.getme_status_string(status).decode()

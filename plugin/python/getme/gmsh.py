@@ -1,0 +1,129 @@
+"""getme.gmsh: GETMe adaptive smoothing of the current Gmsh model.
+
+Mirrors gmsh.model.mesh.optimize(method, force, niter, dimTags):
+
+    getme.gmsh.optimize(niter=0, dimTags=[], method="getme", fix=[],
+                        log=2, **params)
+
+niter      maximum iterations (0: max_iter, default 1000)
+dimTags    [(dim, tag), ...] of one dimension (3, or 2 for planar surfaces);
+           empty: every entity of the highest mesh dimension
+method     "getme" (GETMe adaptive) or "laplace" (smart Laplace)
+fix        physical group names (or "dim:tag") whose nodes stay fixed
+log        0 silent, 1 summary + histograms, 2 also one line per iteration
+params     any libgetme parameter: sigma, max_iter, tol, threshold_fraction,
+           max_no_min_improve, keep_best, num_threads, renumber; and
+           fix_skin, fix_interfaces (0/1)
+
+Returns a dict: iterations (total, mean stage, min stage, cycles),
+q_min_star / q_min / q_mean before and after, nodes moved, seconds.
+Raises getme.GetmeError (with the Gmsh-logged message) on bad use; the
+model is then unchanged.
+"""
+import ctypes
+import os
+
+from . import _lib
+from ._lib import GetmeError
+from .quality import stats_dict
+
+_VALUES = ("dim", "num_entities", "num_nodes", "num_elements", "num_fixed",
+           "num_moved", "wall", "cpu", "iterations", "iterations_mean",
+           "iterations_min", "cycles_min", "threshold")
+
+
+def _options(method, fix, log, params):
+    opt = _lib.plugin.getme_gmsh_options_new()
+    if not opt:
+        raise GetmeError("out of memory", 2)
+    try:
+        if _lib.plugin.getme_gmsh_options_set_method(opt, method.encode()):
+            raise GetmeError(_lib.plugin.getme_gmsh_options_error(opt)
+                             .decode())
+        for name, value in dict(params, log=log).items():
+            if _lib.plugin.getme_gmsh_options_set(opt, name.encode(),
+                                                   float(value)):
+                raise GetmeError(_lib.plugin.getme_gmsh_options_error(opt)
+                                 .decode())
+        for group in fix:
+            _lib.plugin.getme_gmsh_options_add_fixed_group(
+                opt, str(group).encode())
+        return opt
+    except Exception:
+        _lib.plugin.getme_gmsh_options_free(opt)
+        raise
+
+
+def _dim_tags(dimTags):
+    flat = [int(v) for pair in dimTags for v in pair]
+    arr = (ctypes.c_int * max(len(flat), 1))(*flat)
+    return arr, len(flat)
+
+
+def _report_dict(rep):
+    val = lambda name: _lib.plugin.getme_gmsh_report_value(rep,  # noqa: E731
+                                                           name.encode())
+    out = {k: val(k) for k in _VALUES}
+    for k in ("dim", "num_entities", "num_nodes", "num_elements",
+              "num_fixed", "num_moved", "iterations", "iterations_mean",
+              "iterations_min", "cycles_min"):
+        out[k] = int(out[k])
+    out["seconds"] = out.pop("wall")
+    for when in ("before", "after"):
+        for k in ("q_min_star", "q_min", "q_mean", "q_max"):
+            out["%s_%s" % (k, when)] = val("%s_%s" % (when, k))
+        out["num_invalid_" + when] = int(val(when + "_num_invalid"))
+        out["histogram_" + when] = [int(val("%s_hist%d" % (when, b)))
+                                    for b in range(_lib.HIST_BINS)]
+    return out
+
+
+def _run(fn, dimTags, method="getme", fix=(), log=0, niter=None, **params):
+    opt = _options(method, fix, log, params)
+    rep = ctypes.create_string_buffer(_lib.plugin.getme_gmsh_report_sizeof())
+    arr, n = _dim_tags(dimTags)
+    try:
+        if niter is None:
+            st = fn(arr, n, opt, rep)
+        else:
+            st = fn(int(niter), arr, n, opt, rep)
+        if st not in (0, 6):
+            raise GetmeError(_lib.plugin.getme_gmsh_report_message(rep)
+                             .decode(), st)
+        return rep
+    finally:
+        _lib.plugin.getme_gmsh_options_free(opt)
+
+
+def optimize(niter=0, dimTags=(), method="getme", fix=(), log=2, **params):
+    """Smooth the current Gmsh model in place (see the module help)."""
+    rep = _run(_lib.plugin.getme_gmsh_optimize, dimTags, method, fix, log,
+               niter, **params)
+    return _report_dict(rep)
+
+
+def model_quality(dimTags=(), fix=()):
+    """Mean-ratio statistics of the current Gmsh model (nothing moves)."""
+    rep = _run(_lib.plugin.getme_gmsh_quality, dimTags, "getme", fix, 0)
+    d = _report_dict(rep)
+    return {"num_elements": d["num_elements"], "num_nodes": d["num_nodes"],
+            "num_fixed": d["num_fixed"], "q_min": d["q_min_before"],
+            "q_min_star": d["q_min_star_before"],
+            "q_mean": d["q_mean_before"], "q_max": d["q_max_before"],
+            "num_invalid": d["num_invalid_before"],
+            "histogram": d["histogram_before"]}
+
+
+def loaded_gmsh_libraries():
+    """Paths of every libgmsh mapped in this process (expect exactly one)."""
+    paths = set()
+    with open("/proc/self/maps") as maps:
+        for line in maps:
+            path = line.split()[-1] if len(line.split()) >= 6 else ""
+            if "libgmsh" in os.path.basename(path):
+                paths.add(os.path.realpath(path))
+    return sorted(paths)
+
+
+__all__ = ["optimize", "model_quality", "loaded_gmsh_libraries",
+           "stats_dict"]
