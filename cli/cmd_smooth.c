@@ -201,6 +201,11 @@ static int run(smooth_args *a)
     opts.fix_interfaces = !a->free_interfaces;
     opts.verbose = log->verbose;
 
+    if (getme_io_same_file(a->input, a->output)) {
+        cli_error("%s: refusing to overwrite the input; choose another output "
+                  "file", a->output);
+        return EXIT_USAGE;
+    }
     double t0 = omp_get_wtime();
     cli_info(log, "Reading '%s'...", a->input);
     getme_doc *doc = NULL;
@@ -226,8 +231,15 @@ static int run(smooth_args *a)
     progress_state ps = {log, &history};
     a->params.progress = on_progress;
     a->params.progress_data = &ps;
-    int threads = a->params.num_threads ? a->params.num_threads
-                                        : omp_get_max_threads();
+    /* Gmsh's initialisation sets OpenMP's global thread count to 1, so
+       "default" must be decided here: OMP_NUM_THREADS if set, else every
+       core. */
+    if (!a->params.num_threads) {
+        const char *env = getenv("OMP_NUM_THREADS");
+        int n = env ? atoi(env) : 0;
+        a->params.num_threads = n > 0 ? n : omp_get_num_procs();
+    }
+    int threads = a->params.num_threads;
     cli_info(log, "Optimizing mesh (%s, %d thread%s)...",
              a->params.method == GETME_METHOD_ADAPTIVE ? "GETMe adaptive"
                                                        : "smart Laplace",

@@ -1,0 +1,288 @@
+#!/usr/bin/python3
+"""Integration tests of the getme command on Gmsh-generated, distorted meshes.
+
+usage: /usr/bin/python3 test_cli.py GETME_BINARY WORKDIR CASE
+CASE: tet | hex | mixed | tri | quad | errors
+
+For a mesh case: Gmsh (Python API) generates the mesh, `getme distort`
+distorts it, then `getme smooth` runs with GETMe adaptive (1 and 2 threads)
+and smart Laplace.  Asserted: every output element valid by a mean ratio
+computed here with numpy (independently of libgetme), nodes on
+lower-dimensional Gmsh entities bit-identical, q*min and qmean improved,
+GETMe's q*min above smart Laplace's, 1- and 2-thread outputs byte-identical,
+the input file untouched.
+"""
+import hashlib
+import json
+import os
+import subprocess
+import sys
+
+import gmsh
+import numpy as np
+
+GETME, WORK, CASE = sys.argv[1], sys.argv[2], sys.argv[3]
+os.makedirs(WORK, exist_ok=True)
+failures = []
+passed = 0
+
+
+def check(cond, what):
+    global passed
+    if cond:
+        passed += 1
+    else:
+        failures.append(what)
+        print("FAILED:", what, flush=True)
+
+
+def run(*args, expect=0):
+    p = subprocess.run([GETME, *args], capture_output=True, text=True)
+    if p.returncode != expect:
+        print(p.stdout[-3000:], p.stderr[-3000:])
+    check(p.returncode == expect, f"getme {' '.join(args)} -> {p.returncode}, want {expect}")
+    return p
+
+
+# ---- independent mean ratio (DESIGN.md §2) -------------------------------
+
+def _simplex_q(D, Winv):
+    S = D @ Winv
+    det = np.linalg.det(S)
+    fro = np.einsum("nij,nij->n", S, S)
+    q = np.where(det > 0, 3.0 * np.cbrt(det * det) / np.where(fro > 0, fro, 1), 0.0)
+    return q, det
+
+
+def _edges(x, simplices):
+    return [np.stack([x[:, s[1]] - x[:, s[0]], x[:, s[2]] - x[:, s[0]], x[:, s[3]] - x[:, s[0]]], axis=2)
+            for s in simplices]
+
+
+W = {
+    "tet": np.array([[1, .5, .5], [0, np.sqrt(3) / 2, np.sqrt(3) / 6], [0, 0, np.sqrt(2 / 3)]]),
+    "hex": np.eye(3),
+    "prism": np.array([[1, .5, 0], [0, np.sqrt(3) / 2, 0], [0, 0, 1]]),
+    "pyramid": np.array([[1, 0, .5], [0, 1, .5], [0, 0, 1 / np.sqrt(2)]]),
+}
+SIMPLICES = {
+    "tet": [(0, 1, 2, 3)],
+    "hex": [(0, 3, 4, 1), (1, 0, 5, 2), (2, 1, 6, 3), (3, 2, 7, 0),
+            (4, 7, 5, 0), (5, 4, 6, 1), (6, 5, 7, 2), (7, 6, 4, 3)],
+    "prism": [(0, 1, 2, 3), (1, 2, 0, 4), (2, 0, 1, 5), (3, 5, 4, 0), (4, 3, 5, 1), (5, 4, 3, 2)],
+    "pyramid": [(0, 1, 3, 4), (1, 2, 0, 4), (2, 3, 1, 4), (3, 0, 2, 4)],
+}
+
+
+def mean_ratio(kind, x):
+    """x: (n, nv, 3) element coordinates -> (n,) qualities, 0 if invalid."""
+    if kind == "tri":
+        e = [x[:, 1] - x[:, 0], x[:, 2] - x[:, 1], x[:, 0] - x[:, 2]]
+        area = 0.5 * (e[0][:, 0] * (-e[2][:, 1]) - e[0][:, 1] * (-e[2][:, 0]))
+        s = sum((v[:, :2] ** 2).sum(1) for v in e)
+        return np.where(area > 0, 4 * np.sqrt(3) * area / s, 0.0)
+    if kind == "quad":
+        qs, ok = [], np.ones(len(x), bool)
+        for k in range(4):
+            a = x[:, (k + 1) % 4, :2] - x[:, k, :2]
+            b = x[:, (k + 3) % 4, :2] - x[:, k, :2]
+            det = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+            ok &= det > 0
+            qs.append(2 * det / ((a ** 2).sum(1) + (b ** 2).sum(1)))
+        return np.where(ok, np.mean(qs, axis=0), 0.0)
+    Winv = np.linalg.inv(W[kind])
+    qs, ok = [], np.ones(len(x), bool)
+    for D in _edges(x, SIMPLICES[kind]):
+        q, det = _simplex_q(D, Winv)
+        ok &= det > 0
+        qs.append(q)
+    return np.where(ok, np.mean(qs, axis=0), 0.0)
+
+
+GMSH_TYPES = {4: "tet", 5: "hex", 6: "prism", 7: "pyramid", 2: "tri", 3: "quad"}
+
+
+def read(path):
+    """Nodes (tag -> xyz), fixed node tags (on entities below the mesh
+    dimension), per-type element qualities, element tags."""
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.open(path)
+    tags, xyz, _ = gmsh.model.mesh.getNodes()
+    xyz = xyz.reshape(-1, 3)
+    node = {int(t): xyz[i] for i, t in enumerate(tags)}
+    dim = max(d for d, _ in gmsh.model.getEntities() if len(gmsh.model.mesh.getElements(d)[0]))
+    fixed = set()
+    for d in range(dim):
+        t, _, _ = gmsh.model.mesh.getNodes(d, -1, includeBoundary=True)
+        fixed.update(int(v) for v in t)
+    qual, etags = {}, []
+    index = {int(t): i for i, t in enumerate(tags)}
+    types, etag_lists, conns = gmsh.model.mesh.getElements(dim)
+    for ty, et, conn in zip(types, etag_lists, conns):
+        kind = GMSH_TYPES[ty]
+        nv = len(conn) // len(et)
+        idx = np.vectorize(index.get)(conn.reshape(-1, nv))
+        qual[kind] = mean_ratio(kind, xyz[idx])
+        etags.extend(int(e) for e in et)
+    gmsh.finalize()
+    return node, fixed, qual, sorted(etags), dim
+
+
+def summary(qual, fixed=None):
+    allq = np.concatenate(list(qual.values()))
+    return float(allq.min()), float(allq.mean()), int((allq <= 0).sum())
+
+
+def sha(path):
+    return hashlib.sha256(open(path, "rb").read()).hexdigest()
+
+
+# ---- mesh generation -----------------------------------------------------
+
+def make(case, path):
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    occ, gm = gmsh.model.occ, gmsh.model
+    if case == "tet":
+        b = occ.addBox(0, 0, 0, 2, 1, 1)
+        c = occ.addCylinder(1, 0.5, -0.1, 0, 0, 1.2, 0.25)
+        occ.cut([(3, b)], [(3, c)])
+        occ.synchronize()
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 0.09)
+        gm.mesh.generate(3)
+    elif case == "hex":
+        r = occ.addRectangle(0, 0, 0, 2, 1)
+        d = occ.addDisk(1, 0.5, 0, 0.25, 0.25)
+        occ.cut([(2, r)], [(2, d)])
+        occ.extrude([(2, r)], 0, 0, 0.5, numElements=[5], recombine=True)
+        occ.synchronize()
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 0.08)
+        gmsh.option.setNumber("Mesh.RecombineAll", 1)
+        gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 1)
+        gm.mesh.generate(3)
+    elif case == "mixed":
+        b1 = occ.addBox(0, 0, 0, 1, 1, 1)
+        b2 = occ.addBox(1, 0, 0, 1, 1, 1)
+        occ.fragment([(3, b1)], [(3, b2)])
+        occ.synchronize()
+        top = [s for s in gm.getBoundary([(3, 2)], oriented=False)
+               if abs(occ.getCenterOfMass(2, s[1])[2] - 1) < 1e-9][0]
+        occ.extrude([top], 0, 0, 0.5, numElements=[3], recombine=True)
+        occ.synchronize()
+        for c in gm.getEntities(1):
+            gm.mesh.setTransfiniteCurve(c[1], 7)
+        for s in gm.getBoundary([(3, 1)], oriented=False):
+            gm.mesh.setTransfiniteSurface(s[1])
+            gm.mesh.setRecombine(2, s[1])
+        gm.mesh.setTransfiniteVolume(1)
+        gm.mesh.generate(3)
+    elif case in ("tri", "quad"):
+        r = occ.addRectangle(0, 0, 0, 2, 1)
+        d = occ.addDisk(0.7, 0.5, 0, 0.2, 0.2)
+        occ.cut([(2, r)], [(2, d)])
+        occ.synchronize()
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 0.04)
+        if case == "quad":
+            gmsh.option.setNumber("Mesh.RecombineAll", 1)
+        gm.mesh.generate(2)
+    gmsh.write(path)
+    gmsh.finalize()
+
+
+def mesh_case(case):
+    base = os.path.join(WORK, case)
+    orig, dist = base + ".msh", base + "-distorted.msh"
+    make(case, orig)
+    run("distort", orig, "-o", dist, "--seed", "11", "--target-qmean", "0.55", "-q")
+    digest = sha(dist)
+    out1, out2, lap = base + "-t1.msh", base + "-t2.msh", base + "-laplace.msh"
+    run("smooth", dist, "-o", out1, "--threads", "1", "-q", "--report", base + ".json")
+    run("smooth", dist, "-o", out2, "--threads", "2", "-q")
+    run("smooth", dist, "-o", lap, "--method", "laplace", "-q")
+    check(sha(dist) == digest, "input file untouched")
+    check(sha(out1) == sha(out2), "1 and 2 threads give byte-identical output")
+
+    n0, fixed, q0, e0, dim = read(dist)
+    n1, _, q1, e1, _ = read(out1)
+    _, _, ql, _, _ = read(lap)
+    kinds = sorted(q0)
+    check(e0 == e1, "element tags kept")
+    check(set(n0) == set(n1), "node tags kept")
+    moved_fixed = [t for t in fixed if not np.array_equal(n0[t], n1[t])]
+    check(not moved_fixed, f"fixed nodes bit-identical ({len(moved_fixed)} moved)")
+    moved = sum(not np.array_equal(n0[t], n1[t]) for t in n0)
+    check(moved > 0, "free nodes moved")
+    mn0, mean0, bad0 = summary(q0)
+    mn1, mean1, bad1 = summary(q1)
+    mnl, meanl, badl = summary(ql)
+    check(bad0 == 0 and bad1 == 0 and badl == 0, "every element valid")
+    check(mn1 > mn0 + 0.1, f"q*min improved ({mn0:.4f} -> {mn1:.4f})")
+    check(mean1 > mean0 + 0.05, f"qmean improved ({mean0:.4f} -> {mean1:.4f})")
+    check(mn1 > mnl, f"GETMe q*min {mn1:.4f} above smart Laplace {mnl:.4f}")
+    rep = json.load(open(base + ".json"))
+    check(abs(rep["after"]["q_mean"] - mean1) < 1e-9,
+          "report's qmean equals the independent one")
+    check(rep["iterations"]["mean_stage"] > 0 and rep["iterations"]["min_stage"] > 0,
+          "both stages ran")
+    check(len(rep["history"]) == rep["iterations"]["total"], "one history record per iteration")
+    print(f"{case}: {', '.join(f'{k} {len(q0[k])}' for k in kinds)}; q*min {mn0:.4f} -> "
+          f"getme {mn1:.4f} (laplace {mnl:.4f}); qmean {mean0:.4f} -> {mean1:.4f} "
+          f"(laplace {meanl:.4f}); iterations {rep['iterations']['mean_stage']}/"
+          f"{rep['iterations']['min_stage']}")
+
+
+def errors_case():
+    missing = os.path.join(WORK, "nope.msh")
+    p = run("smooth", missing, "-o", os.path.join(WORK, "x.msh"), expect=3)
+    check("nope.msh" in p.stderr, "missing file named in the error")
+    run("smooth", expect=2)
+    run("smooth", missing, expect=2)
+    run("smooth", "a.msh", "-o", "b.msh", "--threads", "zero", expect=2)
+    run("smooth", "a.msh", "-o", "b.msh", "--param", "sigma=-1", expect=2)
+    run("frobnicate", expect=2)
+    p = run("--help")
+    check("smooth" in p.stdout and "exit codes" in p.stdout, "--help answers")
+    p = run("smooth", "--help")
+    check("--fix" in p.stdout, "smooth --help lists options")
+    garbage = os.path.join(WORK, "garbage.msh")
+    open(garbage, "w").write("$MeshFormat\nthis is not a mesh\n")
+    p = subprocess.run([GETME, "smooth", garbage, "-o", garbage + ".out"], capture_output=True, text=True)
+    check(p.returncode in (4, 5), f"garbage input -> {p.returncode}, want 4 (malformed)")
+    check(not os.path.exists(garbage + ".out"), "no output for bad input")
+    # An inverted element: swap the last two nodes of one tet (MSH 2.2 text:
+    # "tag type ntags tags... nodes").
+    good = os.path.join(WORK, "inv-src.msh")
+    make("tet", good)
+    lines = open(good).read().split("\n")
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.open(good)
+    gmsh.option.setNumber("Mesh.MshFileVersion", 2.2)
+    gmsh.write(good + ".v2.msh")
+    gmsh.finalize()
+    lines = open(good + ".v2.msh").read().split("\n")
+    start = lines.index("$Elements") + 2
+    tets = [i for i in range(start, len(lines)) if lines[i].split()[1:2] == ["4"]]
+    victim = lines[tets[5]].split()
+    victim[-1], victim[-2] = victim[-2], victim[-1]
+    lines[tets[5]] = " ".join(victim)
+    inv = os.path.join(WORK, "inverted.msh")
+    open(inv, "w").write("\n".join(lines))
+    tags = [[int(victim[0])] * 6]
+    digest = sha(inv)
+    p = run("smooth", inv, "-o", inv + ".out", expect=6)
+    check("invalid" in p.stderr and str(tags[0][5]) in p.stderr,
+          "inverted element reported by its Gmsh tag")
+    check(sha(inv) == digest and not os.path.exists(inv + ".out"), "input untouched, no output")
+    run("quality", inv, expect=6)
+    p = run("smooth", good, "-o", good, expect=2)
+    check("overwrite" in p.stderr, "refuses to overwrite the input")
+
+
+if CASE == "errors":
+    errors_case()
+else:
+    mesh_case(CASE)
+print(f"{passed} passed, {len(failures)} failed")
+sys.exit(1 if failures else 0)
