@@ -1,0 +1,50 @@
+#!/bin/sh
+# `getme gmsh`: mesh a two-material OCC .geo with Gmsh, smooth, write MSH
+# 2.2 and 4.1; Gmsh-style lines on the terminal; exit codes for bad use.
+# usage: test_cli_gmsh.sh GETME_BINARY PYTHON
+set -u
+G=$1
+PY=$2
+fail=0
+ok() { echo "ok: $*"; }
+bad() { echo "FAILED: $*"; fail=1; }
+cat > part.geo <<'GEO'
+SetFactory("OpenCASCADE");
+Box(1) = {0, 0, 0, 2, 1, 1};
+Cylinder(2) = {1, 0.5, -0.2, 0, 0, 1.4, 0.3};
+BooleanFragments{ Volume{1}; Delete; }{ Volume{2}; Delete; }
+Physical Volume("matrix") = {3};
+Physical Volume("insert") = {2};
+Physical Surface("clamp") = {1};
+GEO
+rm -f part.msh part22.msh
+"$G" gmsh part.geo -3 -clmax 0.15 --fix clamp -o part.msh > run.log 2>&1
+rc=$?
+[ $rc -eq 0 ] && ok "exit 0" || bad "exit $rc"
+grep -q "^Info    : Optimizing mesh (GETMe adaptive)..." run.log && ok "start line" || bad "no start line"
+grep -q "^Info    : 0.90 < quality < 1.00 : " run.log && ok "histogram" || bad "no histogram"
+grep -q "^Info    : Done optimizing mesh (Wall " run.log && ok "done line" || bad "no done line"
+grep -q "^Info    : Done meshing 3D" run.log && ok "Gmsh's own meshing lines" || bad "no Gmsh lines"
+head -2 part.msh | grep -q "^4.1 0 8" && ok "MSH 4.1" || bad "not MSH 4.1"
+"$G" gmsh part.msh -q -format msh22 -bin -o part22.msh; rc=$?
+[ $rc -eq 0 ] && head -2 part22.msh | grep -q "^2.2 1 8" && ok "msh input -> MSH 2.2 binary" || bad "msh22 ($rc)"
+# The result is a valid mesh for Gmsh and by an independent mean ratio.
+"$PY" - <<'PYEOF' || bad "python check of part.msh"
+import gmsh, numpy as np
+gmsh.initialize(); gmsh.option.setNumber("General.Terminal", 0)
+gmsh.open("part.msh")
+t, x, _ = gmsh.model.mesh.getNodes(); o = np.argsort(t); t = t[o]; x = x.reshape(-1, 3)[o]
+_, en = gmsh.model.mesh.getElementsByType(4)
+p = x[np.searchsorted(t, en).reshape(-1, 4)]
+det = np.einsum("ij,ij->i", p[:, 1] - p[:, 0], np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 0]))
+assert (det > 0).all(), "inverted tets"
+names = sorted(gmsh.model.getPhysicalName(d, t) for d, t in gmsh.model.getPhysicalGroups())
+assert names == ["clamp", "insert", "matrix"], names
+print("ok: part.msh valid, %d tets, groups %s" % (len(p), names))
+PYEOF
+"$G" gmsh missing.geo -q; rc=$?; [ $rc -eq 3 ] && ok "missing input: 3" || bad "missing input: $rc"
+"$G" gmsh part.geo -q -3 -clmax 0.3 --fix nope -o x.msh 2> err.log; rc=$?
+[ $rc -eq 2 ] && grep -q "Unknown physical group 'nope'" err.log && ok "unknown group: 2" || bad "unknown group: $rc"
+"$G" gmsh part.msh -o part.msh -q; rc=$?; [ $rc -eq 2 ] && ok "refuses to overwrite input" || bad "overwrite: $rc"
+"$G" gmsh part.geo --bogus 2> err.log; rc=$?; [ $rc -eq 2 ] && grep -q "unknown option" err.log && ok "bad option: 2" || bad "bad option: $rc"
+exit $fail
