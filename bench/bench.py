@@ -22,6 +22,7 @@ it must not, 2 usage, 3 a required tool is missing.
 import argparse
 import os
 import shutil
+import subprocess
 import sys
 import time
 
@@ -33,7 +34,7 @@ import methods as M  # noqa: E402
 import runner  # noqa: E402
 import tables  # noqa: E402
 from meshdata import read_mesh  # noqa: E402
-from stats import mesh_stats, topology_change  # noqa: E402
+from stats import boundary_kept, mesh_stats, topology_change  # noqa: E402
 
 REPO = os.path.dirname(HERE)
 # q_mean the distortion aims at: the paper's initial meshes (0.4506 / 0.4709)
@@ -61,6 +62,8 @@ def parse_args(argv):
     ap.add_argument("--cache", default=os.environ.get("GETME_BENCH_CACHE",
                                                       os.path.join(HERE, "cache")))
     ap.add_argument("--getme", help="the getme executable (default: build*/cli/getme, PATH)")
+    ap.add_argument("--getme-runner", choices=("auto", "cli", "ctypes"), default="auto",
+                    help="auto: the CLI if it reads .msh, else libgetme via ctypes")
     ap.add_argument("--seed", type=int, default=1, help="distortion seed")
     ap.add_argument("--distort", choices=("getme", "none"), default="getme",
                     help="'none' benchmarks the generated meshes as they are")
@@ -92,14 +95,33 @@ def parse_args(argv):
     return args
 
 
-def find_getme(explicit):
-    if explicit:
-        return explicit if os.access(explicit, os.X_OK) else None
-    for entry in sorted(os.listdir(REPO)):
-        path = os.path.join(REPO, entry, "cli", "getme")
-        if entry.startswith("build") and os.access(path, os.X_OK):
-            return path
-    return shutil.which("getme")
+def _cli_reads_msh(cli):
+    try:
+        out = subprocess.run([cli, "formats"], capture_output=True, text=True,
+                             timeout=30).stdout
+    except OSError:
+        return False
+    return "msh" in out
+
+
+def find_getme(explicit, runner_kind):
+    """Command prefix that runs getme: the CLI, or (while the CLI cannot read
+    .msh files) bench/getme_ctypes.py on the libgetme next to it."""
+    cli = explicit
+    if cli is None:
+        builds = sorted(e for e in os.listdir(REPO) if e.startswith("build"))
+        found = [os.path.join(REPO, e, "cli", "getme") for e in builds]
+        found = [p for p in found if os.access(p, os.X_OK)]
+        cli = found[0] if found else shutil.which("getme")
+    if cli is None or not os.access(cli, os.X_OK):
+        return None
+    if runner_kind == "cli" or (runner_kind == "auto" and _cli_reads_msh(cli)):
+        return [cli]
+    lib = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(cli))),
+                       "core", "libgetme.so")
+    if not os.path.exists(lib):
+        return None
+    return [runner.PYTHON, os.path.join(HERE, "getme_ctypes.py"), "--lib", lib]
 
 
 def distort(ctx, case, src):
@@ -113,7 +135,7 @@ def distort(ctx, case, src):
     log(f"Info    : distorting {os.path.basename(src)} (seed {ctx.args.seed}, "
         f"target q_mean {target})")
     tmp = dst[:-4] + ".tmp.msh"
-    r = runner.run([ctx.getme, "distort", src, "-o", tmp, "--seed", ctx.args.seed,
+    r = runner.run([*ctx.getme, "distort", src, "-o", tmp, "--seed", ctx.args.seed,
                     "--target-qmean", target], timeout=ctx.args.timeout)
     if r.returncode != 0:
         raise RuntimeError(f"getme distort failed on {src}: {r.error_line()}")
@@ -124,14 +146,17 @@ def distort(ctx, case, src):
 def report_fields(report):
     """Iterations, time, history and final qualities from getme's --report
     JSON (tolerant of where the CLI puts them)."""
-    res = report.get("result", report)
-    hist = report.get("history") or report.get("progress") or []
+    iters = report.get("iterations", {})
+    after = report.get("after", {})
+    hist = report.get("history") or []
     return {
-        "iterations_mean": res.get("iterations_mean"),
-        "iterations_min": res.get("iterations_min"),
-        "seconds": res.get("seconds"),
-        "report_q_min_star": res.get("q_min_star"),
-        "report_q_mean": res.get("q_mean"),
+        "iterations_mean": iters.get("mean_stage"),
+        "iterations_min": iters.get("min_stage"),
+        "seconds": report.get("seconds"),
+        "report_q_min_star": after.get("q_min_star"),
+        "report_q_mean": after.get("q_mean"),
+        "report_fixed_nodes": report.get("fixed_nodes"),
+        "runner": report.get("runner", "cli"),
         "history": [{"elapsed": h["elapsed"], "q_min_star": h["q_min_star"],
                      "q_mean": h["q_mean"], "stage": h.get("stage")}
                     for h in hist if "elapsed" in h],
@@ -146,7 +171,11 @@ def measure(row, ref, path):
                                    "q_min_star", "q_mean", "n_le_04", "n_lt_01",
                                    "invalid", "histogram")})
     row["types"] = st["types"]
+    row["q_min_star_by_type"] = st["q_min_star_by_type"]
     row["topology"] = topology_change(ref, mesh)
+    row["boundary_kept"] = bool(boundary_kept(ref, mesh))
+    if not row["boundary_kept"]:
+        row["topology"] += "; boundary nodes moved"
 
 
 def run_method(ctx, case, method, src, ref, params=(), tag=None):
@@ -175,6 +204,10 @@ def run_method(ctx, case, method, src, ref, params=(), tag=None):
     if row.get("seconds") is None:
         row["seconds"] = r.wall
     measure(row, ref, dst)
+    same = r.last_json().get("same_connectivity")
+    if row["topology"].startswith("yes (reconnected)") and same:
+        # Gmsh renumbered the nodes but kept the connectivity
+        row["topology"] = row["topology"].replace("yes (reconnected)", "no (renumbered)")
     base = ctx.baseline(case, method, src)
     row["delta_gib"] = row["peak_gib"] - base if base is not None else None
     if not ctx.args.keep_outputs:
@@ -235,6 +268,10 @@ def check_row(row, notes):
             notes.append(f"  ERROR: {row['label']}: topology {row['topology']}, "
                          f"{row['invalid']} invalid elements")
             bad = True
+        fixed = row.get("report_fixed_nodes")
+        if fixed is not None and fixed != row["nodes"] - row["free_nodes"]:
+            notes.append(f"  note: {row['label']}: getme fixed {fixed} nodes, numpy "
+                         f"counts {row['nodes'] - row['free_nodes']} on skin/interfaces")
         for key in ("q_min_star", "q_mean"):
             theirs = row.get("report_" + key)
             if theirs is not None and abs(theirs - row[key]) > 1e-6:
@@ -301,11 +338,12 @@ def make_meta(args, getme):
               f"times are indicative)\n"
               "Mem = peak RSS of the process (/usr/bin/time); dMem = minus a run of "
               "the same tool that only loads/writes the mesh.\n"
+              f"getme runs as: {' '.join(getme or ['-'])}\n"
               "Time = the smoothing call only (getme's report, or timed inside the "
               "Gmsh/Netgen process).  q*min: min over elements with a free node "
               "(free = not on skin or region interface).")
     return {"size": args.size, "cpu": cpu, "load_average": load, "header": header,
-            "getme": getme, "seed": args.seed, "generator_version": meshes.GENERATOR_VERSION}
+            "getme": " ".join(getme or []), "seed": args.seed, "generator_version": meshes.GENERATOR_VERSION}
 
 
 def sweep(ctx, meta):
@@ -346,7 +384,7 @@ def main(argv=None):
         for case in args.cases:
             meshes.generate(case, args.size, args.cache, log=log)
         return 0
-    getme = find_getme(args.getme)
+    getme = find_getme(args.getme, args.getme_runner)
     needs_getme = args.distort == "getme" or args.sweep or any(
         m.tool == "getme" for c in args.cases for m in selected_methods(args, c))
     if getme is None and needs_getme:

@@ -1,19 +1,14 @@
-"""Reading the benchmark's meshes with meshio (a reader independent of both
-Gmsh's SDK, which libgetme's MSH adapter uses, and of our own code).
+"""Reading the benchmark's meshes into flat numpy arrays.
 
 A mesh here is points (N x 3 float64), blocks [(type, conn)] of the elements
 of the highest dimension present, and one region id per element (Gmsh
 physical tag, else elementary entity tag), block by block.
 """
 
-import contextlib
-import io
 from dataclasses import dataclass, field
 
 import numpy as np
 
-MESHIO_TYPES = {"tetra": "tet", "hexahedron": "hex", "wedge": "prism",
-                "pyramid": "pyramid", "triangle": "tri", "quad": "quad"}
 VOLUME = ("tet", "hex", "prism", "pyramid")
 PLANAR = ("tri", "quad")
 
@@ -23,6 +18,7 @@ class Mesh:
     points: np.ndarray
     blocks: list = field(default_factory=list)   # [(type, conn)]
     regions: list = field(default_factory=list)  # [region id per element]
+    tags: np.ndarray = None  # file node tag of each point (None: 1..N)
 
     @property
     def dim(self):
@@ -44,35 +40,49 @@ class Mesh:
             if parts:
                 out_blocks.append((etype, np.concatenate([p[0] for p in parts])))
                 out_regions.append(np.concatenate([p[1] for p in parts]))
-        return Mesh(self.points, out_blocks, out_regions)
+        return Mesh(self.points, out_blocks, out_regions, self.tags)
 
 
-def _region_of(cell_data, index, count):
-    for key in ("gmsh:physical", "gmsh:geometrical", "medit:ref"):
-        if key in cell_data:
-            return np.asarray(cell_data[key][index], dtype=np.int64)
-    return np.zeros(count, dtype=np.int64)
+GMSH_TYPES = {4: ("tet", 4), 5: ("hex", 8), 6: ("prism", 6), 7: ("pyramid", 5),
+              2: ("tri", 3), 3: ("quad", 4)}
+
+
+def _region(gmsh, dim, tag):
+    """The element region: the entity's (first) physical group, else the
+    entity itself -- what libgetme's fixing rule calls a region."""
+    phys = gmsh.model.getPhysicalGroupsForEntity(dim, tag)
+    return int(phys[0]) if len(phys) else int(tag)
 
 
 def read_mesh(path):
-    """Read a mesh file meshio understands; keep only the elements of the
-    highest dimension and merge blocks by type."""
-    import meshio  # imported late: quality.py/skin.py work without it
+    """Read an MSH file (any version Gmsh reads) with the Gmsh API; keep the
+    elements of the highest dimension, nodes ordered by their file tags.
 
-    # meshio 5 prints a stray empty line to stdout while reading MSH 4.1:
-    # keep the benchmark's stdout for its tables
-    with contextlib.redirect_stdout(io.StringIO()):
-        m = meshio.read(path)
-    blocks, regions = [], []
-    for i, cells in enumerate(m.cells):
-        etype = MESHIO_TYPES.get(cells.type)
-        if etype is None:
-            continue
-        conn = np.asarray(cells.data, dtype=np.int64)
-        blocks.append((etype, conn))
-        regions.append(_region_of(m.cell_data, i, len(conn)))
-    mesh = Mesh(np.asarray(m.points, dtype=np.float64), blocks, regions)
-    top = [t for t in VOLUME] if mesh.dim == 3 else list(PLANAR)
-    keep = [i for i, (t, _) in enumerate(blocks) if t in top]
-    return Mesh(mesh.points, [blocks[i] for i in keep],
-                [regions[i] for i in keep]).merged()
+    Tags, not file order, define node identity: tools that preserve tags
+    (Gmsh, getme) may still write nodes in another order, which must not
+    count as a topology change."""
+    import gmsh
+    gmsh.initialize(["bench-read"])
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.open(path)
+        tags, coords, _ = gmsh.model.mesh.getNodes()
+        order = np.argsort(tags)
+        tags = np.asarray(tags)[order]
+        points = np.asarray(coords, dtype=np.float64).reshape(-1, 3)[order]
+        blocks, regions = [], []
+        for dim in (3, 2):
+            for _, tag in gmsh.model.getEntities(dim):
+                types, _, node_tags = gmsh.model.mesh.getElements(dim, tag)
+                for gtype, nt in zip(types, node_tags):
+                    if gtype not in GMSH_TYPES:
+                        continue
+                    etype, nn = GMSH_TYPES[gtype]
+                    conn = np.searchsorted(tags, nt).reshape(-1, nn)
+                    blocks.append((etype, conn.astype(np.int64)))
+                    regions.append(np.full(len(conn), _region(gmsh, dim, tag), np.int64))
+            if blocks:
+                break
+    finally:
+        gmsh.finalize()
+    return Mesh(points, blocks, regions, tags).merged()

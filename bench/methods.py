@@ -52,9 +52,10 @@ METHODS = (
 
 
 def command(method, getme, src, dst, report, params=()):
-    """The command line that runs method on src and writes dst."""
+    """The command line that runs method on src and writes dst (getme: the
+    command prefix, the CLI or the ctypes stand-in)."""
     if method.tool == "getme":
-        cmd = [getme, "smooth", src, "-o", dst, *method.args, "--report", report]
+        cmd = [*getme, "smooth", src, "-o", dst, *method.args, "--report", report]
         for name, value in tuple(method.params) + tuple(params):
             cmd += ["--param", f"{name}={value}"]
         return cmd
@@ -70,7 +71,7 @@ def baseline_command(method, getme, src, dst):
     """A run of the same tool that loads (and writes) the mesh but does not
     smooth it: its peak memory is subtracted to give the smoothing's own."""
     if method.tool == "getme":
-        return [getme, "quality", src]
+        return [*getme, "quality", src]
     return command(method, getme, src, dst, None) + ["--load-only"]
 
 

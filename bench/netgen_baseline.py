@@ -9,7 +9,8 @@ Mesh.OptimizeVolumeMesh() runs: in netgen 6.2 that is OptimizeVolume with
 default MeshingParameters and 5 steps of its default "cmdmustm" sequence --
 edge collapse (c), smoothing (m), edge split (d), face/edge swaps (u, s, t):
 it changes the topology, unlike GETMe.  Only that call is timed.  The result
-is compressed (unused points dropped) and written as MSH 4.1 with meshio,
+is compressed (unused points dropped) and written as MSH 2.2 with meshio
+(meshio's 4.1 files lack the $Entities Gmsh needs),
 tets in Gmsh node order.  --load-only does everything but the optimization
 (the memory baseline).  Prints one JSON line {"method", "seconds"}.
 """
@@ -98,7 +99,7 @@ def main():
                       cell_data={"gmsh:physical": [domains],
                                  "gmsh:geometrical": [domains]})
     tmp_out = args.output + ".tmp.msh"
-    meshio.write(tmp_out, out, file_format="gmsh", binary=True)
+    meshio.write(tmp_out, out, file_format="gmsh22", binary=True)
     os.replace(tmp_out, args.output)
     print(json.dumps({"method": "netgen", "seconds": seconds}))
     return 0

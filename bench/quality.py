@@ -53,7 +53,8 @@ def _simplex_quality(points, conn, simplex, winv):
     a, b, c, d = (points[conn[:, i]] for i in simplex)
     dmat = np.stack([b - a, c - a, d - a], axis=2)  # columns are the edges
     smat = dmat @ winv
-    det = np.linalg.det(smat)
+    with np.errstate(invalid="ignore"):  # non-finite input: judged invalid below
+        det = np.linalg.det(smat)
     frob = np.einsum("nij,nij->n", smat, smat)
     q = np.zeros(len(conn))
     ok = (det > 0.0) & (frob > 0.0)
