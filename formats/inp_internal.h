@@ -311,9 +311,9 @@ getme_io_status inp_write(getme_doc *doc, const inp_doc *st,
                           const char *out_path);
 void inp_doc_free(inp_doc *st);
 
-/* Shortest of %.17g / %.16g / %.15g that reads back to v and fits Abaqus'
-   20-character field limit (else the most digits that fit).  Returns the
-   length written to buf (size >= 32). */
+/* %.15g if that reads back to v, else %.17g, within Abaqus' 20-character
+   field limit (else the most digits that fit).  Returns the length written
+   to buf (size >= 32). */
 int inp_format_real(double v, char *buf);
 
 #endif /* GETME_INP_INTERNAL_H */

@@ -202,15 +202,19 @@ int inp_is_label(const inp_field *f)
 
 int inp_format_real(double v, char *buf)
 {
-    /* Abaqus reads at most 20 characters per real field; within that,
-       prefer the shortest text that reads back to the same double. */
-    for (int prec = 15; prec <= 17; prec++) {
-        int n = snprintf(buf, 32, "%.*g", prec, v);
-        if (n <= 20 && strtod(buf, NULL) == v)
-            return n;
-    }
-    for (int prec = 17; prec > 1; prec--) {
-        int n = snprintf(buf, 32, "%.*g", prec, v);
+    /* Abaqus reads at most 20 characters per real field.  Values that came
+       from short decimal text come back short (%.15g); anything else gets
+       the 17 significant digits that always read back to the same double. */
+    int n = snprintf(buf, 32, "%.15g", v);
+    if (n <= 20 && strtod(buf, NULL) == v)
+        return n;
+    n = snprintf(buf, 32, "%.17g", v);
+    if (n <= 20)
+        return n;
+    /* Tiny or huge magnitudes with a long exponent: as many digits as fit
+       (a relative change below 1e-15, on a free node only). */
+    for (int prec = 16; prec > 1; prec--) {
+        n = snprintf(buf, 32, "%.*g", prec, v);
         if (n <= 20)
             return n;
     }

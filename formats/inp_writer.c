@@ -126,9 +126,12 @@ static int node_line(writer *w, FILE *out, const inp_lines *in, int32_t node)
     if (!moved)
         return put(out, in->text, in->len);
     w->moved++;
-    /* Replace the number of each coordinate field in place. */
+    /* Replace the number of each changed coordinate field in place; a
+       coordinate that kept its value keeps its text. */
     const char *cur = in->text;
     for (int k = 0; k < ncoord; k++) {
+        if (same_bits(old[k], x[k]))
+            continue;
         if (put(out, cur, (size_t)(f[k + 1].s - cur)) || put_real(out, x[k]))
             return -1;
         cur = f[k + 1].s + f[k + 1].n;

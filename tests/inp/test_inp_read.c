@@ -142,7 +142,7 @@ static void test_hex_write(void)
     CHECK(in && out);
     CHECK_EQ_INT(diff_lines(in, out, line, sizeof line), 1);
     /* Only the coordinate fields change; spacing and CRLF stay. */
-    CHECK(strcmp(line, "  387,  2.1, 1,2.3333333333333335\r\n") == 0);
+    CHECK(strcmp(line, "  387,  2.1, 1.,2.3333333333333335\r\n") == 0);
     fprintf(stderr, "changed line: %s", line);
     free(in);
     free(out);
