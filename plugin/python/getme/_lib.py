@@ -75,6 +75,15 @@ _sig(plugin, "getme_gmsh_quality", c_int, POINTER(c_int), c_size_t,
 _sig(plugin, "getme_gmsh_report_sizeof", c_size_t)
 _sig(plugin, "getme_gmsh_report_value", c_double, c_void_p, c_char_p)
 _sig(plugin, "getme_gmsh_report_message", c_char_p, c_void_p)
+_sig(plugin, "getme_gmsh_model_read", c_int, POINTER(c_void_p), POINTER(c_int),
+     c_size_t, c_void_p, c_char_p, c_size_t)
+_sig(plugin, "getme_gmsh_model_free", None, c_void_p)
+_sig(plugin, "getme_gmsh_model_mesh", c_void_p, c_void_p)
+_sig(plugin, "getme_gmsh_model_apply", c_int, c_void_p, POINTER(c_double),
+     POINTER(c_int32), c_char_p, c_size_t)
+_sig(core, "getme_mesh_coords", POINTER(c_double), c_void_p)
+_sig(core, "getme_mesh_distort", c_int, c_void_p, ctypes.c_uint64, c_double,
+     c_double, c_int)
 
 
 def version():

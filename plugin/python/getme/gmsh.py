@@ -114,6 +114,36 @@ def model_quality(dimTags=(), fix=()):
             "histogram": d["histogram_before"]}
 
 
+def distort(seed=1, amount=0.4, rounds=5, dimTags=(), fix=()):
+    """Distort the current model for demos and benchmarks: libgetme's
+    random validity-preserving moves of the nodes optimize() may move
+    (getme_mesh_distort), written back like optimize() does.  Returns the
+    number of nodes moved."""
+    opt = _options("getme", fix, 0, {})
+    model = ctypes.c_void_p()
+    msg = ctypes.create_string_buffer(512)
+    arr, n = _dim_tags(dimTags)
+    try:
+        st = _lib.plugin.getme_gmsh_model_read(ctypes.byref(model), arr, n,
+                                               opt, msg, 512)
+        if st:
+            raise GetmeError(msg.value.decode(), st)
+        mesh = _lib.plugin.getme_gmsh_model_mesh(model)
+        st = _lib.core.getme_mesh_distort(mesh, seed, amount, 0.0, rounds)
+        if st:
+            raise GetmeError(_lib.core.getme_mesh_error(mesh).decode(), st)
+        moved = ctypes.c_int32()
+        st = _lib.plugin.getme_gmsh_model_apply(
+            model, _lib.core.getme_mesh_coords(mesh), ctypes.byref(moved),
+            msg, 512)
+        if st:
+            raise GetmeError(msg.value.decode(), st)
+        return moved.value
+    finally:
+        _lib.plugin.getme_gmsh_model_free(model)
+        _lib.plugin.getme_gmsh_options_free(opt)
+
+
 def loaded_gmsh_libraries():
     """Paths of every libgmsh mapped in this process (expect exactly one)."""
     paths = set()
@@ -125,5 +155,5 @@ def loaded_gmsh_libraries():
     return sorted(paths)
 
 
-__all__ = ["optimize", "model_quality", "loaded_gmsh_libraries",
+__all__ = ["optimize", "model_quality", "distort", "loaded_gmsh_libraries",
            "stats_dict"]
