@@ -33,7 +33,7 @@ static const char GMSH_HELP[] =
     "  -format msh22|msh41   MSH version of the output (default 4.1)\n"
     "  -bin                  binary MSH\n"
     "  --method getme|laplace   GETMe adaptive (default) or smart Laplace\n"
-    "  --fix GROUP           keep the nodes of a physical group (name or dim:tag)\n"
+    "  --fix GROUP[,GROUP]   keep the nodes of physical groups (names or dim:tag)\n"
     "                        fixed; repeatable\n"
     "  --free-interfaces     do not fix faces between physical groups (nodes on\n"
     "                        Gmsh interface surfaces stay fixed regardless)\n"
@@ -87,6 +87,29 @@ static int takes_value(const char *o)
     return 0;
 }
 
+/* --fix takes one name or a comma-separated list ("clamp,bolt holes"). */
+static int add_fixed_groups(gmsh_args *a, const char *list)
+{
+    char name[256];
+    while (*list) {
+        size_t n = strcspn(list, ",");
+        while (n && *list == ' ') {
+            list++;
+            n--;
+        }
+        snprintf(name, sizeof name, "%.*s", (int)(n < 255 ? n : 255), list);
+        for (size_t k = strlen(name); k && name[k - 1] == ' ';)
+            name[--k] = 0;
+        if (name[0] &&
+            getme_gmsh_options_add_fixed_group(a->opt, name) != GETME_OK) {
+            cli_error("out of memory");
+            return -1;
+        }
+        list += n + (list[n] == ',');
+    }
+    return 0;
+}
+
 /* One option at argv[*i]; advances *i past its value.  0 ok, -1 error. */
 static int parse_one(gmsh_args *a, int argc, char **argv, int *i)
 {
@@ -124,7 +147,7 @@ static int parse_one(gmsh_args *a, int argc, char **argv, int *i)
             rc = -1;
         }
     } else if (!strcmp(o, "--fix"))
-        rc = getme_gmsh_options_add_fixed_group(a->opt, v) == GETME_OK ? 0 : -1;
+        rc = add_fixed_groups(a, v);
     else if (!strcmp(o, "--threads"))
         rc = set_param(a, "num_threads", o, v);
     else if (!strcmp(o, "--sigma"))
