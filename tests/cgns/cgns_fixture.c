@@ -316,3 +316,30 @@ int fixture_write_structured(const char *path, int structured_only)
     TRY(cg_close(fn));
     return 0;
 }
+
+int fixture_write_meshio_style(const char *path)
+{
+    const int n = 4, c = 3;
+    static const int kuhn[6][4] = {{0, 1, 2, 6}, {0, 2, 3, 6}, {0, 3, 7, 6},
+                                   {0, 7, 4, 6}, {0, 4, 5, 6}, {0, 5, 1, 6}};
+    cgsize_t size[3] = {n * n * n, 162, 0}, tets[162 * 4], v[8];
+    int fn, B, Z, S, e = 0;
+
+    TRY(cg_set_file_type(CG_FILE_HDF5));
+    TRY(cg_open(path, CG_MODE_WRITE, &fn));
+    TRY(cg_base_write(fn, "Base", 3, 3, &B));
+    TRY(cg_zone_write(fn, B, "Zone1", size, CGNS_ENUMV(Unstructured), &Z));
+    TRY(write_grid_coords(fn, B, Z, n, 0.0, 0.3, 0));
+    for (int k = 0; k < c; k++)
+        for (int j = 0; j < c; j++)
+            for (int i = 0; i < c; i++) {
+                hex_nodes(n, i, j, k, v);
+                for (int t = 0; t < 6; t++, e++)
+                    for (int a = 0; a < 4; a++)
+                        tets[4 * e + a] = v[kuhn[t][a]];
+            }
+    TRY(cg_section_write(fn, B, Z, "GridElements", CGNS_ENUMV(TETRA_4), 1, 162,
+                         0, tets, &S));
+    TRY(cg_close(fn));
+    return 0;
+}

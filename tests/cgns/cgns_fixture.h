@@ -53,4 +53,9 @@ int fixture_write_custom(const char *path, CGNS_ENUMT(ElementType_t) type,
    to an unstructured hex zone (0). */
 int fixture_write_structured(const char *path, int structured_only);
 
+/* The layout meshio's CGNS reader expects: /Base/Zone1 with one TETRA_4
+   section "GridElements" (a 4x4x4-node box, 162 tets, interior jittered),
+   written by libcgns. */
+int fixture_write_meshio_style(const char *path);
+
 #endif
