@@ -8,6 +8,8 @@
 #include "check.h"
 #include "getme_formats.h"
 
+#include <cgns_io.h>
+
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -239,6 +241,29 @@ static void test_malformed(const char *good_h5, const char *good_adf)
     getme_doc_close(doc);
 }
 
+/* A file whose /Base/Block/GridCoordinates is a link into another file:
+   writing it would modify that other file, so it is refused. */
+static void test_link(const char *target)
+{
+    char linked[640];
+    int cg;
+    double root, id, pid;
+    snprintf(linked, sizeof linked, "%s", path_of("linked.cgns"));
+    fixture_opts o = {CG_FILE_HDF5, 0, 0.25};
+    CHECK_EQ_INT(fixture_write(linked, &o), 0);
+    int ok = cgio_open_file(linked, CGIO_MODE_MODIFY, CGIO_FILE_NONE, &cg) == 0 &&
+             cgio_get_root_id(cg, &root) == 0 &&
+             cgio_get_node_id(cg, root, "/Base/Block", &pid) == 0 &&
+             cgio_get_node_id(cg, root, "/Base/Block/GridCoordinates", &id) == 0 &&
+             cgio_delete_node(cg, pid, id) == 0 &&
+             cgio_create_link(cg, pid, "GridCoordinates", target,
+                              "/Base/Block/GridCoordinates", &id) == 0 &&
+             cgio_close_file(cg) == 0;
+    CHECK(ok);
+    expect_fail(linked, GETME_IO_ERR_UNSUPPORTED,
+                "/Base/Block/GridCoordinates is a link", NULL);
+}
+
 int main(void)
 {
     const char *base = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
@@ -263,6 +288,7 @@ int main(void)
     test_names(h5);
     test_2d();
     test_malformed(h5, adf);
+    test_link(h5);
     /* adapter selection by content as well as by extension */
     CHECK(getme_format_for(h5) == &getme_format_cgns);
     CHECK(getme_format_cgns.probe(h5) == 1);

@@ -15,6 +15,8 @@
 #include "check.h"
 #include "getme_formats.h"
 
+#include <cgns_io.h>
+
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -135,13 +137,46 @@ static char *check_report(const char *path)
     return run(cmd);
 }
 
-static void roundtrip(const char *name, int file_type, int single)
+/* Make the fixture look written by CGNS 3.1: no ElementStartOffset under
+   the MIXED section, CGNSLibraryVersion 3.1.  libcgns 3.4 would add the
+   offsets back if the file were opened with cg_open(MODE_MODIFY). */
+static int make_old(const char *path)
+{
+    int cg;
+    double root, id, pid;
+    float version = 3.1f;
+    if (cgio_open_file(path, CGIO_MODE_MODIFY, CGIO_FILE_NONE, &cg) ||
+        cgio_get_root_id(cg, &root) ||
+        cgio_get_node_id(cg, root, "/Base/Tets/TetMix", &pid) ||
+        cgio_get_node_id(cg, root, "/Base/Tets/TetMix/ElementStartOffset", &id) ||
+        cgio_delete_node(cg, pid, id) ||
+        cgio_get_node_id(cg, root, "/CGNSLibraryVersion", &id) ||
+        cgio_write_all_data(cg, id, &version) || cgio_close_file(cg))
+        return -1;
+    return 0;
+}
+
+static int has_node(const char *path, const char *node)
+{
+    int cg, found;
+    double root, id;
+    if (cgio_open_file(path, CGIO_MODE_READ, CGIO_FILE_NONE, &cg))
+        return -1;
+    cgio_get_root_id(cg, &root);
+    found = cgio_get_node_id(cg, root, node, &id) == 0;
+    cgio_close_file(cg);
+    return found;
+}
+
+static void roundtrip(const char *name, int file_type, int single, int old)
 {
     char in[640], out[640], cmd[1400];
     fixture_opts o = {file_type, single, 0.25};
     snprintf(in, sizeof in, "%s/%s.cgns", dir, name);
     snprintf(out, sizeof out, "%s/%s-smooth.cgns", dir, name);
     CHECK_EQ_INT(fixture_write(in, &o), 0);
+    if (old)
+        CHECK_EQ_INT(make_old(in), 0);
     size_t n_before, n_after;
     char *before = slurp(in, &n_before);
 
@@ -166,6 +201,8 @@ static void roundtrip(const char *name, int file_type, int single)
     CHECK(res.q_min_star > res.q_min_star_initial);
     CHECK_EQ_INT(getme_doc_write(doc, out), GETME_IO_OK);
     getme_doc_close(doc);
+    if (old) /* the old layout is kept: nothing was "upgraded" */
+        CHECK_EQ_INT(has_node(out, "/Base/Tets/TetMix/ElementStartOffset"), 0);
 
     char *after = slurp(in, &n_after);
     CHECK(before && after && n_before == n_after &&
@@ -259,10 +296,12 @@ int main(void)
     const char *base = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
     snprintf(dir, sizeof dir, "%s/getme-cgns-rt-%ld", base, (long)getpid());
     mkdir(dir, 0700);
-    roundtrip("hdf5", CG_FILE_HDF5, 0);
-    roundtrip("hdf5-single", CG_FILE_HDF5, 1);
-    roundtrip("adf", CG_FILE_ADF, 0);
-    roundtrip("adf-single", CG_FILE_ADF, 1);
+    roundtrip("hdf5", CG_FILE_HDF5, 0, 0);
+    roundtrip("hdf5-single", CG_FILE_HDF5, 1, 0);
+    roundtrip("adf", CG_FILE_ADF, 0, 0);
+    roundtrip("adf-single", CG_FILE_ADF, 1, 0);
+    roundtrip("hdf5-v31", CG_FILE_HDF5, 0, 1);
+    roundtrip("adf-v31", CG_FILE_ADF, 0, 1);
     write_errors();
     if (check_failed_ == 0) {
         char cmd[700];
