@@ -47,4 +47,15 @@ PYEOF
 [ $rc -eq 2 ] && grep -q "Unknown physical group 'nope'" err.log && ok "unknown group: 2" || bad "unknown group: $rc"
 "$G" gmsh part.msh -o part.msh -q; rc=$?; [ $rc -eq 2 ] && ok "refuses to overwrite input" || bad "overwrite: $rc"
 "$G" gmsh part.geo --bogus 2> err.log; rc=$?; [ $rc -eq 2 ] && grep -q "unknown option" err.log && ok "bad option: 2" || bad "bad option: $rc"
+# getme.geo: the stock gmsh runs `getme gmsh` from the .geo and loads the
+# smoothed mesh (what the GUI does when "Smooth the mesh" is ticked).
+here=$(cd "$(dirname "$0")" && pwd)
+rm -f getme_raw.msh getme_smoothed.msh
+cp "$here/../../examples/gmsh_gui/plate.geo" plate.geo
+printf 'getme_dim = 2;\ngetme_dir = CurrentDirectory;\nInclude "%s";\n' \
+  "$here/../../examples/gmsh_gui/getme.geo" >> plate.geo
+gmsh plate.geo -setnumber getme_run 1 -setstring getme_exe "$G" -parse_and_exit > geo.log 2>&1
+grep -q "Calling '.*gmsh .*getme_raw.msh' -o '.*getme_smoothed.msh'" geo.log \
+  && [ -s getme_smoothed.msh ] && grep -q "^Info    : Reading '.*getme_smoothed.msh'" geo.log \
+  && ok "getme.geo: gmsh ran getme and loaded the result" || bad "getme.geo path"
 exit $fail

@@ -201,6 +201,33 @@ def test_bad_uses():
     gmsh.model.mesh.setOrder(1)
 
 
+def test_gui_logic():
+    """The ONELAB side of getme.gui without a display: the panel's
+    parameters, the demo distortion on "check", Smooth on "getme", the
+    results written back into the panel."""
+    import json
+    from getme import gui
+    here = os.path.dirname(os.path.abspath(__file__))
+    gmsh.open(os.path.join(here, "..", "..", "examples", "gmsh_gui",
+                           "plate.geo"))
+    gmsh.model.mesh.generate(2)
+    gmsh.onelab.set(json.dumps(gui.parameters()))
+    gmsh.onelab.setNumber(gui.P + "5Distort mesh now (demo)", [1])
+    gmsh.onelab.setString("ONELAB/Action", ["check"])
+    gui.handle_events()
+    q_bad = getme.quality()["q_min_star"]
+    check(gmsh.onelab.getNumber(gui.P + "5Distort mesh now (demo)") == [0],
+          "demo box unticked after distorting")
+    gmsh.onelab.setNumber(gui.P + "1Sigma", [1.5])
+    gmsh.onelab.setString("ONELAB/Action", ["getme"])
+    gui.handle_events()
+    after = gmsh.onelab.getNumber(gui.P + "Result/1q*min after")
+    check(after and after[0] > q_bad + 0.3 and
+          abs(after[0] - getme.quality()["q_min_star"]) < 1e-12,
+          "GUI smoothing result %s (distorted %.4f)" % (after, q_bad))
+    check(gmsh.onelab.getString("ONELAB/Action") == [""], "action consumed")
+
+
 if __name__ == "__main__":
     WORK = tempfile.mkdtemp(prefix="getme_plugin_")
     gmsh.initialize()
@@ -215,6 +242,7 @@ if __name__ == "__main__":
               % (name, "%.4f" % qin if qin is not None else "-", qmin, qmean,
                  n, s))
     test_bad_uses()
+    test_gui_logic()
     gmsh.finalize()
     print("plugin_gmsh_python: %d failed" % len(FAILS))
     sys.exit(1 if FAILS else 0)

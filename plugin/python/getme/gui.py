@@ -79,8 +79,9 @@ def redraw():
         v = gmsh.option.getNumber(opt)
         gmsh.option.setNumber(opt, 1 - v)
         gmsh.option.setNumber(opt, v)
-    gmsh.graphics.draw()
-    gmsh.fltk.update()
+    if gmsh.fltk.isAvailable():
+        gmsh.graphics.draw()
+        gmsh.fltk.update()
 
 
 def smooth():
