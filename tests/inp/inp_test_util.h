@@ -28,6 +28,16 @@ static inline void scratch_init(const char *name)
     }
 }
 
+/* Remove the scratch directory when the test passed (kept for a look
+   otherwise). */
+static inline void scratch_done(int passed)
+{
+    char cmd[300];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tdir);
+    if (passed && system(cmd) != 0)
+        fprintf(stderr, "could not remove %s\n", tdir);
+}
+
 static inline const char *tpath(const char *name)
 {
     static char buf[8][512];

@@ -122,5 +122,6 @@ int main(void)
     test_cases();
     test_missing_file();
     test_changed_input();
+    scratch_done(check_failed_ == 0);
     return check_summary("test_inp_errors");
 }

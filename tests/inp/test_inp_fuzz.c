@@ -125,5 +125,6 @@ int main(int argc, char **argv)
     printf("fuzz: %d inputs, %d opened and written, %d refused with a "
            "message\n", iters, opened, failed);
     CHECK(opened > 0 && failed > 0);
+    scratch_done(check_failed_ == 0);
     return check_summary("test_inp_fuzz");
 }

@@ -322,5 +322,6 @@ int main(void)
     test_hex_smooth();
     test_parts();
     test_planar();
+    scratch_done(check_failed_ == 0);
     return check_summary("test_inp_read");
 }
