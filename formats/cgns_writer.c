@@ -199,6 +199,9 @@ static getme_io_status copy_input(getme_doc *doc, const cgns_impl *impl,
     }
     /* getme_io_tmp_path created the (empty) file: truncate it, do not race */
     out = open(tmp, O_WRONLY | O_TRUNC | O_CLOEXEC);
+    /* mkstemp made it 0600: give the copy the input's permissions */
+    if (out >= 0)
+        (void)fchmod(out, sb.st_mode & 07777);
     buf = malloc(COPY_CHUNK);
     if (out < 0 || !buf) {
         st = out < 0 ? getme_doc_fail(doc, GETME_IO_ERR_WRITE, "%s: %s", tmp,

@@ -177,6 +177,7 @@ static void roundtrip(const char *name, int file_type, int single, int old)
     CHECK_EQ_INT(fixture_write(in, &o), 0);
     if (old)
         CHECK_EQ_INT(make_old(in), 0);
+    chmod(in, 0640); /* the output gets the input's permissions */
     size_t n_before, n_after;
     char *before = slurp(in, &n_before);
 
@@ -201,6 +202,8 @@ static void roundtrip(const char *name, int file_type, int single, int old)
     CHECK(res.q_min_star > res.q_min_star_initial);
     CHECK_EQ_INT(getme_doc_write(doc, out), GETME_IO_OK);
     getme_doc_close(doc);
+    struct stat sb;
+    CHECK(stat(out, &sb) == 0 && (sb.st_mode & 0777) == 0640);
     if (old) /* the old layout is kept: nothing was "upgraded" */
         CHECK_EQ_INT(has_node(out, "/Base/Tets/TetMix/ElementStartOffset"), 0);
 
