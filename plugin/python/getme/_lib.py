@@ -6,13 +6,25 @@ libgmsh.so.4.8 by its soname, so the dynamic loader hands it the copy the
 gmsh module already loaded: one Gmsh instance, one current model.
 """
 import ctypes
+import os
 from ctypes import (POINTER, c_char_p, c_double, c_int, c_int32, c_int64,
                     c_size_t, c_void_p)
 
 from ._paths import LIBGETME, LIBGETME_GMSH
 
-core = ctypes.CDLL(LIBGETME)
-plugin = ctypes.CDLL(LIBGETME_GMSH)
+
+
+def _load(path):
+    """The recorded path; if the tree was installed under another prefix
+    than configured, the soname through the loader's search path."""
+    try:
+        return ctypes.CDLL(path)
+    except OSError:
+        return ctypes.CDLL(os.path.basename(path))
+
+
+core = _load(LIBGETME)
+plugin = _load(LIBGETME_GMSH)
 
 STATUS = {0: "ok", 1: "bad argument", 2: "out of memory", 3: "invalid mesh",
           4: "topology", 5: "state", 6: "cancelled"}
