@@ -214,7 +214,22 @@ def test_meshio_writer():
           "input untouched, no output")
 
 
+def test_damaged(cg):
+    """libcgns prints nothing of its own: one line from us, status 4."""
+    data = open(cg, "rb").read()
+    bad, out = path("cut.cgns"), path("cut-smooth.cgns")
+    open(bad, "wb").write(data[: len(data) // 2])
+    r = run("smooth", bad, out)
+    lines = r.stderr.strip().splitlines()
+    check(r.returncode == 4 and len(lines) == 1 and r.stdout == "" and
+          lines[0].startswith("Error   : " + bad + ": libcgns cannot read"),
+          "truncated HDF5 file: one error line, status 4: " +
+          (lines[0] if lines else ""))
+    check(not os.path.exists(out), "no output for the truncated file")
+
+
 cg, total = test_node_order()
+test_damaged(cg)
 test_vtk_chain(cg, total)
 test_meshio_reader()
 test_meshio_writer()
