@@ -70,6 +70,10 @@ def parse_args(argv):
     ap.add_argument("--sweep", action="store_true",
                     help="sweep getme's threshold_fraction on the tet and hex meshes")
     ap.add_argument("--fractions", default=",".join(str(f) for f in SWEEP_FRACTIONS))
+    ap.add_argument("--omp-wait-policy", choices=("active", "passive"),
+                    help="OMP_WAIT_POLICY for the getme runs (default: as in the "
+                         "environment; on a loaded machine 'passive' avoids "
+                         "spinning threads, see docs/bench.md)")
     ap.add_argument("--generate-only", action="store_true")
     ap.add_argument("--keep-outputs", action="store_true",
                     help="keep every method's output mesh (in the cache)")
@@ -185,8 +189,11 @@ def run_method(ctx, case, method, src, ref, params=(), tag=None):
     row = {"size": ctx.args.size, "case": case, "method": key,
            "label": method.label + (f" [{tag}]" if tag else ""), "status": "ok"}
     log(f"Info    : {case}: running {row['label']}")
+    env = None
+    if method.tool == "getme" and ctx.args.omp_wait_policy:
+        env = dict(os.environ, OMP_WAIT_POLICY=ctx.args.omp_wait_policy.upper())
     r = runner.run(M.command(method, ctx.getme, src, dst, report, params),
-                   timeout=ctx.args.timeout)
+                   timeout=ctx.args.timeout, env=env)
     row["peak_gib"], row["wall"] = r.peak_gib, r.wall
     if r.returncode != 0 or not os.path.exists(dst):
         row["status"] = f"failed: {r.error_line()}"
@@ -300,7 +307,8 @@ def bench_case(ctx, case, meta):
                          "status": "skipped (python3-netgen not installed)"})
             continue
         rows.append(run_method(ctx, case, method, dist, ref))
-    notes = [f"  generated: q*min {gen_st['q_min_star']:.4f}, q_mean "
+    notes = [f"  run {meta['date']}, load average {meta['load_average'][0]:.2f}",
+             f"  generated: q*min {gen_st['q_min_star']:.4f}, q_mean "
              f"{gen_st['q_mean']:.4f}; distorted (seed {ctx.args.seed}): q*min "
              f"{init['q_min_star']:.4f}, q_mean {init['q_mean']:.4f}"]
     failed = any(check_row(r, notes) for r in rows[1:]
@@ -314,9 +322,24 @@ def bench_case(ctx, case, meta):
     return case_out, failed
 
 
+def merge_previous(path, cases):
+    """Cases of an earlier run of the same size that this run did not redo
+    (so big cases can be run one at a time), followed by this run's."""
+    import json
+    if not os.path.exists(path):
+        return cases
+    with open(path) as f:
+        old = json.load(f).get("cases", {})
+    merged = {c: v for c, v in old.items() if c not in cases}
+    merged.update(cases)
+    return {c: merged[c] for c in meshes.CASES if c in merged}
+
+
 def write_outputs(args, meta, cases, stem):
     import plots
     os.makedirs(args.out, exist_ok=True)
+    new = list(cases)
+    cases = merge_previous(os.path.join(args.out, f"{stem}.json"), cases)
     all_rows = [r for c in cases.values() for r in [c["initial_row"]] + c["rows"]]
     tables.write_csv(os.path.join(args.out, f"{stem}.csv"), all_rows)
     tables.write_json(os.path.join(args.out, f"{stem}.json"),
@@ -324,7 +347,7 @@ def write_outputs(args, meta, cases, stem):
     with open(os.path.join(args.out, f"{stem}.txt"), "w") as f:
         f.write(meta["header"] + "\n\n")
         f.write("\n\n".join(c["text"] for c in cases.values()) + "\n")
-    for case, c in cases.items():
+    for case, c in ((k, cases[k]) for k in new):
         plots.plot_quality_time(c, os.path.join(args.out, f"{case}-{args.size}-quality-time.png"),
                                 meta["cpu"])
         plots.plot_histogram(c, os.path.join(args.out, f"{case}-{args.size}-histogram.png"))
@@ -333,16 +356,19 @@ def write_outputs(args, meta, cases, stem):
 def make_meta(args, getme):
     cpu = runner.cpu_name()
     load = runner.load_average()
-    header = (f"getme benchmark, size {args.size}, {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}\n"
+    date = time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())
+    header = (f"getme benchmark, size {args.size}, {date}\n"
               f"CPU: {cpu}; load average at start {load[0]:.2f} (shared machine: "
               f"times are indicative)\n"
               "Mem = peak RSS of the process (/usr/bin/time); dMem = minus a run of "
               "the same tool that only loads/writes the mesh.\n"
-              f"getme runs as: {' '.join(getme or ['-'])}\n"
+              f"getme runs as: {' '.join(getme or ['-'])}; OMP_WAIT_POLICY="
+              f"{args.omp_wait_policy or os.environ.get('OMP_WAIT_POLICY', 'unset (libgomp: spin, then sleep)')}\n"
               "Time = the smoothing call only (getme's report, or timed inside the "
               "Gmsh/Netgen process).  q*min: min over elements with a free node "
               "(free = not on skin or region interface).")
     return {"size": args.size, "cpu": cpu, "load_average": load, "header": header,
+            "date": date,
             "getme": " ".join(getme or []), "seed": args.seed, "generator_version": meshes.GENERATOR_VERSION}
 
 

@@ -8,7 +8,7 @@ Cases (DESIGN.md section 6 and the paper's Sec. 3):
          recombination) and swept along z in layers: all hexahedra.
   mixed  a block whose lower part is swept (quads -> hexes, triangles ->
          prisms) and whose upper part is Delaunay tets; Gmsh puts pyramids on
-         the quads the tets meet.  Physical volumes "base" and "cap".
+         the quads the tets meet.  One physical volume per volume (4).
   tri    the flange section, triangles (Frontal-Delaunay).
   quad   the flange section, quads (Blossom recombination).
 
@@ -24,6 +24,9 @@ import os
 import time
 
 GENERATOR_VERSION = 1  # bump when a geometry or option changes
+# per-case bumps: mixed 2 = one physical volume per volume, so that region
+# interfaces are exactly the geometric interfaces getme's MSH adapter fixes
+CASE_VERSION = {"mixed": 2}
 
 # case -> size -> mesh size h (model units: mm).  Targets: tet ~200k / 1M /
 # 4.1M, hex ~100k / 650k / 2.6M (the paper's 4.13M tets and 2.65M hexes).
@@ -150,10 +153,10 @@ def _mixed(h):
     ex2 = g.extrude([(2, t) for t in tops], 0, 0, cap)  # unstructured: tets
     cap_vols = [t for d, t in ex2 if d == 3]
     g.synchronize()
-    gmsh.model.addPhysicalGroup(3, base_vols, 1)
-    gmsh.model.setPhysicalName(3, 1, "base")
-    gmsh.model.addPhysicalGroup(3, cap_vols, 2)
-    gmsh.model.setPhysicalName(3, 2, "cap")
+    names = ("base-hex", "base-prism", "cap-over-hex", "cap-over-prism")
+    for tag, (vol, name) in enumerate(zip(base_vols + cap_vols, names), start=1):
+        gmsh.model.addPhysicalGroup(3, [vol], tag)
+        gmsh.model.setPhysicalName(3, tag, name)
     gmsh.option.setNumber("Mesh.Algorithm", 6)
     gmsh.option.setNumber("Mesh.Algorithm3D", 1)
     gmsh.model.mesh.generate(3)
@@ -171,7 +174,8 @@ GMSH_TYPES = {4: "tet", 5: "hex", 6: "prism", 7: "pyramid", 2: "tri", 3: "quad"}
 
 
 def cache_path(cache_dir, case, size):
-    return os.path.join(cache_dir, f"{case}-{size}-g{GENERATOR_VERSION}.msh")
+    version = CASE_VERSION.get(case, GENERATOR_VERSION)
+    return os.path.join(cache_dir, f"{case}-{size}-g{version}.msh")
 
 
 def _element_counts():
@@ -216,7 +220,7 @@ def generate(case, size, cache_dir, log=print):
     os.replace(tmp, path)
     info = {"case": case, "size": size, "h": h, "nodes": nodes,
             "elements": counts, "seconds": round(seconds, 2),
-            "generator_version": GENERATOR_VERSION}
+            "generator_version": CASE_VERSION.get(case, GENERATOR_VERSION)}
     with open(path + ".json", "w") as f:
         json.dump(info, f, indent=1)
     log(f"Info    : {case}-{size}: {nodes} nodes, "
