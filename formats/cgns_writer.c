@@ -390,9 +390,12 @@ getme_io_status cgns_write(getme_doc *doc, const char *out_path)
         return getme_doc_fail(doc, GETME_IO_ERR_USAGE,
                               "%s: the output is the input file; getme never "
                               "overwrites its input", out_path);
+    errno = 0;
     if (getme_io_tmp_path(out_path, tmp, sizeof tmp) != 0)
-        return getme_doc_fail(doc, GETME_IO_ERR_WRITE, "%s: path too long",
-                              out_path);
+        return getme_doc_fail(doc, GETME_IO_ERR_WRITE,
+                              "%s: cannot create a temporary file next to "
+                              "it: %s", out_path,
+                              errno ? strerror(errno) : "path too long");
     double *xyz = malloc(3 * (size_t)n * sizeof *xyz);
     if (!xyz || getme_mesh_get_coords(doc->mesh, xyz) != GETME_OK) {
         free(xyz);
