@@ -27,6 +27,9 @@ typedef struct builder {
     int32_t *sfirst;       /* per element block: first smoothed index      */
     int32_t nsmooth;
     uint8_t *fixed;
+    uint32_t *stamp[2];    /* per set: traversal that visited it, per depth */
+    uint32_t now[2];
+    int32_t *stack[2];
 } builder;
 
 static const char *where(const inp_deck *d, int file, uint32_t line,
@@ -222,6 +225,30 @@ static getme_io_status unknown_member(builder *b, const inp_chunk *c, int kind,
                           kind == INP_SET_NODE ? "node" : "element", id);
 }
 
+static getme_io_status visit_wide_range(builder *b, int kind, int scope,
+                                        int64_t first, int64_t last,
+                                        int64_t step, member_fn fn, void *arg)
+{
+    const inp_deck *d = b->d;
+    size_t nb = kind == INP_SET_NODE ? d->nnblocks : d->neblocks;
+    getme_io_status st;
+    for (size_t k = 0; k < nb; k++) {
+        int sc = kind == INP_SET_NODE ? d->nblocks[k].scope : d->eblocks[k].scope;
+        int32_t beg = kind == INP_SET_NODE ? d->nblocks[k].first
+                                           : d->eblocks[k].first;
+        int32_t cnt = kind == INP_SET_NODE ? d->nblocks[k].count
+                                           : d->eblocks[k].count;
+        const int32_t *ids = kind == INP_SET_NODE ? d->node_id : d->elem_id;
+        if (sc != scope)
+            continue;
+        for (int32_t i = beg; i < beg + cnt; i++)
+            if (ids[i] >= first && ids[i] <= last &&
+                (ids[i] - first) % step == 0 && (st = fn(b, i, arg)))
+                return st;
+    }
+    return GETME_IO_OK;
+}
+
 static getme_io_status visit_ids(builder *b, int32_t set, const inp_chunk *c,
                                  member_fn fn, void *arg)
 {
@@ -242,12 +269,20 @@ static getme_io_status visit_ids(builder *b, int32_t set, const inp_chunk *c,
            with sparse numbering. */
         int64_t first = -(int64_t)d->items[i], last = d->items[i + 1],
                 step = d->items[i + 2];
+        i += 2;
+        if ((last - first) / step > 2 * (int64_t)(d->nnodes + d->nelems) + 1024) {
+            /* A range far wider than the mesh ("1, 2147483647"): test the
+               entries of the scope instead of every id of the range. */
+            if ((st = visit_wide_range(b, kind, c->scope, first, last, step,
+                                       fn, arg)))
+                return st;
+            continue;
+        }
         for (int64_t id = first; id <= last; id += step) {
             int32_t idx = inp_ids_get(m, c->scope, id);
             if (idx >= 0 && (st = fn(b, idx, arg)))
                 return st;
         }
-        i += 2;
     }
     return GETME_IO_OK;
 }
@@ -276,29 +311,66 @@ static getme_io_status elem_nodes(builder *b, int32_t e, void *varg)
     return GETME_IO_OK;
 }
 
+static getme_io_status visit_chunk(builder *b, int32_t set,
+                                   const inp_chunk *c, member_fn fn, void *arg,
+                                   int depth)
+{
+    const inp_deck *d = b->d;
+    getme_io_status st;
+    if (c->nblock >= 0) {
+        const inp_node_block *nb = &d->nblocks[c->nblock];
+        for (int32_t i = nb->first; i < nb->first + nb->count; i++)
+            if ((st = fn(b, i, arg)))
+                return st;
+    } else if (c->eblock >= 0) {
+        const inp_elem_block *eb = &d->eblocks[c->eblock];
+        for (int32_t i = eb->first; i < eb->first + eb->count; i++)
+            if ((st = fn(b, i, arg)))
+                return st;
+    } else if (c->elset >= 0) {
+        elem_nodes_arg a = {fn, arg};
+        if (depth == 0 &&
+            (st = for_each_member(b, c->elset, elem_nodes, &a, 1)))
+            return st;
+    } else if ((st = visit_ids(b, set, c, fn, arg))) {
+        return st;
+    }
+    return GETME_IO_OK;
+}
+
+/* Every member of set, following set references; each referenced set is
+   visited once (an explicit stack: reference chains can be long). */
 static getme_io_status for_each_member(builder *b, int32_t set, member_fn fn,
                                        void *arg, int depth)
 {
     inp_deck *d = b->d;
-    getme_io_status st;
-    for (int32_t k = d->sets[set].head; k >= 0; k = d->chunks[k].next) {
-        const inp_chunk *c = &d->chunks[k];
-        if (c->nblock >= 0) {
-            const inp_node_block *nb = &d->nblocks[c->nblock];
-            for (int32_t i = nb->first; i < nb->first + nb->count; i++)
-                if ((st = fn(b, i, arg)))
-                    return st;
-        } else if (c->eblock >= 0) {
-            const inp_elem_block *eb = &d->eblocks[c->eblock];
-            for (int32_t i = eb->first; i < eb->first + eb->count; i++)
-                if ((st = fn(b, i, arg)))
-                    return st;
-        } else if (c->elset >= 0 && depth == 0) {
-            elem_nodes_arg a = {fn, arg};
-            if ((st = for_each_member(b, c->elset, elem_nodes, &a, 1)))
+    if (!b->stamp[depth]) {
+        b->stamp[depth] = calloc(d->nsets, sizeof *b->stamp[depth]);
+        b->stack[depth] = malloc(d->nsets * sizeof *b->stack[depth]);
+        if (!b->stamp[depth] || !b->stack[depth])
+            return getme_doc_fail(b->doc, GETME_IO_ERR_INTERNAL,
+                                  "out of memory");
+    }
+    uint32_t *stamp = b->stamp[depth];
+    int32_t *stack = b->stack[depth];
+    uint32_t now = ++b->now[depth];
+    size_t top = 0;
+    stack[top++] = set;
+    stamp[set] = now;
+    while (top) {
+        int32_t s = stack[--top];
+        for (int32_t k = d->sets[s].head; k >= 0; k = d->chunks[k].next) {
+            const inp_chunk *c = &d->chunks[k];
+            if (c->setref >= 0) {
+                if (stamp[c->setref] != now) {
+                    stamp[c->setref] = now;
+                    stack[top++] = c->setref;
+                }
+                continue;
+            }
+            getme_io_status st = visit_chunk(b, s, c, fn, arg, depth);
+            if (st)
                 return st;
-        } else if ((st = visit_ids(b, set, c, fn, arg))) {
-            return st;
         }
     }
     return GETME_IO_OK;
@@ -631,6 +703,10 @@ getme_io_status inp_build(inp_deck *d, getme_doc *doc,
     inp_ids_free(&b.elems);
     free(b.sfirst);
     free(b.fixed);
+    for (int i = 0; i < 2; i++) {
+        free(b.stamp[i]);
+        free(b.stack[i]);
+    }
     return st;
 }
 

@@ -204,7 +204,8 @@ typedef struct inp_set {
 
 /* A piece of a set: ids items[beg, end) of the pool (a range is stored as
    -first, last, step), or a whole node / element block, or the nodes of an
-   element set.  Sets referencing sets copy the referenced chunks. */
+   element set, or another set named in a data line (visited once per
+   traversal, so chains and cycles of references cost linear time). */
 typedef struct inp_chunk {
     int scope;                /* scope the ids refer to                     */
     int file;
@@ -212,6 +213,7 @@ typedef struct inp_chunk {
     int64_t beg, end;
     int32_t nblock, eblock;   /* whole block, or -1                         */
     int32_t elset;            /* *NSET, ELSET=: that element set, or -1     */
+    int32_t setref;           /* a set named in a data line, or -1          */
     int32_t next;
 } inp_chunk;
 

@@ -136,7 +136,7 @@ static int32_t add_chunk(reader *rd, int32_t s, int scope)
         return -1;
     int32_t c = (int32_t)d->nchunks++;
     d->chunks[c] = (inp_chunk){scope, rd->file, rd->line, d->nitems,
-                               d->nitems, -1, -1, -1, -1};
+                               d->nitems, -1, -1, -1, -1, -1};
     if (d->sets[s].tail >= 0)
         d->chunks[d->sets[s].tail].next = c;
     else
@@ -358,23 +358,13 @@ static getme_io_status element_line(reader *rd, const char *text, size_t len)
 
 /* ---- sets ----------------------------------------------------------------- */
 
-/* Copy the chunks of set src into rd->set (a set made of sets). */
+/* A set named in a data line: a reference chunk (a set made of sets). */
 static getme_io_status copy_set(reader *rd, int32_t src)
 {
-    inp_deck *d = rd->d;
-    /* Snapshot the tail first: a set listing itself must not loop. */
-    int32_t stop = d->sets[src].tail;
-    for (int32_t c = d->sets[src].head; c >= 0; c = d->chunks[c].next) {
-        inp_chunk copy = d->chunks[c];
-        int32_t n = add_chunk(rd, rd->set, copy.scope);
-        if (n < 0)
-            return fail(rd, GETME_IO_ERR_UNSUPPORTED,
-                        "too many set references");
-        copy.next = -1;
-        d->chunks[n] = copy;
-        if (c == stop)
-            break;
-    }
+    int32_t n = add_chunk(rd, rd->set, rd->d->sets[src].ns);
+    if (n < 0)
+        return fail(rd, GETME_IO_ERR_UNSUPPORTED, "too many set references");
+    rd->d->chunks[n].setref = src;
     rd->chunk = -1;
     return GETME_IO_OK;
 }

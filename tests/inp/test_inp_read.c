@@ -48,6 +48,9 @@ static void hex_deck(const char *name)
         "\r\n1075, 1078\r\n");
     OUT("*ELSET,ELSET=Rest\r\nLayer1, LAYER2\r\n");
     OUT("*NSET, NSET=Center\r\n%d\r\n", nid(1, 1, 1));
+    /* a range far wider than the mesh, and a set naming itself */
+    OUT("*NSET, NSET=Wide, GENERATE\r\n7, 2147483647, 10\r\n");
+    OUT("*NSET, NSET=Loop\r\nLoop, Center\r\n");
     OUT("*Material, name=Steel\r\n*Elastic\r\n210000., 0.3\r\n");
     OUT("*Solid Section, elset=Layer0, material=Steel\r\n,\r\n");
     OUT("*SOLID SECTION, ELSET=REST, MATERIAL=Steel\r\n,\r\n");
@@ -94,6 +97,10 @@ static void test_hex_counts(void)
     CHECK_EQ_INT(fixed_count("hex.inp", 0, 1, layer1, &st), 64);
     const char *rest[] = {"Rest"};     /* set of sets */
     CHECK_EQ_INT(fixed_count("hex.inp", 0, 1, rest, &st), 64);
+    const char *wide[] = {"Wide"};
+    CHECK_EQ_INT(fixed_count("hex.inp", 0, 1, wide, &st), 64);
+    const char *loop[] = {"loop"};
+    CHECK_EQ_INT(fixed_count("hex.inp", 0, 1, loop, &st), 59);
     const char *all[] = {"allnodes"};
     CHECK_EQ_INT(fixed_count("hex.inp", 0, 1, all, &st), 64);
     const char *bad[] = {"NoSuchSet"};
