@@ -268,6 +268,32 @@ static void roundtrip(const char *name, int file_type, int single, int old)
     free(xyz_out);
 }
 
+/* A planar zone in 3-D space: only CoordinateX and CoordinateY change. */
+static void roundtrip_2d(void)
+{
+    char in[640], out[640], cmd[1400];
+    snprintf(in, sizeof in, "%s/plane.cgns", dir);
+    snprintf(out, sizeof out, "%s/plane-smooth.cgns", dir);
+    CHECK_EQ_INT(fixture_write_2d(in), 0);
+    getme_doc *doc;
+    CHECK_EQ_INT(getme_doc_open(&doc, in, NULL), GETME_IO_OK);
+    getme_result res;
+    CHECK_EQ_INT(getme_smooth(getme_doc_mesh(doc), NULL, &res), GETME_OK);
+    CHECK(res.q_mean > res.q_mean_initial);
+    CHECK_EQ_INT(getme_doc_write(doc, out), GETME_IO_OK);
+    getme_doc_close(doc);
+    snprintf(cmd, sizeof cmd, "cgnsdiff -d '%s' '%s' 2>&1", in, out);
+    char *diff = run(cmd);
+    CHECK(strstr(diff, "/Plane/Sheet/GridCoordinates/CoordinateX") != NULL);
+    CHECK(strstr(diff, "/Plane/Sheet/GridCoordinates/CoordinateY") != NULL);
+    CHECK(strstr(diff, "CoordinateZ") == NULL);
+    int lines = 0;
+    for (char *p = diff; *p; p++)
+        lines += *p == '\n';
+    CHECK_EQ_INT(lines, 2);
+    free(diff);
+}
+
 /* Writing onto the input, or into a missing directory, fails cleanly. */
 static void write_errors(void)
 {
@@ -306,6 +332,7 @@ int main(void)
     roundtrip("adf-single", CG_FILE_ADF, 1, 0);
     roundtrip("hdf5-v31", CG_FILE_HDF5, 0, 1);
     roundtrip("adf-v31", CG_FILE_ADF, 0, 1);
+    roundtrip_2d();
     write_errors();
     if (check_failed_ == 0) {
         char cmd[700];
