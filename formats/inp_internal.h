@@ -54,6 +54,8 @@ typedef struct inp_lines {
     char *text;          /* current line without terminator, NUL-ended     */
     size_t len;
     const char *term;    /* its terminator as found: "\n", "\r\n" or ""    */
+    int bom;             /* the file starts with a UTF-8 byte order mark,
+                            which is not part of line 1's text            */
 } inp_lines;
 
 /* 0, or -1 with errno set. */

@@ -91,6 +91,12 @@ int inp_lines_next(inp_lines *r)
     /* The terminator byte (or the spare byte after the buffer) becomes the
        NUL, so callers get a C string without copying. */
     start[len] = '\0';
+    if (r->lineno == 0 && len >= 3 && memcmp(start, "\xEF\xBB\xBF", 3) == 0) {
+        /* Windows editors may start a deck with a byte order mark. */
+        r->bom = 1;
+        start += 3;
+        len -= 3;
+    }
     r->text = start;
     r->len = len;
     r->offset = r->next_offset;

@@ -206,6 +206,8 @@ static int copy_line(writer *w, FILE *out, const inp_lines *in, int file,
 {
     const inp_doc *st = w->st;
     int rc;
+    if (in->lineno == 1 && in->bom && put(out, "\xEF\xBB\xBF", 3))
+        return -1;
     if (c->inc < st->nincs && st->incs[c->inc].offset == in->offset) {
         rc = include_line(w, out, in, &st->incs[c->inc]);
         c->inc = next_inc(st, c->inc + 1, file);

@@ -300,7 +300,7 @@ static void test_planar(void)
     char *b = malloc(1 << 14);
     size_t n = 0;
 #define OUT(...) n += (size_t)sprintf(b + n, __VA_ARGS__)
-    OUT("*NODE\n");
+    OUT("\xEF\xBB\xBF*NODE\n"); /* with a UTF-8 byte order mark */
     for (int q = 0; q < 16; q++)
         OUT("%d, %d., %d., 2.5\n", q + 1, q % 4, q / 4);
     OUT("*ELEMENT, TYPE=CPS4R, ELSET=Plate\n");
@@ -318,7 +318,16 @@ static void test_planar(void)
     CHECK_EQ_INT(getme_mesh_dim(m), 2);
     CHECK_EQ_INT(getme_mesh_num_elements_of_type(m, GETME_QUAD), 9);
     CHECK_EQ_INT(getme_mesh_num_fixed(m), 14); /* 12 skin + 2 truss nodes */
+    double x[48];
+    getme_mesh_get_coords(m, x);
+    x[3 * 9 + 1] = 2.25; /* node 10, interior */
+    getme_mesh_set_coords(m, x);
+    CHECK_EQ_INT(getme_doc_write(doc, tpath("plane-out.inp")), GETME_IO_OK);
     getme_doc_close(doc);
+    char *out = get_file(tpath("plane-out.inp"), NULL);
+    CHECK(out && memcmp(out, "\xEF\xBB\xBF*NODE\n1, 0., 0., 2.5\n", 21) == 0);
+    CHECK(out && strstr(out, "\n10, 1., 2.25, 2.5\n") != NULL);
+    free(out);
 }
 
 int main(void)
