@@ -223,7 +223,7 @@ getme_status getme__adaptive(getme_run *run)
     }
 
     double q_mean = res->q_mean_initial, q_min = res->q_min_star_initial;
-    double qt = 1.0, best_min = -1.0, cycle_start_min = 0.0, cycle_best = 0.0;
+    double qt = 1.0, best_min = -1.0, record = -1.0, cycle_best = 0.0;
     const double *R = p->relax_mean;
     int nR = p->num_relax_mean;
     int state = MEAN_RUNNING, counter = 0, have_cycle = 0;
@@ -271,16 +271,25 @@ getme_status getme__adaptive(getme_run *run)
                 state = MIN_START;
         }
         if (state == MIN_START) {
-            if (have_cycle && !(cycle_best > cycle_start_min + p->min_tol)) {
+            /* "No q*_min improvement in the last cycle" means: the cycle
+               did not beat the best q*_min seen before it.  Comparing with
+               the q*_min at the cycle's start instead lets an oscillating
+               mesh "improve" on its own dips forever (measured: 988
+               iterations with threshold_fraction 0.05). */
+            if (have_cycle && !(cycle_best > record + p->min_tol)) {
                 res->stop_reason = GETME_STOP_CONVERGED;
                 break;
             }
+            if (cycle_best > record)
+                record = cycle_best;
+            if (q_min > record)
+                record = q_min;
             state = MIN_RUNNING;
             counter = 0;
             qt = determine_threshold(run, scratch);
             have_cycle = 1;
             res->cycles_min++;
-            cycle_start_min = cycle_best = q_min;
+            cycle_best = q_min;
         }
     }
 
