@@ -11,6 +11,8 @@
  *  - no element is inverted, by an independent determinant check;
  *  - the mean quality went up (recomputed by the core on the read-back).
  */
+#define _POSIX_C_SOURCE 200809L /* popen, chmod */
+
 #include "cgns_fixture.h"
 #include "check.h"
 #include "getme_formats.h"
