@@ -44,59 +44,10 @@ def run(*args, expect=0):
     return p
 
 
-# ---- independent mean ratio (DESIGN.md §2) -------------------------------
-
-def _simplex_q(D, Winv):
-    S = D @ Winv
-    det = np.linalg.det(S)
-    fro = np.einsum("nij,nij->n", S, S)
-    q = np.where(det > 0, 3.0 * np.cbrt(det * det) / np.where(fro > 0, fro, 1), 0.0)
-    return q, det
-
-
-def _edges(x, simplices):
-    return [np.stack([x[:, s[1]] - x[:, s[0]], x[:, s[2]] - x[:, s[0]], x[:, s[3]] - x[:, s[0]]], axis=2)
-            for s in simplices]
-
-
-W = {
-    "tet": np.array([[1, .5, .5], [0, np.sqrt(3) / 2, np.sqrt(3) / 6], [0, 0, np.sqrt(2 / 3)]]),
-    "hex": np.eye(3),
-    "prism": np.array([[1, .5, 0], [0, np.sqrt(3) / 2, 0], [0, 0, 1]]),
-    "pyramid": np.array([[1, 0, .5], [0, 1, .5], [0, 0, 1 / np.sqrt(2)]]),
-}
-SIMPLICES = {
-    "tet": [(0, 1, 2, 3)],
-    "hex": [(0, 3, 4, 1), (1, 0, 5, 2), (2, 1, 6, 3), (3, 2, 7, 0),
-            (4, 7, 5, 0), (5, 4, 6, 1), (6, 5, 7, 2), (7, 6, 4, 3)],
-    "prism": [(0, 1, 2, 3), (1, 2, 0, 4), (2, 0, 1, 5), (3, 5, 4, 0), (4, 3, 5, 1), (5, 4, 3, 2)],
-    "pyramid": [(0, 1, 3, 4), (1, 2, 0, 4), (2, 3, 1, 4), (3, 0, 2, 4)],
-}
-
-
-def mean_ratio(kind, x):
-    """x: (n, nv, 3) element coordinates -> (n,) qualities, 0 if invalid."""
-    if kind == "tri":
-        e = [x[:, 1] - x[:, 0], x[:, 2] - x[:, 1], x[:, 0] - x[:, 2]]
-        area = 0.5 * (e[0][:, 0] * (-e[2][:, 1]) - e[0][:, 1] * (-e[2][:, 0]))
-        s = sum((v[:, :2] ** 2).sum(1) for v in e)
-        return np.where(area > 0, 4 * np.sqrt(3) * area / s, 0.0)
-    if kind == "quad":
-        qs, ok = [], np.ones(len(x), bool)
-        for k in range(4):
-            a = x[:, (k + 1) % 4, :2] - x[:, k, :2]
-            b = x[:, (k + 3) % 4, :2] - x[:, k, :2]
-            det = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-            ok &= det > 0
-            qs.append(2 * det / ((a ** 2).sum(1) + (b ** 2).sum(1)))
-        return np.where(ok, np.mean(qs, axis=0), 0.0)
-    Winv = np.linalg.inv(W[kind])
-    qs, ok = [], np.ones(len(x), bool)
-    for D in _edges(x, SIMPLICES[kind]):
-        q, det = _simplex_q(D, Winv)
-        ok &= det > 0
-        qs.append(q)
-    return np.where(ok, np.mean(qs, axis=0), 0.0)
+# ---- independent mean ratio: bench/quality.py (numpy, DESIGN.md §2, written
+# apart from libgetme and checked against it by the bench_quality test) -----
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "bench"))
+from quality import element_quality  # noqa: E402
 
 
 GMSH_TYPES = {4: "tet", 5: "hex", 6: "prism", 7: "pyramid", 2: "tri", 3: "quad"}
@@ -123,7 +74,7 @@ def read(path):
         kind = GMSH_TYPES[ty]
         nv = len(conn) // len(et)
         idx = np.vectorize(index.get)(conn.reshape(-1, nv))
-        qual[kind] = mean_ratio(kind, xyz[idx])
+        qual[kind] = element_quality(xyz, idx, kind)
         etags.extend(int(e) for e in et)
     gmsh.finalize()
     return node, fixed, qual, sorted(etags), dim
