@@ -48,8 +48,8 @@ def plot_histogram(case, path):
     x = np.arange(10)
     for i, row in enumerate(rows):
         counts = np.asarray(row["histogram"], dtype=float)
-        ax.bar(x + (i - (len(rows) - 1) / 2) * width, np.maximum(counts, 0.8),
-               width, label=row["label"])
+        counts[counts == 0] = np.nan  # an empty bin draws no bar
+        ax.bar(x + (i - (len(rows) - 1) / 2) * width, counts, width, label=row["label"])
     ax.set_yscale("log")
     ax.set_ylim(bottom=0.7)
     ax.set_xticks(x, [f"{b / 10:.1f}-{(b + 1) / 10:.1f}" for b in range(10)])
