@@ -75,6 +75,8 @@ def parse_args(argv):
                          "environment; on a loaded machine 'passive' avoids "
                          "spinning threads, see docs/bench.md)")
     ap.add_argument("--generate-only", action="store_true")
+    ap.add_argument("--replot", action="store_true",
+                    help="redraw the PNGs of --out's bench-SIZE.json, run nothing")
     ap.add_argument("--keep-outputs", action="store_true",
                     help="keep every method's output mesh (in the cache)")
     ap.add_argument("--timeout", type=float, default=None,
@@ -404,8 +406,24 @@ def sweep(ctx, meta):
     return failed
 
 
+def replot(args):
+    import json
+    import plots
+    path = os.path.join(args.out, f"bench-{args.size}.json")
+    with open(path) as f:
+        data = json.load(f)
+    for case, c in data["cases"].items():
+        plots.plot_quality_time(c, os.path.join(args.out, f"{case}-{args.size}-quality-time.png"),
+                                data["meta"]["cpu"])
+        plots.plot_histogram(c, os.path.join(args.out, f"{case}-{args.size}-histogram.png"))
+    log(f"Info    : plots of {path} redrawn")
+    return 0
+
+
 def main(argv=None):
     args = parse_args(sys.argv[1:] if argv is None else argv)
+    if args.replot:
+        return replot(args)
     if args.generate_only:
         for case in args.cases:
             meshes.generate(case, args.size, args.cache, log=log)
