@@ -60,7 +60,9 @@ def parse_args(argv):
                     help="comma list of method keys (default: all that apply)")
     ap.add_argument("--out", help="result directory (default bench/results/SIZE)")
     ap.add_argument("--cache", default=os.environ.get("GETME_BENCH_CACHE",
-                                                      os.path.join(HERE, "cache")))
+                                                      os.path.join(HERE, "cache")),
+                    help="generated/distorted meshes and run outputs "
+                         "(default bench/cache, or $GETME_BENCH_CACHE)")
     ap.add_argument("--getme", help="the getme executable (default: build*/cli/getme, PATH)")
     ap.add_argument("--getme-runner", choices=("auto", "cli", "ctypes"), default="auto",
                     help="auto: the CLI if it reads .msh, else libgetme via ctypes")
@@ -69,7 +71,8 @@ def parse_args(argv):
                     help="'none' benchmarks the generated meshes as they are")
     ap.add_argument("--sweep", action="store_true",
                     help="sweep getme's threshold_fraction on the tet and hex meshes")
-    ap.add_argument("--fractions", default=",".join(str(f) for f in SWEEP_FRACTIONS))
+    ap.add_argument("--fractions", default=",".join(str(f) for f in SWEEP_FRACTIONS),
+                    help="threshold_fraction values of --sweep")
     ap.add_argument("--omp-wait-policy", choices=("active", "passive"),
                     help="OMP_WAIT_POLICY for the getme runs (default: as in the "
                          "environment; on a loaded machine 'passive' avoids "
