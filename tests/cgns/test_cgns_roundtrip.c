@@ -270,6 +270,114 @@ static void roundtrip(const char *name, int file_type, int single, int old)
     free(xyz_out);
 }
 
+/* Node g at c + t (orig_g - c), every other node at its input position. */
+static void place(double *trial, const double *orig, int g, const double *c,
+                  double t)
+{
+    memcpy(trial, orig, 3 * FIX_NODES * sizeof *trial);
+    for (int k = 0; k < 3; k++)
+        trial[3 * g + k] = c[k] + t * (orig[3 * g + k] - c[k]);
+}
+
+/* Are the tets around g valid as given, and how many are not once
+   rounded to float? */
+static void check_star(const double *trial, const cgsize_t *data,
+                       const cgsize_t *offs, int g, int *valid, int *flips)
+{
+    *valid = 1;
+    *flips = 0;
+    for (int f = 0; f < 162; f++) {
+        double x[12], xr[12];
+        int has = 0;
+        for (int a = 0; a < 4; a++) {
+            int32_t n = (int32_t)(data[offs[f] + 1 + a] - 1 + 125);
+            has |= n == g;
+            for (int k = 0; k < 3; k++) {
+                x[3 * a + k] = trial[3 * n + k];
+                xr[3 * a + k] = (double)(float)trial[3 * n + k];
+            }
+        }
+        if (!has)
+            continue;
+        *valid &= getme_element_quality(GETME_TET, x) > 0.0;
+        *flips += getme_element_quality(GETME_TET, xr) <= 0.0;
+    }
+}
+
+/* RealSingle: a free node moved so close to the opposite face of one of its
+   tets that the tet is (barely) valid in double but not once the node is
+   rounded to float.  The writer must put the node back to its input
+   position and say so. */
+static void rounding_repair(void)
+{
+    char in[640], out[640];
+    fixture_opts o = {CG_FILE_HDF5, 1, 0.25};
+    snprintf(in, sizeof in, "%s/round.cgns", dir);
+    snprintf(out, sizeof out, "%s/round-smooth.cgns", dir);
+    CHECK_EQ_INT(fixture_write(in, &o), 0);
+    int fn;
+    cgsize_t size, offs[181], *data;
+    CHECK_EQ_INT(cg_open(in, CG_MODE_READ, &fn), CG_OK);
+    cg_ElementDataSize(fn, 1, 2, 1, &size);
+    data = malloc((size_t)size * sizeof *data);
+    cg_poly_elements_read(fn, 1, 2, 1, data, offs, NULL);
+    cg_close(fn);
+
+    getme_doc *doc;
+    CHECK_EQ_INT(getme_doc_open(&doc, in, NULL), GETME_IO_OK);
+    getme_mesh *m = getme_doc_mesh(doc);
+    double xyz[3 * FIX_NODES], orig[3 * FIX_NODES];
+    getme_mesh_get_coords(m, xyz);
+    memcpy(orig, xyz, sizeof xyz);
+    const int g = 125 + 21; /* grid point (1,1,1) of zone Tets: free */
+    int found = 0;
+    for (int e = 0; e < 162 && !found; e++) {
+        int32_t v[4], at = -1;
+        for (int a = 0; a < 4; a++) {
+            v[a] = (int32_t)(data[offs[e] + 1 + a] - 1 + 125);
+            if (v[a] == g)
+                at = a;
+        }
+        if (at < 0)
+            continue;
+        double c[3] = {0, 0, 0};
+        for (int a = 0; a < 4; a++)
+            for (int k = 0; a != at && k < 3; k++)
+                c[k] += orig[3 * v[a] + k] / 3.0;
+        /* Move g towards the face: find by bisection where the tet stops
+           counting as valid, then step just above that point until the
+           float-rounded position is invalid while the double one is not. */
+        double lo = 0.0, hi = 1.0, trial[3 * FIX_NODES];
+        int valid, flips;
+        for (int it = 0; it < 60; it++) {
+            double t = 0.5 * (lo + hi);
+            place(trial, orig, g, c, t);
+            check_star(trial, data, offs, g, &valid, &flips);
+            if (valid)
+                hi = t;
+            else
+                lo = t;
+        }
+        for (int k = 0; k < 400 && !found; k++) {
+            place(trial, orig, g, c, hi + k * 2e-9);
+            check_star(trial, data, offs, g, &valid, &flips);
+            if (valid && flips > 0) {
+                found = 1;
+                memcpy(xyz, trial, sizeof xyz);
+            }
+        }
+    }
+    free(data);
+    CHECK(found);
+    CHECK_EQ_INT(getme_mesh_set_coords(m, xyz), GETME_OK);
+    CHECK_EQ_INT(getme_doc_write(doc, out), GETME_IO_OK);
+    CHECK(strstr(getme_doc_info(doc), "; 1 nodes kept at their input position") != NULL);
+    getme_doc_close(doc);
+    double back[3 * FIX_NODES];
+    CHECK_EQ_INT(count_inverted(out, back, 1), 0);
+    CHECK(memcmp(back + 3 * g, orig + 3 * g, 3 * sizeof(double)) == 0);
+}
+
 /* A planar zone in 3-D space: only CoordinateX and CoordinateY change. */
 static void roundtrip_2d(void)
 {
@@ -335,6 +443,7 @@ int main(void)
     roundtrip("hdf5-v31", CG_FILE_HDF5, 0, 1);
     roundtrip("adf-v31", CG_FILE_ADF, 0, 1);
     roundtrip_2d();
+    rounding_repair();
     write_errors();
     if (check_failed_ == 0) {
         char cmd[700];
