@@ -12,10 +12,13 @@ Cases (DESIGN.md section 6 and the paper's Sec. 3):
   tri    the flange section, triangles (Frontal-Delaunay).
   quad   the flange section, quads (Blossom recombination).
 
-Sizes: the mesh size h is set per case and size; the element counts it
-gives with Debian 12's Gmsh 4.8 are in SIZES (measured, approximate).
+Sizes: the mesh size h per case and size is calibrated on counts measured
+with Debian 12's Gmsh 4.8 (the piston's count grows like h^-2.5 because of
+its curvature refinement, the swept hexes' like h^-3).  Measured: tet
+190581 (small, h 2.11), 735669 (h 1.22); hex 93632 (small), 577936 (medium).
 Gmsh's meshers are deterministic for a given version and options, so a
-(case, size) pair always gives the same mesh; files are cached by name.
+(case, size, h) always gives the same mesh; files are cached under a name
+holding all three.
 """
 
 import json
@@ -31,8 +34,8 @@ CASE_VERSION = {"mixed": 2}
 # case -> size -> mesh size h (model units: mm).  Targets: tet ~200k / 1M /
 # 4.1M, hex ~100k / 650k / 2.6M (the paper's 4.13M tets and 2.65M hexes).
 SIZES = {
-    "tet":   {"quick": 5.0, "small": 2.11, "medium": 1.22, "full": 0.77},
-    "hex":   {"quick": 4.5, "small": 1.83, "medium": 0.98, "full": 0.617},
+    "tet":   {"quick": 5.0, "small": 2.11, "medium": 1.08, "full": 0.61},
+    "hex":   {"quick": 4.5, "small": 1.83, "medium": 0.98, "full": 0.595},
     "mixed": {"quick": 0.16, "small": 0.075, "medium": 0.044, "full": 0.028},
     "tri":   {"quick": 3.0, "small": 1.0, "medium": 0.45, "full": 0.22},
     "quad":  {"quick": 3.0, "small": 1.0, "medium": 0.45, "full": 0.22},
@@ -175,7 +178,8 @@ GMSH_TYPES = {4: "tet", 5: "hex", 6: "prism", 7: "pyramid", 2: "tri", 3: "quad"}
 
 def cache_path(cache_dir, case, size):
     version = CASE_VERSION.get(case, GENERATOR_VERSION)
-    return os.path.join(cache_dir, f"{case}-{size}-g{version}.msh")
+    h = SIZES[case][size]
+    return os.path.join(cache_dir, f"{case}-{size}-g{version}-h{h:g}.msh")
 
 
 def _element_counts():
