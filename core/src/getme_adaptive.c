@@ -124,7 +124,8 @@ static int32_t scatter_pass(getme_run *run, int transformed, double qt,
 /* ComputeNewNodes: p-hat = weighted sum / weight sum, for I_T. */
 static void compute_new_nodes(getme_run *run)
 {
-#pragma omp parallel for schedule(static) num_threads(run->ws->nt)
+#pragma omp parallel for schedule(static) num_threads(run->ws->nt) \
+    if (run->num_nodes > GETME_PAR_MIN)
     for (int32_t k = 0; k < run->num_nodes; k++) {
         double *a = run->acc + 4 * (int64_t)run->nodes[k];
         double inv = 1.0 / a[3];

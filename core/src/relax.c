@@ -50,19 +50,19 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
     const int32_t nn = run->num_nodes, ne = run->num_elems;
     int nt = ws->nt;
 
-#pragma omp parallel for schedule(static) num_threads(nt)
+#pragma omp parallel for schedule(static) num_threads(nt) if (nn > GETME_PAR_MIN)
     for (int32_t k = 0; k < nn; k++) {
         run->ridx[nodes[k]] = 0;
         place(run, nodes[k], R[0]);
     }
-#pragma omp parallel for schedule(static) num_threads(nt)
+#pragma omp parallel for schedule(static) num_threads(nt) if (ne > GETME_PAR_MIN)
     for (int32_t k = 0; k < ne; k++)
         q[elems[k]] = getme__ws_quality(ws, run->xnew, elems[k]);
 
     for (;;) {
         int32_t changed = 0;
 #pragma omp parallel for schedule(static) num_threads(nt) \
-    reduction(+ : changed)
+    reduction(+ : changed) if (nn > GETME_PAR_MIN)
         for (int32_t k = 0; k < nn; k++) {
             int32_t i = nodes[k];
             run->flag[i] = 0;
@@ -78,7 +78,7 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
            valid positions.  So no change means no invalid element. */
         if (changed == 0)
             break;
-#pragma omp parallel for schedule(static) num_threads(nt)
+#pragma omp parallel for schedule(static) num_threads(nt) if (ne > GETME_PAR_MIN)
         for (int32_t k = 0; k < ne; k++)
             if (touches_flagged(ws, run->flag, elems[k]))
                 q[elems[k]] = getme__ws_quality(ws, run->xnew, elems[k]);
@@ -86,7 +86,7 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
 
     int32_t relaxed = 0;
 #pragma omp parallel for schedule(static) num_threads(nt) \
-    reduction(+ : relaxed)
+    reduction(+ : relaxed) if (nn > GETME_PAR_MIN)
     for (int32_t k = 0; k < nn; k++) {
         int32_t i = nodes[k];
         double *x = ws->x + 3 * (int64_t)i;

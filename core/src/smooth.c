@@ -107,7 +107,8 @@ void getme__collect(getme_run *run)
 
 void getme__reset_nodes(getme_run *run)
 {
-#pragma omp parallel for schedule(static) num_threads(run->ws->nt)
+#pragma omp parallel for schedule(static) num_threads(run->ws->nt) \
+    if (run->num_nodes > GETME_PAR_MIN)
     for (int32_t k = 0; k < run->num_nodes; k++) {
         int32_t i = run->nodes[k];
         run->in_t[i] = 0;

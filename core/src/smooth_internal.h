@@ -7,6 +7,12 @@
 
 #include "workspace.h"
 
+/* Loops over fewer items than this run on one thread: in the q*_min stage
+   the lists are small, and a parallel loop's barrier then costs more than
+   the work (libgomp spins at barriers, which is slow on a loaded machine).
+   Results do not depend on it: every loop is deterministic. */
+#define GETME_PAR_MIN 8192
+
 /* Per-thread dedupe marks for the Eq. 9 neighbour sums (weights.c). */
 typedef struct getme_stamp {
     uint32_t *mark; /* ne entries */

@@ -10,6 +10,7 @@
  */
 #include "internal.h"
 
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -33,58 +34,75 @@ static const face_table FACES[GETME_NUM_TYPES] = {
     /* quad */ {4, {2, 2, 2, 2}, {{0, 1}, {1, 2}, {2, 3}, {3, 0}}},
 };
 
-typedef struct elem_ref {
-    const int32_t *conn;
-    int nv;
-    int32_t region;
-} elem_ref;
-
-static elem_ref element(const getme_mesh *mesh, int32_t e)
+static int32_t region_of(const getme_mesh *mesh, int32_t e)
 {
     int32_t local;
     const getme_block *b = getme__find_block(mesh, e, &local);
-    elem_ref r;
-    r.nv = getme__nv[b->type];
-    r.conn = b->conn + (int64_t)local * r.nv;
-    r.region = b->region ? b->region[local] : 0;
-    return r;
+    return b->region ? b->region[local] : 0;
 }
 
-static int contains(const elem_ref *r, int32_t node)
-{
-    for (int i = 0; i < r->nv; i++)
-        if (r->conn[i] == node)
-            return 1;
-    return 0;
-}
+/* Per-thread scratch of the face search: for each neighbour of the element
+   at hand, which of its nodes it shares (bit i = local node i). */
+typedef struct face_scratch {
+    uint32_t *stamp; /* ne: element last seen for this stamp value */
+    uint8_t *shared; /* ne: shared-node mask                      */
+    int32_t *list;   /* the neighbours of the current element      */
+    uint32_t now;
+} face_scratch;
 
-/* Bit f of the result: face f of element e must be fixed. */
+/* Bit f of the result: face f of element e must be fixed.  One pass over
+   the stars of e's nodes records, for every neighbour, which of e's nodes
+   it has; a face is shared with a neighbour whose mask covers the face's
+   nodes.  No face table, and only face neighbours need their region. */
 static unsigned faces_to_fix(const getme_mesh *mesh, const int64_t *ptr,
-                             const int32_t *star, int32_t e, int type,
-                             unsigned flags)
+                             const int32_t *star, const int32_t *conn,
+                             int32_t e, int type, unsigned flags,
+                             face_scratch *sc)
 {
     const face_table *ft = &FACES[type];
-    elem_ref me = element(mesh, e);
-    unsigned bits = 0;
-    for (int f = 0; f < ft->num_faces; f++) {
-        int32_t n0 = me.conn[ft->node[f][0]];
-        int shared = 0, interface = 0;
-        for (int64_t k = ptr[n0]; k < ptr[n0 + 1]; k++) {
-            if (star[k] == e)
+    int nv = getme__nv[type];
+    uint32_t now = ++sc->now;
+    int32_t count = 0;
+    for (int i = 0; i < nv; i++)
+        for (int64_t k = ptr[conn[i]]; k < ptr[conn[i] + 1]; k++) {
+            int32_t n = star[k];
+            if (n == e)
                 continue;
-            elem_ref other = element(mesh, star[k]);
-            int all = 1;
-            for (int j = 1; j < ft->size[f] && all; j++)
-                all = contains(&other, me.conn[ft->node[f][j]]);
-            if (all) {
-                shared = 1;
-                interface |= other.region != me.region;
+            if (sc->stamp[n] != now) {
+                sc->stamp[n] = now;
+                sc->shared[n] = 0;
+                sc->list[count++] = n;
+            }
+            sc->shared[n] |= (uint8_t)(1u << i);
+        }
+    unsigned face_mask[6], shared = 0, interface = 0;
+    for (int f = 0; f < ft->num_faces; f++) {
+        face_mask[f] = 0;
+        for (int j = 0; j < ft->size[f]; j++)
+            face_mask[f] |= 1u << ft->node[f][j];
+    }
+    int32_t my_region = -1;
+    for (int32_t k = 0; k < count; k++) {
+        unsigned m = sc->shared[sc->list[k]];
+        if (__builtin_popcount(m) < 2)
+            continue; /* shares at most a node: no face (or 2-D edge) */
+        for (int f = 0; f < ft->num_faces; f++) {
+            if ((m & face_mask[f]) != face_mask[f])
+                continue;
+            shared |= 1u << f;
+            if (flags & GETME_FIX_INTERFACES) {
+                if (my_region == -1)
+                    my_region = region_of(mesh, e);
+                if (region_of(mesh, sc->list[k]) != my_region)
+                    interface |= 1u << f;
             }
         }
-        if (((flags & GETME_FIX_SKIN) && !shared) ||
-            ((flags & GETME_FIX_INTERFACES) && interface))
-            bits |= 1u << f;
     }
+    unsigned all = (1u << ft->num_faces) - 1, bits = 0;
+    if (flags & GETME_FIX_SKIN)
+        bits |= all & ~shared;
+    if (flags & GETME_FIX_INTERFACES)
+        bits |= interface;
     return bits;
 }
 
@@ -129,12 +147,39 @@ getme_status getme_mesh_fix_boundary(getme_mesh *mesh, unsigned flags,
 
     /* Find faces in parallel (each element writes its own mark), fix their
        nodes serially (many elements share a node). */
-    for (int b = 0; b < mesh->num_blocks; b++) {
-        const getme_block *bl = &mesh->blocks[b];
-#pragma omp parallel for schedule(dynamic, 4096)
-        for (int32_t e = 0; e < bl->count; e++)
-            mark[bl->first + e] = (uint8_t)faces_to_fix(
-                mesh, ptr, star, bl->first + e, bl->type, flags);
+    int64_t max_star = 0;
+    for (int32_t i = 0; i < nn; i++)
+        if (ptr[i + 1] - ptr[i] > max_star)
+            max_star = ptr[i + 1] - ptr[i];
+    int nt = omp_get_max_threads();
+    face_scratch *sc = calloc((size_t)nt, sizeof *sc);
+    int ok = sc != NULL;
+    for (int t = 0; ok && t < nt; t++) {
+        sc[t].stamp = calloc((size_t)(ne ? ne : 1), sizeof *sc[t].stamp);
+        sc[t].shared = malloc((size_t)(ne ? ne : 1));
+        sc[t].list = malloc((size_t)(8 * max_star + 1) * sizeof *sc[t].list);
+        ok = sc[t].stamp && sc[t].shared && sc[t].list;
+    }
+    if (ok) {
+        for (int b = 0; b < mesh->num_blocks; b++) {
+            const getme_block *bl = &mesh->blocks[b];
+            int nv = getme__nv[bl->type];
+#pragma omp parallel for schedule(dynamic, 4096) num_threads(nt)
+            for (int32_t e = 0; e < bl->count; e++)
+                mark[bl->first + e] = (uint8_t)faces_to_fix(
+                    mesh, ptr, star, bl->conn + (int64_t)e * nv, bl->first + e,
+                    bl->type, flags, &sc[omp_get_thread_num()]);
+        }
+    }
+    for (int t = 0; sc && t < nt; t++) {
+        free(sc[t].stamp);
+        free(sc[t].shared);
+        free(sc[t].list);
+    }
+    free(sc);
+    if (!ok) {
+        free(ptr), free(star), free(mark);
+        return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
     }
     for (int b = 0; b < mesh->num_blocks; b++) {
         const getme_block *bl = &mesh->blocks[b];
