@@ -11,7 +11,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 static const getme_format *const FORMATS[] = {
@@ -159,20 +161,30 @@ void getme_doc_close(getme_doc *doc)
 int getme_io_tmp_path(const char *out_path, char *buf, size_t size)
 {
     /* Same directory as the output, so rename() is atomic and never crosses
-       file systems; hidden; mkstemp makes the name unique even with
-       concurrent writers.  The empty file it creates is overwritten by the
-       adapter (or removed by getme_io_commit on failure). */
+       file systems; hidden.  O_EXCL makes the name ours even with concurrent
+       writers; mode 0666 lets the umask decide the output's permissions as
+       for any new file (mkstemp would leave 0600).  The empty file is
+       overwritten by the adapter (or removed by getme_io_commit). */
     const char *slash = strrchr(out_path, '/');
     int dirlen = slash ? (int)(slash - out_path) + 1 : 0;
     const char *base = slash ? slash + 1 : out_path;
-    int len = snprintf(buf, size, "%.*s.%s.tmp.XXXXXX", dirlen, out_path, base);
-    if (len < 0 || (size_t)len >= size)
-        return -1;
-    int fd = mkstemp(buf);
-    if (fd < 0)
-        return -1;
-    close(fd);
-    return 0;
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    for (unsigned attempt = 0; attempt < 100; attempt++) {
+        unsigned long tag = (unsigned long)ts.tv_nsec + attempt * 7919ul;
+        int len = snprintf(buf, size, "%.*s.%s.tmp.%ld.%lu", dirlen, out_path,
+                           base, (long)getpid(), tag);
+        if (len < 0 || (size_t)len >= size)
+            return -1;
+        int fd = open(buf, O_WRONLY | O_CREAT | O_EXCL, 0666);
+        if (fd >= 0) {
+            close(fd);
+            return 0;
+        }
+        if (errno != EEXIST)
+            return -1;
+    }
+    return -1;
 }
 
 int getme_io_commit(const char *tmp, const char *out)
