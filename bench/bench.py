@@ -401,6 +401,7 @@ def sweep(ctx, meta):
             case, ctx.args.size, init), "rows": rows, "text": text}
     os.makedirs(ctx.args.out, exist_ok=True)
     stem = f"sweep-{ctx.args.size}"
+    cases = merge_previous(os.path.join(ctx.args.out, stem + ".json"), cases)
     all_rows = [r for c in cases.values() for r in c["rows"]]
     tables.write_csv(os.path.join(ctx.args.out, stem + ".csv"), all_rows)
     tables.write_json(os.path.join(ctx.args.out, stem + ".json"), {"meta": meta, "cases": cases})
