@@ -40,6 +40,8 @@ case "$mode" in
     build build
     bash examples/demo.sh build ;;
   test)
+    # Tests run side by side on few cores: OpenMP threads must not spin.
+    export OMP_WAIT_POLICY=passive
     build build -DGETME_WERROR=ON
     echo "Info    : running the test suite (release build)"
     ctest --test-dir build --output-on-failure -j "$jobs"
