@@ -30,7 +30,7 @@ static const char SMOOTH_HELP[] =
     "  --free NAME            do not fix this CGNS BC/family (repeatable)\n"
     "  --free-interfaces      let nodes on region interfaces move\n"
     "  --param NAME=VALUE     any smoothing parameter: sigma (1.5), tol (1e-4),\n"
-    "                         threshold_fraction (0.002), max_no_min_improve (5),\n"
+    "                         threshold_fraction (0.005), max_no_min_improve (5),\n"
     "                         keep_best (1), renumber (1)\n"
     "  --report FILE.json     write before/after statistics, iterations and\n"
     "                         the per-iteration history as JSON\n"
