@@ -15,7 +15,10 @@ Cases (DESIGN.md section 6 and the paper's Sec. 3):
 Sizes: the mesh size h per case and size is calibrated on counts measured
 with Debian 12's Gmsh 4.8 (the piston's count grows like h^-2.5 because of
 its curvature refinement, the swept hexes' like h^-3).  Measured: tet
-190581 (small, h 2.11), 735669 (h 1.22); hex 93632 (small), 577936 (medium).
+190581 (small, h 2.11), 735669 (h 1.22), 1006908 (medium, h 1.08),
+4933455 (full, h 0.61: h 0.655 would give ~4.1M); hex 93632 (small),
+577936 (medium), 2466672 (full, h 0.595: h 0.585 would give ~2.6M).  The
+full sizes are kept where they are because their meshes are cached.
 Gmsh's meshers are deterministic for a given version and options, so a
 (case, size, h) always gives the same mesh; files are cached under a name
 holding all three.
