@@ -37,6 +37,13 @@ void cli_print_stats(const cli_log *log, const char *title,
 int cli_parse_int(const char *opt, const char *s, long min, long max, long *out);
 int cli_parse_double(const char *opt, const char *s, double *out);
 
+/* Open a document; on failure print its one-line error, close it and
+   return NULL with the exit code in *code.  With allow_invalid, an input
+   whose only problem is invalid elements is returned (*code =
+   GETME_IO_ERR_INVALID) so that it can still be reported on. */
+getme_doc *cli_open(const char *path, const getme_doc_options *opts,
+                    int allow_invalid, int *code);
+
 /* Mesh summary: "195070 tets, 12 prisms; 37012 nodes (8123 fixed)". */
 void cli_describe_mesh(getme_mesh *mesh, char *buf, size_t size);
 

@@ -73,13 +73,10 @@ int cli_distort(int argc, char **argv)
     }
     if (rounds < 0)
         rounds = target > 0.0 ? 100 : 1;
-    getme_doc *doc = NULL;
-    getme_io_status st = getme_doc_open(&doc, input, NULL);
-    if (st != GETME_IO_OK) {
-        cli_error("%s", getme_doc_error(doc));
-        getme_doc_close(doc);
+    int st;
+    getme_doc *doc = cli_open(input, NULL, 0, &st);
+    if (!doc)
         return st;
-    }
     getme_mesh *mesh = getme_doc_mesh(doc);
     getme_quality_stats s;
     getme_mesh_quality_stats(mesh, -1, &s);
@@ -93,7 +90,7 @@ int cli_distort(int argc, char **argv)
     getme_mesh_quality_stats(mesh, -1, &s);
     cli_print_stats(&log, "Quality after ", &s);
     st = getme_doc_write(doc, output);
-    if (st != GETME_IO_OK)
+    if (st != (int)GETME_IO_OK)
         cli_error("%s", getme_doc_error(doc));
     else
         cli_info(&log, "Done writing '%s'", output);

@@ -70,14 +70,10 @@ int cli_quality(int argc, char **argv)
         cli_error("getme quality needs an input file (see getme quality --help)");
         return EXIT_USAGE;
     }
-    getme_doc *doc = NULL;
-    getme_io_status st = getme_doc_open(&doc, input, &opts);
-    /* An invalid mesh is still worth a report: that is what the user asks. */
-    if (st != GETME_IO_OK && st != GETME_IO_ERR_INVALID) {
-        cli_error("%s", getme_doc_error(doc));
-        getme_doc_close(doc);
+    int st;
+    getme_doc *doc = cli_open(input, &opts, 1, &st);
+    if (!doc)
         return st;
-    }
     getme_mesh *mesh = getme_doc_mesh(doc);
     char desc[256];
     cli_describe_mesh(mesh, desc, sizeof desc);

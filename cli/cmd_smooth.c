@@ -208,13 +208,10 @@ static int run(smooth_args *a)
     }
     double t0 = omp_get_wtime();
     cli_info(log, "Reading '%s'...", a->input);
-    getme_doc *doc = NULL;
-    getme_io_status ios = getme_doc_open(&doc, a->input, &opts);
-    if (ios != GETME_IO_OK) {
-        cli_error("%s", getme_doc_error(doc));
-        getme_doc_close(doc);
-        return ios;
-    }
+    int code;
+    getme_doc *doc = cli_open(a->input, &opts, 0, &code);
+    if (!doc)
+        return code;
     getme_mesh *mesh = getme_doc_mesh(doc);
     char desc[256];
     cli_describe_mesh(mesh, desc, sizeof desc);
@@ -246,7 +243,6 @@ static int run(smooth_args *a)
              threads, threads == 1 ? "" : "s");
     getme_result res;
     getme_status st = getme_smooth(mesh, &a->params, &res);
-    int code = 0;
     if (st != GETME_OK) {
         cli_error("%s: %s", a->input, getme_mesh_error(mesh));
         code = st == GETME_ERR_INVALID_MESH ? GETME_IO_ERR_INVALID
@@ -261,7 +257,7 @@ static int run(smooth_args *a)
     cli_print_stats(log, "Quality after ", &after);
 
     cli_info(log, "Writing '%s'...", a->output);
-    ios = getme_doc_write(doc, a->output);
+    getme_io_status ios = getme_doc_write(doc, a->output);
     if (ios != GETME_IO_OK) {
         cli_error("%s", getme_doc_error(doc));
         code = ios;

@@ -106,3 +106,16 @@ void cli_describe_mesh(getme_mesh *mesh, char *buf, size_t size)
         snprintf(buf + len, size - len, "; %d nodes (%d fixed)",
                  (int)getme_mesh_num_nodes(mesh), (int)getme_mesh_num_fixed(mesh));
 }
+
+getme_doc *cli_open(const char *path, const getme_doc_options *opts,
+                    int allow_invalid, int *code)
+{
+    getme_doc *doc = NULL;
+    getme_io_status st = getme_doc_open(&doc, path, opts);
+    *code = st;
+    if (st == GETME_IO_OK || (allow_invalid && st == GETME_IO_ERR_INVALID))
+        return doc;
+    cli_error("%s", getme_doc_error(doc));
+    getme_doc_close(doc);
+    return NULL;
+}
