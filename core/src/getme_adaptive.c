@@ -224,7 +224,9 @@ getme_status getme__adaptive(getme_run *run)
     }
 
     double q_mean = res->q_mean_initial, q_min = res->q_min_star_initial;
-    double qt = 1.0, best_min = -1.0, record = -1.0, cycle_best = 0.0;
+    /* best_min: best q*_min since the end of the q_mean stage (its mesh is
+       kept in best); record: best_min when the current cycle started. */
+    double qt = 1.0, best_min = -1.0, record = -1.0;
     const double *R = p->relax_mean;
     int nR = p->num_relax_mean;
     int state = MEAN_RUNNING, counter = 0, have_cycle = 0;
@@ -243,9 +245,10 @@ getme_status getme__adaptive(getme_run *run)
             res->iterations_mean++;
         else
             res->iterations_min++;
-        if (best && stage == GETME_STAGE_MIN && q_min > best_min) {
+        if (stage == GETME_STAGE_MIN && q_min > best_min) {
             best_min = q_min;
-            memcpy(best, ws->x, (size_t)ws->nn * 3 * sizeof *best);
+            if (best)
+                memcpy(best, ws->x, (size_t)ws->nn * 3 * sizeof *best);
         }
         if (getme__report(run, it, stage, res->cycles_min, q_min, q_mean, qt,
                           ntrans, nrelax)) {
@@ -258,14 +261,11 @@ getme_status getme__adaptive(getme_run *run)
             state = MIN_START;
             R = p->relax_min;
             nR = p->num_relax_min;
-            if (best) { /* the end of stage 1 is the first candidate */
-                best_min = q_min;
+            best_min = q_min; /* the end of stage 1 is the first candidate */
+            if (best)
                 memcpy(best, ws->x, (size_t)ws->nn * 3 * sizeof *best);
-            }
         }
         if (state == MIN_RUNNING) {
-            if (q_min > cycle_best)
-                cycle_best = q_min;
             if (!(q_min > prev_min + p->min_tol))
                 counter++;
             if (counter >= p->max_no_min_improve)
@@ -277,20 +277,16 @@ getme_status getme__adaptive(getme_run *run)
                the q*_min at the cycle's start instead lets an oscillating
                mesh "improve" on its own dips forever (measured: 988
                iterations with threshold_fraction 0.05). */
-            if (have_cycle && !(cycle_best > record + p->min_tol)) {
+            if (have_cycle && !(best_min > record + p->min_tol)) {
                 res->stop_reason = GETME_STOP_CONVERGED;
                 break;
             }
-            if (cycle_best > record)
-                record = cycle_best;
-            if (q_min > record)
-                record = q_min;
+            record = best_min;
             state = MIN_RUNNING;
             counter = 0;
             qt = determine_threshold(run, scratch);
             have_cycle = 1;
             res->cycles_min++;
-            cycle_best = q_min;
         }
     }
 
