@@ -79,8 +79,7 @@ int cli_distort(int argc, char **argv)
         return st;
     getme_mesh *mesh = getme_doc_mesh(doc);
     getme_quality_stats s;
-    getme_mesh_quality_stats(mesh, -1, &s);
-    cli_print_stats(&log, "Quality before", &s);
+    cli_print_stats(&log, "Quality before", &doc->stats);
     if (getme_mesh_distort(mesh, (uint64_t)seed, amount, target, (int)rounds) !=
         GETME_OK) {
         cli_error("%s: %s", input, getme_mesh_error(mesh));

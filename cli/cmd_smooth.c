@@ -220,8 +220,7 @@ static int run(smooth_args *a)
     if (doc->info[0])
         cli_info(log, "%s", doc->info);
 
-    getme_quality_stats before, after;
-    getme_mesh_quality_stats(mesh, -1, &before);
+    getme_quality_stats before = doc->stats, after;
     cli_print_stats(log, "Quality before", &before);
 
     cli_history history = {0};

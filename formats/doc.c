@@ -67,16 +67,16 @@ getme_mesh *getme_doc_mesh(getme_doc *doc) { return doc ? doc->mesh : NULL; }
 /* Name the first invalid elements by their ids in the file. */
 static getme_io_status check_valid(getme_doc *doc)
 {
-    getme_quality_stats s;
-    if (getme_mesh_quality_stats(doc->mesh, -1, &s) != GETME_OK)
+    getme_quality_stats *sp = &doc->stats;
+    if (getme_mesh_quality_stats(doc->mesh, -1, sp) != GETME_OK)
         return getme_doc_fail(doc, GETME_IO_ERR_INTERNAL, "%s: out of memory",
                               doc->path);
-    if (s.num_invalid == 0)
+    if (sp->num_invalid == 0)
         return GETME_IO_OK;
     char list[256] = "";
     size_t len = 0;
-    for (int i = 0; i < s.num_reported_invalid && len < sizeof list; i++) {
-        int32_t e = s.first_invalid[i];
+    for (int i = 0; i < sp->num_reported_invalid && len < sizeof list; i++) {
+        int32_t e = sp->first_invalid[i];
         long long id = doc->elem_ids ? (long long)doc->elem_ids[e] : (long long)e + 1;
         len += (size_t)snprintf(list + len, sizeof list - len, "%s%lld",
                                 i ? ", " : "", id);
@@ -84,9 +84,9 @@ static getme_io_status check_valid(getme_doc *doc)
     return getme_doc_fail(doc, GETME_IO_ERR_INVALID,
                           "%s: %lld invalid (inverted or degenerate) element%s, "
                           "first: %s%s; getme smooths valid meshes only",
-                          doc->path, (long long)s.num_invalid,
-                          s.num_invalid == 1 ? "" : "s", list,
-                          s.num_invalid > s.num_reported_invalid ? ", ..." : "");
+                          doc->path, (long long)sp->num_invalid,
+                          sp->num_invalid == 1 ? "" : "s", list,
+                          sp->num_invalid > sp->num_reported_invalid ? ", ..." : "");
 }
 
 getme_io_status getme_doc_open(getme_doc **out, const char *path,

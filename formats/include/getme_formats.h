@@ -88,6 +88,9 @@ struct getme_doc {
     /* element ids as written in the file, per global element index (may be
        NULL); used in messages about invalid elements                       */
     int64_t *elem_ids;
+    getme_quality_stats stats; /* all elements as read (set by
+                            getme_doc_open, which needs them for its validity
+                            check; callers need not compute them again)      */
     char info[1024];     /* one line the CLI may log: zones, sets, fixed...  */
     char error[1024];    /* the last error, one line                         */
 };
