@@ -110,17 +110,16 @@ static getme_status order_elements(getme_ws *ws, const getme_mesh *mesh,
     if (!key)
         return GETME_ERR_NOMEM;
     for (int32_t k = 0; k < ws->ne; k++) {
-        double x[3 * GETME_MAX_NV];
-        int t = getme__gather(mesh, ws->elem_orig[k], x);
-        int nv = getme__nv[t];
+        int32_t local;
+        const getme_block *bl = getme__find_block(mesh, ws->elem_orig[k], &local);
+        int nv = getme__nv[bl->type];
+        const int32_t *nodes = bl->conn + (int64_t)local * nv;
         uint32_t code = 0;
         for (int d = 0; d < 3; d++) {
             double c = 0.0;
             for (int i = 0; i < nv; i++)
-                c += x[3 * i + d];
+                c += mesh->coords[3 * (int64_t)nodes[i] + d];
             c = c / nv;
-            if (d == 1 && mesh->mirror == 1)
-                c = -c; /* gather mirrored y; the box is unmirrored */
             double s = (c - lo[d]) * scale[d];
             uint32_t q = s <= 0.0 ? 0u : s >= 1023.0 ? 1023u : (uint32_t)s;
             code |= spread3(q) << d;
