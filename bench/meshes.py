@@ -16,9 +16,8 @@ Sizes: the mesh size h per case and size is calibrated on counts measured
 with Debian 12's Gmsh 4.8 (the piston's count grows like h^-2.5 because of
 its curvature refinement, the swept hexes' like h^-3).  Measured: tet
 190581 (small, h 2.11), 735669 (h 1.22), 1006908 (medium, h 1.08),
-4933455 (full, h 0.61: h 0.655 would give ~4.1M); hex 93632 (small),
-577936 (medium), 2466672 (full, h 0.595: h 0.585 would give ~2.6M).  The
-full sizes are kept where they are because their meshes are cached.
+4031572 (full, h 0.655; 712950 nodes, 278 s to generate); hex 93632
+(small), 577936 (medium), 2594200 (full, h 0.585; 2682513 nodes, 24 s).
 Gmsh's meshers are deterministic for a given version and options, so a
 (case, size, h) always gives the same mesh; files are cached under a name
 holding all three.
@@ -37,8 +36,8 @@ CASE_VERSION = {"mixed": 2}
 # case -> size -> mesh size h (model units: mm).  Targets: tet ~200k / 1M /
 # 4.1M, hex ~100k / 650k / 2.6M (the paper's 4.13M tets and 2.65M hexes).
 SIZES = {
-    "tet":   {"quick": 5.0, "small": 2.11, "medium": 1.08, "full": 0.61},
-    "hex":   {"quick": 4.5, "small": 1.83, "medium": 0.98, "full": 0.595},
+    "tet":   {"quick": 5.0, "small": 2.11, "medium": 1.08, "full": 0.655},
+    "hex":   {"quick": 4.5, "small": 1.83, "medium": 0.98, "full": 0.585},
     "mixed": {"quick": 0.16, "small": 0.075, "medium": 0.044, "full": 0.028},
     "tri":   {"quick": 3.0, "small": 1.0, "medium": 0.45, "full": 0.22},
     "quad":  {"quick": 3.0, "small": 1.0, "medium": 0.45, "full": 0.22},

@@ -23,6 +23,7 @@
  *    the end of the q_mean stage on (the q*_min stage may lose a little
  *    q*_min in its last, unsuccessful cycle).
  */
+#include "adjacency.h"
 #include "smooth_internal.h"
 
 #include <omp.h>
@@ -31,74 +32,53 @@
 
 enum { MEAN_RUNNING, MIN_START, MIN_RUNNING };
 
-/* AddTransformedElementNodesAndWeights for the elements of one block. */
-static int32_t add_transformed(getme_run *run, int32_t e0, int32_t e1,
-                               double qt, double sigma)
+/* AddTransformedElementNodesAndWeights for element e (type t). */
+static inline void add_transformed(getme_run *run, int t, int32_t e,
+                                   double sigma)
 {
-    getme_stamp *st = &run->stamps[omp_get_thread_num()];
     const getme_ws *ws = run->ws;
-    int t = getme__ws_type(ws, e0), nv = getme__nv[t];
-    int32_t count = 0;
-    for (int32_t e = e0; e < e1; e++) {
-        if (!ws->free_elem[e] || run->q[e] > qt)
+    double x[3 * GETME_MAX_NV], y[3 * GETME_MAX_NV];
+    double w = getme__weight(run, t, e);
+    getme__ws_gather(ws, ws->x, t, e, x);
+    getme__transform(t, x, sigma, y);
+    const int32_t *c = getme__ws_nodes(ws, t, e);
+    for (int i = 0; i < getme__nv[t]; i++) {
+        int32_t n = c[i];
+        if (ws->fixed[n])
             continue;
-        double x[3 * GETME_MAX_NV], y[3 * GETME_MAX_NV];
-        double w = getme__weight(ws, run->q, t, e, st);
-        getme__ws_gather(ws, ws->x, t, e, x);
-        getme__transform(t, x, sigma, y);
-        const int32_t *c = getme__ws_nodes(ws, t, e);
-        for (int i = 0; i < nv; i++) {
-            int32_t n = c[i];
-            if (ws->fixed[n])
-                continue;
-            double *a = run->acc + 4 * (int64_t)n;
-            a[0] += w * y[3 * i];
-            a[1] += w * y[3 * i + 1];
-            a[2] += w * y[3 * i + 2];
-            a[3] += w;
-            run->in_t[n] = 1;
-        }
-        count++;
-    }
-    return count;
-}
-
-/* AddUntransformedElementNodesAndWeights for the elements of one block. */
-static void add_untransformed(getme_run *run, int32_t e0, int32_t e1,
-                              double qt)
-{
-    getme_stamp *st = &run->stamps[omp_get_thread_num()];
-    const getme_ws *ws = run->ws;
-    int t = getme__ws_type(ws, e0), nv = getme__nv[t];
-    for (int32_t e = e0; e < e1; e++) {
-        if (!ws->free_elem[e] || run->q[e] <= qt)
-            continue;
-        const int32_t *c = getme__ws_nodes(ws, t, e);
-        int any = 0;
-        for (int i = 0; i < nv; i++)
-            any |= run->in_t[c[i]];
-        if (!any)
-            continue;
-        double w = getme__weight(ws, run->q, t, e, st);
-        for (int i = 0; i < nv; i++) {
-            int32_t n = c[i];
-            if (!run->in_t[n])
-                continue;
-            const double *x = ws->x + 3 * (int64_t)n;
-            double *a = run->acc + 4 * (int64_t)n;
-            a[0] += w * x[0];
-            a[1] += w * x[1];
-            a[2] += w * x[2];
-            a[3] += w;
-        }
+        double *a = run->acc + 4 * (int64_t)n;
+        a[0] += w * y[3 * i];
+        a[1] += w * y[3 * i + 1];
+        a[2] += w * y[3 * i + 2];
+        a[3] += w;
+        run->in_t[n] = 1;
     }
 }
 
-/* Run f over all blocks, colour by colour: blocks of one colour share no
-   node, so they scatter without atomics, and each node receives its
-   contributions in the same order whatever the thread count. */
-static int32_t scatter_pass(getme_run *run, int transformed, double qt,
-                            double sigma)
+/* AddUntransformedElementNodesAndWeights for element e (type t). */
+static inline void add_untransformed(getme_run *run, int t, int32_t e)
+{
+    const getme_ws *ws = run->ws;
+    double w = getme__weight(run, t, e);
+    const int32_t *c = getme__ws_nodes(ws, t, e);
+    for (int i = 0; i < getme__nv[t]; i++) {
+        int32_t n = c[i];
+        if (!run->in_t[n])
+            continue;
+        const double *x = ws->x + 3 * (int64_t)n;
+        double *a = run->acc + 4 * (int64_t)n;
+        a[0] += w * x[0];
+        a[1] += w * x[1];
+        a[2] += w * x[2];
+        a[3] += w;
+    }
+}
+
+/* q_mean stage: every free element is transformed.  Blocks run colour by
+   colour: blocks of one colour share no node, so they scatter without
+   atomics, and each node receives its contributions in the same order
+   whatever the thread count. */
+static int32_t scatter_all(getme_run *run, double sigma)
 {
     const getme_ws *ws = run->ws;
     int32_t total = 0;
@@ -111,14 +91,141 @@ static int32_t scatter_pass(getme_run *run, int transformed, double qt,
         for (int32_t k = b0; k < b1; k++) {
             int32_t b = ws->colour_blocks[k];
             int32_t e0 = ws->block_start[b], e1 = ws->block_start[b + 1];
-            if (transformed)
-                count += add_transformed(run, e0, e1, qt, sigma);
-            else
-                add_untransformed(run, e0, e1, qt);
+            int t = getme__ws_type(ws, e0);
+            for (int32_t e = e0; e < e1; e++)
+                if (ws->free_elem[e]) {
+                    add_transformed(run, t, e, sigma);
+                    count++;
+                }
         }
         total += count;
     }
     return total;
+}
+
+/* The q_mean stage's I_T (every free node in use) and element list (every
+   free element): the same in every iteration, so built once. */
+static void lists_all(getme_run *run)
+{
+    const getme_ws *ws = run->ws;
+    int32_t m = 0;
+    for (int32_t i = 0; i < ws->nn; i++)
+        if (!ws->fixed[i] && ws->star_ptr[i + 1] > ws->star_ptr[i])
+            run->nodes[m++] = i;
+    run->num_nodes = m;
+    m = 0;
+    for (int32_t e = 0; e < ws->ne; e++)
+        if (ws->free_elem[e])
+            run->elems[m++] = e;
+    run->num_elems = m;
+}
+
+/* q*_min stage: only the elements in run->tlist (q <= q_t) are transformed,
+   and the untransformed ones around their moving nodes add their nodes.
+   The lists are small, so this runs on one thread in list order, which
+   also fixes the order of the sums. */
+static int32_t scatter_some(getme_run *run, double qt, double sigma)
+{
+    const getme_ws *ws = run->ws;
+    int32_t nn = 0, ne = 0;
+    for (int32_t k = 0; k < run->num_t; k++) { /* I_T */
+        int32_t e = run->tlist[k];
+        int t = getme__ws_type(ws, e);
+        const int32_t *c = getme__ws_nodes(ws, t, e);
+        for (int i = 0; i < getme__nv[t]; i++)
+            if (!ws->fixed[c[i]] && !run->in_t[c[i]]) {
+                run->in_t[c[i]] = 1;
+                run->nodes[nn++] = c[i];
+            }
+    }
+    for (int32_t k = 0; k < nn; k++) /* the elements around I_T */
+        for (int64_t j = ws->star_ptr[run->nodes[k]];
+             j < ws->star_ptr[run->nodes[k] + 1]; j++) {
+            int32_t e = ws->star[j];
+            if (!run->eflag[e]) {
+                run->eflag[e] = 1;
+                run->elems[ne++] = e;
+            }
+        }
+    for (int32_t k = 0; k < ne; k++)
+        run->eflag[run->elems[k]] = 0;
+    run->num_nodes = nn;
+    run->num_elems = ne;
+    for (int32_t k = 0; k < run->num_t; k++) {
+        int32_t e = run->tlist[k];
+        add_transformed(run, getme__ws_type(ws, e), e, sigma);
+    }
+    for (int32_t k = 0; k < ne; k++) {
+        int32_t e = run->elems[k];
+        if (run->q[e] > qt)
+            add_untransformed(run, getme__ws_type(ws, e), e);
+    }
+    return run->num_t;
+}
+
+static int cmp_int32(const void *a, const void *b)
+{
+    int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* After an iteration of the q*_min stage: bring the Eq. 9 sums up to date
+   by the quality changes of the elements that moved (run->elems; their old
+   qualities are in run->qold), and the list of elements with q <= q_t
+   (only those elements can have entered or left it).  The sums are
+   updated serially in list order, so they do not depend on the thread
+   count; each cycle start recomputes them from scratch, which bounds the
+   rounding drift of the updates. */
+static void update_after(getme_run *run, double qt)
+{
+    const getme_ws *ws = run->ws;
+    getme_adj *adj = run->adj;
+    for (int32_t k = 0; k < run->num_elems; k++) {
+        int32_t e = run->elems[k];
+        double d = run->q[e] - run->qold[k];
+        if (d == 0.0)
+            continue;
+        int t = getme__ws_type(ws, e);
+        const int32_t *c = getme__ws_nodes(ws, t, e);
+        for (int i = 0; i < getme__nv[t]; i++)
+            adj->nsum[c[i]] += d;
+        if (ws->dim == 3) {
+            const int32_t *id = getme__adj_edges(adj, ws, t, e);
+            for (int j = 0; j < getme__edges[t].num_edges; j++)
+                adj->esum[id[j]] += d;
+        }
+    }
+
+    int32_t n = 0;
+    for (int32_t k = 0; k < run->num_t; k++) {
+        int32_t e = run->tlist[k];
+        if (run->q[e] <= qt)
+            run->tlist[n++] = e;
+        else
+            run->tflag[e] = 0;
+    }
+    for (int32_t k = 0; k < run->num_elems; k++) {
+        int32_t e = run->elems[k];
+        if (run->q[e] <= qt && !run->tflag[e]) {
+            run->tflag[e] = 1;
+            run->tlist[n++] = e;
+        }
+    }
+    qsort(run->tlist, (size_t)n, sizeof *run->tlist, cmp_int32);
+    run->num_t = n;
+}
+
+/* A new cycle's transformation list: the free elements with q <= q_t. */
+static void start_tlist(getme_run *run, double qt)
+{
+    const getme_ws *ws = run->ws;
+    int32_t n = 0;
+    for (int32_t e = 0; e < ws->ne; e++) {
+        run->tflag[e] = ws->free_elem[e] && run->q[e] <= qt;
+        if (run->tflag[e])
+            run->tlist[n++] = e;
+    }
+    run->num_t = n;
 }
 
 /* ComputeNewNodes: p-hat = weighted sum / weight sum, for I_T. */
@@ -140,13 +247,20 @@ static void iterate(getme_run *run, double qt, const double *R, int nR,
                     int32_t *num_transformed, int32_t *num_relaxed)
 {
     double sigma = run->params->sigma;
-    *num_transformed = scatter_pass(run, 1, qt, sigma);
-    if (qt < 1.0)
-        scatter_pass(run, 0, qt, sigma);
-    getme__collect(run);
+    if (qt >= 1.0) {
+        getme__adj_sums_all(run->adj, run->ws, run->q);
+        *num_transformed = scatter_all(run, sigma);
+    } else {
+        *num_transformed = scatter_some(run, qt, sigma);
+    }
     compute_new_nodes(run);
+    if (qt < 1.0)
+        for (int32_t k = 0; k < run->num_elems; k++)
+            run->qold[k] = run->q[run->elems[k]];
     *num_relaxed = getme__relax(run, R, nR);
     getme__reset_nodes(run);
+    if (qt < 1.0)
+        update_after(run, qt);
 }
 
 /* Swap a <= b for quickselect. */
@@ -209,19 +323,60 @@ static double determine_threshold(getme_run *run, double *scratch)
     return select_kth(scratch, n, k);
 }
 
+/* The method's own scratch: the q*_min stage's element list, and the
+   per-thread stamps of the union walk if some element needs it. */
+static getme_status alloc_adaptive(getme_run *run)
+{
+    const getme_ws *ws = run->ws;
+    size_t ne = (size_t)(ws->ne ? ws->ne : 1);
+    run->tlist = malloc((size_t)(ws->num_free_elem ? ws->num_free_elem : 1) *
+                        sizeof *run->tlist);
+    run->tflag = calloc(ne, 1);
+    if (!run->tlist || !run->tflag)
+        return GETME_ERR_NOMEM;
+    if (run->adj->num_irregular == 0)
+        return GETME_OK;
+    run->stamps = calloc((size_t)ws->nt, sizeof *run->stamps);
+    if (!run->stamps)
+        return GETME_ERR_NOMEM;
+    for (int t = 0; t < ws->nt; t++)
+        if (!(run->stamps[t].mark = calloc(ne, sizeof(uint32_t))))
+            return GETME_ERR_NOMEM;
+    return GETME_OK;
+}
+
+static void free_adaptive(getme_run *run)
+{
+    free(run->tlist);
+    free(run->tflag);
+    if (run->stamps)
+        for (int t = 0; t < run->ws->nt; t++)
+            free(run->stamps[t].mark);
+    free(run->stamps);
+    run->tlist = NULL, run->tflag = NULL, run->stamps = NULL;
+}
+
 getme_status getme__adaptive(getme_run *run)
 {
     getme_ws *ws = run->ws;
     const getme_params *p = run->params;
     getme_result *res = run->result;
-    double *scratch = malloc((size_t)(ws->num_free_elem ? ws->num_free_elem : 1) *
-                             sizeof *scratch);
-    double *best = p->keep_best ? malloc((size_t)ws->nn * 3 * sizeof *best) : NULL;
-    if (!scratch || (p->keep_best && !best)) {
-        free(scratch);
-        free(best);
-        return GETME_ERR_NOMEM;
-    }
+    double *scratch = NULL, *best = NULL;
+    getme_adj adj;
+    getme_status st = getme__adj_build(&adj, ws);
+    if (st != GETME_OK)
+        return st;
+    run->adj = &adj;
+    if ((st = alloc_adaptive(run)) != GETME_OK)
+        goto done;
+    st = GETME_ERR_NOMEM;
+    scratch = malloc((size_t)(ws->num_free_elem ? ws->num_free_elem : 1) *
+                     sizeof *scratch);
+    best = p->keep_best ? malloc((size_t)ws->nn * 3 * sizeof *best) : NULL;
+    if (!scratch || (p->keep_best && !best))
+        goto done;
+    run->qold = scratch; /* free between cycle starts */
+    lists_all(run);
 
     double q_mean = res->q_mean_initial, q_min = res->q_min_star_initial;
     /* best_min: best q*_min since the end of the q_mean stage (its mesh is
@@ -230,7 +385,7 @@ getme_status getme__adaptive(getme_run *run)
     const double *R = p->relax_mean;
     int nR = p->num_relax_mean;
     int state = MEAN_RUNNING, counter = 0, have_cycle = 0;
-    getme_status st = GETME_OK;
+    st = GETME_OK;
     res->stop_reason = GETME_STOP_MAX_ITER;
 
     for (int it = 1; it <= p->max_iter; it++) {
@@ -285,6 +440,8 @@ getme_status getme__adaptive(getme_run *run)
             state = MIN_RUNNING;
             counter = 0;
             qt = determine_threshold(run, scratch);
+            start_tlist(run, qt);
+            getme__adj_sums_all(run->adj, ws, run->q);
             have_cycle = 1;
             res->cycles_min++;
         }
@@ -298,7 +455,11 @@ getme_status getme__adaptive(getme_run *run)
     }
     getme__ws_summary(ws, run->q, &res->q_mean, &res->q_min_star, &res->q_min);
     res->threshold = qt;
+done:
     free(scratch);
     free(best);
+    free_adaptive(run);
+    getme__adj_free(&adj);
+    run->adj = NULL;
     return st;
 }

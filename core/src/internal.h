@@ -23,6 +23,23 @@
 /* Nodes per type, indexed by getme_elem_type. */
 extern const int getme__nv[GETME_NUM_TYPES];
 
+/* Faces of volume types and edges of planar types (the (d-1)-dimensional
+   sides of an element), as local node lists; and the edges of every type
+   (tables.c). */
+typedef struct getme_face_table {
+    int num_faces;
+    int size[6];
+    int8_t node[6][4];
+} getme_face_table;
+
+typedef struct getme_edge_table {
+    int num_edges;
+    int8_t node[12][2];
+} getme_edge_table;
+
+extern const getme_face_table getme__faces[GETME_NUM_TYPES];
+extern const getme_edge_table getme__edges[GETME_NUM_TYPES];
+
 /* ---- kernels (quality.c) ------------------------------------------------ */
 
 /* Mean ratio of one element, 0 when invalid; see getme_element_quality(). */

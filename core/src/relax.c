@@ -21,25 +21,41 @@ static inline void place(getme_run *run, int32_t i, double rho)
                            : (1.0 - rho) * x[d] + rho * ph[d];
 }
 
-/* Does node i touch an element that is invalid at xnew? */
-static inline int touches_invalid(const getme_ws *ws, const double *q,
-                                  int32_t i)
+/* How many elements of the list are invalid at xnew (parallel count). */
+static int32_t count_invalid(const getme_run *run)
 {
-    for (int64_t k = ws->star_ptr[i]; k < ws->star_ptr[i + 1]; k++)
-        if (!(q[ws->star[k]] > 0.0))
-            return 1;
-    return 0;
+    const double *q = run->q;
+    const int32_t *elems = run->elems;
+    int32_t n = run->num_elems, bad = 0;
+#pragma omp parallel for schedule(static) num_threads(run->ws->nt) \
+    reduction(+ : bad) if (n > GETME_PAR_MIN)
+    for (int32_t k = 0; k < n; k++)
+        bad += !(q[elems[k]] > 0.0);
+    return bad;
 }
 
-static inline int touches_flagged(const getme_ws *ws, const uint8_t *flag,
-                                  int32_t e)
+/* The moving nodes of invalid elements that can still step down the table,
+   each once, into run->list (serial: few elements are invalid, and the
+   list order must not depend on the thread count). */
+static int32_t nodes_to_step(getme_run *run, int nR)
 {
-    int t = getme__ws_type(ws, e);
-    const int32_t *c = getme__ws_nodes(ws, t, e);
-    for (int i = 0; i < getme__nv[t]; i++)
-        if (flag[c[i]])
-            return 1;
-    return 0;
+    const getme_ws *ws = run->ws;
+    int32_t m = 0;
+    for (int32_t k = 0; k < run->num_elems; k++) {
+        int32_t e = run->elems[k];
+        if (run->q[e] > 0.0)
+            continue;
+        int t = getme__ws_type(ws, e);
+        const int32_t *c = getme__ws_nodes(ws, t, e);
+        for (int i = 0; i < getme__nv[t]; i++) {
+            int32_t n = c[i];
+            if (run->in_t[n] && !run->flag[n] && run->ridx[n] + 1 < nR) {
+                run->flag[n] = 1;
+                run->list[m++] = n;
+            }
+        }
+    }
+    return m;
 }
 
 int32_t getme__relax(getme_run *run, const double *R, int nR)
@@ -59,29 +75,26 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
     for (int32_t k = 0; k < ne; k++)
         q[elems[k]] = getme__ws_quality(ws, run->xnew, elems[k]);
 
-    for (;;) {
-        int32_t changed = 0;
-#pragma omp parallel for schedule(static) num_threads(nt) \
-    reduction(+ : changed) if (nn > GETME_PAR_MIN)
-        for (int32_t k = 0; k < nn; k++) {
-            int32_t i = nodes[k];
+    /* Step the nodes of invalid elements down the table until none is
+       invalid.  Only elements around a stepped node change, so only they
+       are re-evaluated.  An invalid element always has a node that can
+       still step: with all its moving nodes at R's last entry 0 it would
+       be back at its old, valid shape. */
+    while (count_invalid(run) > 0) {
+        int32_t m = nodes_to_step(run, nR);
+        if (m == 0)
+            break; /* unreachable for a valid input, see above */
+        for (int32_t j = 0; j < m; j++) {
+            int32_t i = run->list[j];
+            run->ridx[i]++;
+            place(run, i, R[run->ridx[i]]);
             run->flag[i] = 0;
-            if (run->ridx[i] + 1 < nR && touches_invalid(ws, q, i)) {
-                run->ridx[i]++;
-                place(run, i, R[run->ridx[i]]);
-                run->flag[i] = 1;
-                changed++;
-            }
         }
-        /* No node could move back although an element is invalid cannot
-           happen: such an element would have all its nodes at their old,
-           valid positions.  So no change means no invalid element. */
-        if (changed == 0)
-            break;
-#pragma omp parallel for schedule(static) num_threads(nt) if (ne > GETME_PAR_MIN)
-        for (int32_t k = 0; k < ne; k++)
-            if (touches_flagged(ws, run->flag, elems[k]))
-                q[elems[k]] = getme__ws_quality(ws, run->xnew, elems[k]);
+        for (int32_t j = 0; j < m; j++) {
+            int32_t i = run->list[j];
+            for (int64_t k = ws->star_ptr[i]; k < ws->star_ptr[i + 1]; k++)
+                q[ws->star[k]] = getme__ws_quality(ws, run->xnew, ws->star[k]);
+        }
     }
 
     int32_t relaxed = 0;
@@ -92,7 +105,6 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
         double *x = ws->x + 3 * (int64_t)i;
         const double *xn = run->xnew + 3 * (int64_t)i;
         x[0] = xn[0], x[1] = xn[1], x[2] = xn[2];
-        run->flag[i] = 0;
         relaxed += run->ridx[i] > 0;
     }
     return relaxed;

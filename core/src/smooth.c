@@ -22,13 +22,10 @@ getme_status getme__run_alloc(getme_run *run)
     run->eflag = calloc(ne, 1);
     run->nodes = malloc(nn * sizeof *run->nodes);
     run->elems = malloc(ne * sizeof *run->elems);
-    run->stamps = calloc((size_t)ws->nt, sizeof *run->stamps);
+    run->list = malloc(nn * sizeof *run->list);
     if (!run->q || !run->acc || !run->xnew || !run->in_t || !run->flag ||
-        !run->ridx || !run->eflag || !run->nodes || !run->elems || !run->stamps)
+        !run->ridx || !run->eflag || !run->nodes || !run->elems || !run->list)
         return GETME_ERR_NOMEM;
-    for (int t = 0; t < ws->nt; t++)
-        if (!(run->stamps[t].mark = calloc(ne, sizeof(uint32_t))))
-            return GETME_ERR_NOMEM;
     memcpy(run->xnew, ws->x, (size_t)ws->nn * 3 * sizeof *run->xnew);
     return GETME_OK;
 }
@@ -44,10 +41,7 @@ void getme__run_free(getme_run *run)
     free(run->eflag);
     free(run->nodes);
     free(run->elems);
-    if (run->stamps)
-        for (int t = 0; t < run->ws->nt; t++)
-            free(run->stamps[t].mark);
-    free(run->stamps);
+    free(run->list);
 }
 
 /* Chunked, order-preserving compaction: the same list for any thread

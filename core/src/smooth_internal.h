@@ -37,15 +37,24 @@ typedef struct getme_run {
     int32_t *nodes;     /* nn: compacted list of I_T                        */
     int32_t *elems;     /* ne: compacted list of elements touching I_T      */
     int32_t num_nodes, num_elems;
-    getme_stamp *stamps;/* one per thread                                   */
+    int32_t *list;      /* nn: scratch node list (relaxation, sum updates)  */
+    /* GETMe adaptive only (getme_adaptive.c): */
+    struct getme_adj *adj; /* Eq. 9 sums (adjacency.h)                      */
+    getme_stamp *stamps;/* one per thread, only if adj has irregular ones   */
+    int32_t *tlist;     /* q*_min stage: the elements with q <= q_t, sorted */
+    int32_t num_t;
+    uint8_t *tflag;     /* ne: element is in tlist                          */
+    double *qold;       /* q*_min stage: qualities of run->elems before the
+                           relaxation step                                  */
 } getme_run;
 
 getme_status getme__run_alloc(getme_run *run);
 void getme__run_free(getme_run *run);
 
-/* Eq. 9 weight of element e (type t) from the qualities q. */
-double getme__weight(const getme_ws *ws, const double *q, int t, int32_t e,
-                     getme_stamp *stamp);
+/* Eq. 9 weight of element e (type t) at the qualities run->q (needs
+   run->adj with current sums, and run->stamps if any element is
+   irregular). */
+double getme__weight(const getme_run *run, int t, int32_t e);
 
 /* Build run->nodes from run->in_t and run->elems (elements with a node in
    I_T), both ascending; deterministic. */

@@ -14,26 +14,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Faces (volume types) / edges (planar types) as local node lists. */
-typedef struct face_table {
-    int num_faces;
-    int size[6];
-    int8_t node[6][4];
-} face_table;
-
-static const face_table FACES[GETME_NUM_TYPES] = {
-    /* tet */ {4, {3, 3, 3, 3}, {{0, 1, 2}, {0, 1, 3}, {1, 2, 3}, {0, 2, 3}}},
-    /* hex */ {6, {4, 4, 4, 4, 4, 4},
-               {{0, 1, 2, 3}, {4, 5, 6, 7}, {0, 1, 5, 4},
-                {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}}},
-    /* prism */ {5, {3, 3, 4, 4, 4},
-                 {{0, 1, 2}, {3, 4, 5}, {0, 1, 4, 3}, {1, 2, 5, 4}, {2, 0, 3, 5}}},
-    /* pyramid */ {5, {4, 3, 3, 3, 3},
-                   {{0, 1, 2, 3}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}}},
-    /* tri */ {3, {2, 2, 2}, {{0, 1}, {1, 2}, {2, 0}}},
-    /* quad */ {4, {2, 2, 2, 2}, {{0, 1}, {1, 2}, {2, 3}, {3, 0}}},
-};
-
 static int32_t region_of(const getme_mesh *mesh, int32_t e)
 {
     int32_t local;
@@ -59,7 +39,7 @@ static unsigned faces_to_fix(const getme_mesh *mesh, const int64_t *ptr,
                              int32_t e, int type, unsigned flags,
                              face_scratch *sc)
 {
-    const face_table *ft = &FACES[type];
+    const getme_face_table *ft = &getme__faces[type];
     int nv = getme__nv[type];
     uint32_t now = ++sc->now;
     int32_t count = 0;
@@ -84,7 +64,7 @@ static unsigned faces_to_fix(const getme_mesh *mesh, const int64_t *ptr,
     int32_t my_region = -1;
     for (int32_t k = 0; k < count; k++) {
         unsigned m = sc->shared[sc->list[k]];
-        if (__builtin_popcount(m) < 2)
+        if ((m & (m - 1)) == 0)
             continue; /* shares at most a node: no face (or 2-D edge) */
         for (int f = 0; f < ft->num_faces; f++) {
             if ((m & face_mask[f]) != face_mask[f])
@@ -183,7 +163,7 @@ getme_status getme_mesh_fix_boundary(getme_mesh *mesh, unsigned flags,
     }
     for (int b = 0; b < mesh->num_blocks; b++) {
         const getme_block *bl = &mesh->blocks[b];
-        const face_table *ft = &FACES[bl->type];
+        const getme_face_table *ft = &getme__faces[bl->type];
         int nv = getme__nv[bl->type];
         for (int32_t e = 0; e < bl->count; e++) {
             unsigned bits = mark[bl->first + e];

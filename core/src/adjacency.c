@@ -1,0 +1,516 @@
+/*
+ * adjacency.c -- edge ids, face neighbours, exact neighbour counts and the
+ * per-node / per-edge quality sums behind the Eq. 9 weights (adjacency.h
+ * says why and proves the formula).
+ *
+ * Everything is built from the node stars the workspace already has, in
+ * parallel loops where each iteration writes only what it owns (a node's
+ * edges, an element's rows), so the result is the same for any number of
+ * threads.
+ */
+#include "adjacency.h"
+#include "smooth_internal.h"
+
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+void getme__adj_free(getme_adj *adj)
+{
+    free(adj->eid);
+    free(adj->fnb);
+    free(adj->count);
+    free(adj->irregular);
+    free(adj->nsum);
+    free(adj->esum);
+    memset(adj, 0, sizeof *adj);
+}
+
+/* The check value of element n: a fixed pseudo-random 64-bit integer
+   (splitmix64), so that sum(formula) == sum(union) over such values means
+   every element was counted exactly once, with overwhelming probability. */
+static inline uint64_t check_value(int32_t n)
+{
+    uint64_t z = (uint64_t)(uint32_t)n + 0x9e3779b97f4a7c15u;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
+    return z ^ (z >> 31);
+}
+
+static inline int local_index(const int32_t *c, int nv, int32_t u)
+{
+    for (int i = 0; i < nv; i++)
+        if (c[i] == u)
+            return i;
+    return -1;
+}
+
+/* Other end of local edge j of a type-t element at local node li, or -1 if
+   the edge does not touch li. */
+static inline int edge_other(int t, int j, int li)
+{
+    const getme_edge_table *et = &getme__edges[t];
+    return et->node[j][0] == li   ? et->node[j][1]
+           : et->node[j][1] == li ? et->node[j][0]
+                                  : -1;
+}
+
+/* The upper neighbours of node u (other ends w > u of edges at u), sorted
+   and without repeats, into buf; returns how many.  An edge belongs to its
+   lower node, which is what makes the edge ids race-free to assign. */
+static int upper_neighbours(const getme_ws *ws, int32_t u, int32_t *buf)
+{
+    int m = 0;
+    for (int64_t k = ws->star_ptr[u]; k < ws->star_ptr[u + 1]; k++) {
+        int32_t n = ws->star[k];
+        int t = getme__ws_type(ws, n), nv = getme__nv[t];
+        const int32_t *c = getme__ws_nodes(ws, t, n);
+        int li = local_index(c, nv, u);
+        for (int j = 0; j < getme__edges[t].num_edges; j++) {
+            int o = edge_other(t, j, li);
+            if (o >= 0 && c[o] > u)
+                buf[m++] = c[o];
+        }
+    }
+    for (int i = 1; i < m; i++) { /* insertion sort: lists are short */
+        int32_t v = buf[i];
+        int j = i;
+        for (; j > 0 && buf[j - 1] > v; j--)
+            buf[j] = buf[j - 1];
+        buf[j] = v;
+    }
+    int u_count = 0;
+    for (int i = 0; i < m; i++)
+        if (i == 0 || buf[i] != buf[i - 1])
+            buf[u_count++] = buf[i];
+    return u_count;
+}
+
+static int find_sorted(const int32_t *buf, int m, int32_t w)
+{
+    int lo = 0, hi = m - 1;
+    while (lo < hi) {
+        int mid = (lo + hi) / 2;
+        if (buf[mid] < w)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* Edge ids of every element edge (3-D), how many elements have each edge
+   (edeg), and if rn is given the check-value sums of every node (rn) and
+   edge (re). */
+static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
+                                int32_t **edeg_out, uint64_t *rn,
+                                uint64_t **re_out)
+{
+    int64_t total = 0;
+    for (int t = 0; t < GETME_NUM_TYPES; t++) {
+        adj->eoff[t] = total;
+        total += (int64_t)(ws->tstart[t + 1] - ws->tstart[t]) *
+                 getme__edges[t].num_edges;
+    }
+    int64_t *eptr = malloc(((size_t)ws->nn + 1) * sizeof *eptr);
+    adj->eid = malloc((size_t)(total ? total : 1) * sizeof *adj->eid);
+    size_t bufsize = (size_t)ws->max_star * 4 + 1;
+    int32_t *bufs = malloc((size_t)ws->nt * bufsize * sizeof *bufs);
+    if (!eptr || !adj->eid || !bufs) {
+        free(eptr), free(bufs);
+        return GETME_ERR_NOMEM;
+    }
+    eptr[0] = 0;
+#pragma omp parallel for schedule(dynamic, 1024) num_threads(ws->nt)
+    for (int32_t u = 0; u < ws->nn; u++)
+        eptr[u + 1] = upper_neighbours(ws, u, bufs + omp_get_thread_num() * bufsize);
+    for (int32_t u = 0; u < ws->nn; u++)
+        eptr[u + 1] += eptr[u];
+    if (eptr[ws->nn] > INT32_MAX) {
+        free(eptr), free(bufs);
+        return GETME_ERR_NOMEM;
+    }
+    adj->num_edges = (int32_t)eptr[ws->nn];
+    size_t nedge = (size_t)(adj->num_edges ? adj->num_edges : 1);
+    int32_t *edeg = calloc(nedge, sizeof *edeg);
+    uint64_t *re = rn ? calloc(nedge, sizeof *re) : NULL;
+    if (!edeg || (rn && !re)) {
+        free(eptr), free(bufs), free(edeg), free(re);
+        return GETME_ERR_NOMEM;
+    }
+#pragma omp parallel for schedule(dynamic, 1024) num_threads(ws->nt)
+    for (int32_t u = 0; u < ws->nn; u++) {
+        int32_t *buf = bufs + omp_get_thread_num() * bufsize;
+        int m = upper_neighbours(ws, u, buf);
+        uint64_t r = 0;
+        for (int64_t k = ws->star_ptr[u]; k < ws->star_ptr[u + 1]; k++) {
+            int32_t n = ws->star[k];
+            int t = getme__ws_type(ws, n), nv = getme__nv[t];
+            const int32_t *c = getme__ws_nodes(ws, t, n);
+            int li = local_index(c, nv, u);
+            int32_t *row = (int32_t *)getme__adj_edges(adj, ws, t, n);
+            uint64_t rv = rn ? check_value(n) : 0;
+            r += rv;
+            for (int j = 0; j < getme__edges[t].num_edges; j++) {
+                int o = edge_other(t, j, li);
+                if (o < 0 || c[o] < u)
+                    continue;
+                int32_t id = (int32_t)(eptr[u] + find_sorted(buf, m, c[o]));
+                row[j] = id;
+                edeg[id]++;
+                if (re)
+                    re[id] += rv;
+            }
+        }
+        if (rn)
+            rn[u] = r;
+    }
+    free(eptr), free(bufs);
+    *edeg_out = edeg;
+    *re_out = re;
+    return GETME_OK;
+}
+
+/* Check-value node sums for planar meshes (no edge ids needed). */
+static void node_checks(const getme_ws *ws, uint64_t *rn)
+{
+#pragma omp parallel for schedule(static) num_threads(ws->nt)
+    for (int32_t u = 0; u < ws->nn; u++) {
+        uint64_t r = 0;
+        for (int64_t k = ws->star_ptr[u]; k < ws->star_ptr[u + 1]; k++)
+            r += check_value(ws->star[k]);
+        rn[u] = r;
+    }
+}
+
+/* fnb value of a face shared by three or more elements, or by two
+   identical simplices: the formula cannot count those, so the element is
+   irregular (its weight walks the union instead). */
+#define FACE_IRREGULAR (-2)
+
+/* One side of a face seen from its lowest node: the other nodes, sorted
+   (-1 padded), and which element face it is. */
+typedef struct face_key {
+    int32_t k[3];
+    int32_t elem;
+    int32_t face;
+} face_key;
+
+static int key_less(const face_key *a, const face_key *b)
+{
+    for (int i = 0; i < 3; i++)
+        if (a->k[i] != b->k[i])
+            return a->k[i] < b->k[i];
+    return a->elem < b->elem;
+}
+
+static int key_same(const face_key *a, const face_key *b)
+{
+    return a->k[0] == b->k[0] && a->k[1] == b->k[1] && a->k[2] == b->k[2];
+}
+
+/* The faces whose lowest node is u, as keys in buf (sorted); returns how
+   many. */
+static int faces_at(const getme_ws *ws, int32_t u, face_key *buf)
+{
+    int m = 0;
+    for (int64_t s = ws->star_ptr[u]; s < ws->star_ptr[u + 1]; s++) {
+        int32_t n = ws->star[s];
+        int t = getme__ws_type(ws, n);
+        const int32_t *c = getme__ws_nodes(ws, t, n);
+        const getme_face_table *ft = &getme__faces[t];
+        for (int f = 0; f < ft->num_faces; f++) {
+            int32_t other[3] = {-1, -1, -1};
+            int no = 0, has_u = 0, lowest = 1;
+            for (int j = 0; j < ft->size[f]; j++) {
+                int32_t v = c[ft->node[f][j]];
+                if (v == u)
+                    has_u = 1;
+                else if (v < u)
+                    lowest = 0;
+                else if (no < 3)
+                    other[no++] = v;
+            }
+            if (!has_u || !lowest)
+                continue;
+            for (int i = 1; i < no; i++) /* sort the (at most 3) others */
+                for (int j = i; j > 0 && other[j - 1] > other[j]; j--) {
+                    int32_t tmp = other[j];
+                    other[j] = other[j - 1];
+                    other[j - 1] = tmp;
+                }
+            face_key *key = &buf[m];
+            for (int i = 0; i < 3; i++)
+                key->k[i] = i < no ? other[i] : -1;
+            key->elem = n;
+            key->face = f;
+            int j = m++;
+            for (; j > 0 && key_less(key, &buf[j - 1]); j--)
+                ;
+            if (j < m - 1) { /* insertion: keep buf sorted */
+                face_key tmp = *key;
+                memmove(&buf[j + 1], &buf[j], (size_t)(m - 1 - j) * sizeof *buf);
+                buf[j] = tmp;
+            }
+        }
+    }
+    return m;
+}
+
+/* Do simplices a and b have the same nodes?  (Then they are duplicates.) */
+static int same_simplex(const getme_ws *ws, int32_t a, int32_t b)
+{
+    int ta = getme__ws_type(ws, a), tb = getme__ws_type(ws, b);
+    if (ta != tb)
+        return 0;
+    const int32_t *ca = getme__ws_nodes(ws, ta, a), *cb = getme__ws_nodes(ws, tb, b);
+    for (int i = 0; i < getme__nv[ta]; i++)
+        if (local_index(cb, getme__nv[tb], ca[i]) < 0)
+            return 0;
+    return 1;
+}
+
+static int32_t *face_slot(const getme_adj *adj, const getme_ws *ws, int32_t e,
+                          int f)
+{
+    int t = getme__ws_type(ws, e);
+    return adj->fnb + adj->foff[t] +
+           (int64_t)(e - ws->tstart[t]) * getme__faces[t].num_faces + f;
+}
+
+/* Face neighbours: every face is met at its lowest node, where the sides
+   with the same other nodes are neighbours.  Each element face has one
+   lowest node, so each fnb entry is written by one loop iteration only. */
+static getme_status build_faces(getme_adj *adj, const getme_ws *ws)
+{
+    size_t bufsize = (size_t)ws->max_star * 6 + 1;
+    face_key *bufs = malloc((size_t)ws->nt * bufsize * sizeof *bufs);
+    if (!bufs)
+        return GETME_ERR_NOMEM;
+#pragma omp parallel for schedule(dynamic, 1024) num_threads(ws->nt)
+    for (int32_t u = 0; u < ws->nn; u++) {
+        face_key *buf = bufs + omp_get_thread_num() * bufsize;
+        int m = faces_at(ws, u, buf);
+        for (int a = 0; a < m;) {
+            int b = a + 1;
+            while (b < m && key_same(&buf[a], &buf[b]))
+                b++;
+            for (int i = a; i < b; i++) {
+                int32_t *slot = face_slot(adj, ws, buf[i].elem, buf[i].face);
+                if (b - a == 1)
+                    *slot = -1;
+                else if (b - a > 2)
+                    *slot = FACE_IRREGULAR;
+                else {
+                    int32_t other = buf[i == a ? a + 1 : a].elem;
+                    int simplex = ws->dim == 3 ? getme__ws_type(ws, other) == GETME_TET
+                                               : getme__ws_type(ws, other) == GETME_TRI;
+                    *slot = simplex && same_simplex(ws, buf[i].elem, other)
+                                ? FACE_IRREGULAR : other;
+                }
+            }
+            a = b;
+        }
+    }
+    free(bufs);
+    return GETME_OK;
+}
+
+/* |N(E)| by the same inclusion-exclusion, with element counts (node and
+   edge degrees) in place of qualities; and irregular = a face the formula
+   cannot handle. */
+static void counts_and_flags(getme_adj *adj, const getme_ws *ws,
+                             const int32_t *edeg)
+{
+#pragma omp parallel for schedule(static) num_threads(ws->nt)
+    for (int32_t e = 0; e < ws->ne; e++) {
+        int t = getme__ws_type(ws, e), nv = getme__nv[t];
+        const int32_t *c = getme__ws_nodes(ws, t, e);
+        const getme_face_table *ft = &getme__faces[t];
+        const int32_t *f = face_slot(adj, ws, e, 0);
+        int64_t cnt = 0, nb = 0, bad = 0;
+        for (int i = 0; i < nv; i++)
+            cnt += ws->star_ptr[c[i] + 1] - ws->star_ptr[c[i]];
+        for (int k = 0; k < ft->num_faces; k++) {
+            nb += f[k] >= 0;
+            bad |= f[k] == FACE_IRREGULAR;
+        }
+        if (ws->dim == 2) {
+            cnt -= (nv - 1) + nb;
+        } else {
+            const int32_t *id = getme__adj_edges(adj, ws, t, e);
+            for (int j = 0; j < getme__edges[t].num_edges; j++)
+                cnt -= edeg[id[j]];
+            cnt += (ft->num_faces - 1) + nb;
+        }
+        adj->count[e] = (int32_t)cnt;
+        adj->irregular[e] = (uint8_t)(bad != 0);
+    }
+}
+
+typedef struct union_scratch {
+    uint32_t *stamp; /* ne: element last seen at this stamp value */
+    int32_t *list;
+    uint32_t now;
+} union_scratch;
+
+/* Non-simplex meshes: two elements may share nodes that are not a common
+   edge or face of both (a face diagonal), which the formula would
+   miscount.  Check every element once against the true union, with
+   pseudo-random integers in place of q (exact arithmetic), and take the
+   union's exact count where they disagree. */
+static void check_element(getme_adj *adj, const getme_ws *ws,
+                          const uint64_t *rn, const uint64_t *re, int32_t e,
+                          union_scratch *sc)
+{
+    int t = getme__ws_type(ws, e), nv = getme__nv[t];
+    const int32_t *c = getme__ws_nodes(ws, t, e);
+    const getme_face_table *ft = &getme__faces[t];
+    uint32_t now = ++sc->now;
+    int32_t cnt = 0;
+    uint64_t truth = 0;
+    for (int i = 0; i < nv; i++)
+        for (int64_t k = ws->star_ptr[c[i]]; k < ws->star_ptr[c[i] + 1]; k++) {
+            int32_t n = ws->star[k];
+            if (sc->stamp[n] != now) {
+                sc->stamp[n] = now;
+                truth += check_value(n);
+                cnt++;
+            }
+        }
+    const int32_t *f = face_slot(adj, ws, e, 0);
+    uint64_t formula = 0, fs = 0;
+    for (int i = 0; i < nv; i++)
+        formula += rn[c[i]];
+    for (int j = 0; j < ft->num_faces; j++)
+        fs += f[j] >= 0 ? check_value(f[j]) : 0;
+    uint64_t self = check_value(e);
+    if (ws->dim == 2) {
+        formula -= (uint64_t)(nv - 1) * self + fs;
+    } else {
+        const int32_t *id = getme__adj_edges(adj, ws, t, e);
+        for (int j = 0; j < getme__edges[t].num_edges; j++)
+            formula -= re[id[j]];
+        formula += (uint64_t)(ft->num_faces - 1) * self + fs;
+    }
+    if (formula != truth)
+        adj->irregular[e] = 1;
+    adj->count[e] = cnt;
+}
+
+static getme_status check_all(getme_adj *adj, const getme_ws *ws,
+                              const uint64_t *rn, const uint64_t *re)
+{
+    int nt = ws->nt;
+    union_scratch *sc = calloc((size_t)nt, sizeof *sc);
+    int ok = sc != NULL;
+    size_t ne = (size_t)(ws->ne ? ws->ne : 1);
+    for (int k = 0; ok && k < nt; k++) {
+        sc[k].stamp = calloc(ne, sizeof *sc[k].stamp);
+        ok = sc[k].stamp != NULL;
+    }
+    if (ok) {
+#pragma omp parallel for schedule(dynamic, 2048) num_threads(nt)
+        for (int32_t e = 0; e < ws->ne; e++)
+            check_element(adj, ws, rn, re, e, &sc[omp_get_thread_num()]);
+    }
+    for (int k = 0; sc && k < nt; k++)
+        free(sc[k].stamp);
+    free(sc);
+    return ok ? GETME_OK : GETME_ERR_NOMEM;
+}
+
+static int simplices_only(const getme_ws *ws)
+{
+    for (int t = 0; t < GETME_NUM_TYPES; t++)
+        if (t != GETME_TET && t != GETME_TRI && ws->tstart[t + 1] > ws->tstart[t])
+            return 0;
+    return 1;
+}
+
+getme_status getme__adj_build(getme_adj *adj, const getme_ws *ws)
+{
+    memset(adj, 0, sizeof *adj);
+    size_t nn = (size_t)(ws->nn ? ws->nn : 1), ne = (size_t)(ws->ne ? ws->ne : 1);
+    int64_t ftotal = 0;
+    for (int t = 0; t < GETME_NUM_TYPES; t++) {
+        adj->foff[t] = ftotal;
+        ftotal += (int64_t)(ws->tstart[t + 1] - ws->tstart[t]) *
+                  getme__faces[t].num_faces;
+    }
+    /* Simplices meet only in common sub-faces (any 2 or 3 nodes of a tet
+       are an edge or a face of it), so the formula can fail only where
+       build_faces sees it; other types need the check. */
+    int check = !simplices_only(ws);
+    adj->fnb = malloc((size_t)(ftotal ? ftotal : 1) * sizeof *adj->fnb);
+    adj->count = malloc(ne * sizeof *adj->count);
+    adj->irregular = malloc(ne);
+    adj->nsum = malloc(nn * sizeof *adj->nsum);
+    uint64_t *rn = check ? malloc(nn * sizeof *rn) : NULL, *re = NULL;
+    int32_t *edeg = NULL;
+    getme_status st = GETME_ERR_NOMEM;
+    if (!adj->fnb || !adj->count || !adj->irregular || !adj->nsum ||
+        (check && !rn))
+        goto fail;
+    if (ws->dim == 3) {
+        if ((st = build_edges(adj, ws, &edeg, rn, &re)) != GETME_OK)
+            goto fail;
+        st = GETME_ERR_NOMEM;
+        adj->esum = malloc((size_t)(adj->num_edges ? adj->num_edges : 1) *
+                           sizeof *adj->esum);
+        if (!adj->esum)
+            goto fail;
+    } else if (check) {
+        node_checks(ws, rn);
+    }
+    if ((st = build_faces(adj, ws)) != GETME_OK)
+        goto fail;
+    counts_and_flags(adj, ws, edeg);
+    if (check && (st = check_all(adj, ws, rn, re)) != GETME_OK)
+        goto fail;
+    for (int32_t e = 0; e < ws->ne; e++)
+        adj->num_irregular += adj->irregular[e];
+    free(rn), free(re), free(edeg);
+    return GETME_OK;
+fail:
+    free(rn), free(re), free(edeg);
+    getme__adj_free(adj);
+    return st;
+}
+
+/* S_v and S_e contributions of the elements of one block. */
+static void add_block_sums(getme_adj *adj, const getme_ws *ws, const double *q,
+                           int32_t e0, int32_t e1)
+{
+    int t = getme__ws_type(ws, e0), nv = getme__nv[t];
+    int ned = ws->dim == 3 ? getme__edges[t].num_edges : 0;
+    for (int32_t e = e0; e < e1; e++) {
+        double v = q[e];
+        const int32_t *c = getme__ws_nodes(ws, t, e);
+        for (int i = 0; i < nv; i++)
+            adj->nsum[c[i]] += v;
+        if (ned == 0)
+            continue; /* planar: no edge sums (and no eid array) */
+        const int32_t *id = getme__adj_edges(adj, ws, t, e);
+        for (int j = 0; j < ned; j++)
+            adj->esum[id[j]] += v;
+    }
+}
+
+void getme__adj_sums_all(getme_adj *adj, const getme_ws *ws, const double *q)
+{
+    memset(adj->nsum, 0, (size_t)ws->nn * sizeof *adj->nsum);
+    if (adj->esum)
+        memset(adj->esum, 0, (size_t)adj->num_edges * sizeof *adj->esum);
+    /* Blocks of one colour share no node, hence no edge: no atomics, and a
+       node's sum is added colour by colour whatever the thread count. */
+    for (int col = 0; col < ws->num_colours; col++) {
+        int32_t b0 = ws->colour_ptr[col], b1 = ws->colour_ptr[col + 1];
+        int nt = col == ws->serial_colour ? 1 : ws->nt;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(nt)
+        for (int32_t k = b0; k < b1; k++) {
+            int32_t b = ws->colour_blocks[k];
+            add_block_sums(adj, ws, q, ws->block_start[b], ws->block_start[b + 1]);
+        }
+    }
+}

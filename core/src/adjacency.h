@@ -1,0 +1,91 @@
+/*
+ * adjacency.h -- what the Eq. 9 weights need to be computed from a handful
+ * of sums instead of a walk over the whole neighbourhood.
+ *
+ * Eq. 9 needs, for every element E, the sum and the number of the
+ * qualities of N(E) = the elements sharing at least one node with E (E
+ * included).  Walking the union of E's node stars costs ~96 star entries
+ * per tet every iteration.  Inclusion-exclusion over E's own sub-faces gives
+ * the same sum from per-node sums S_v, per-edge sums S_e and per-face sums
+ * S_f (each over the elements that have that node, edge or face):
+ *
+ *     3-D:  sum = sum_v S_v - sum_e S_e + sum_f S_f - q_E
+ *     2-D:  sum = sum_v S_v - sum_e S_e + q_E
+ *
+ * An element n that meets E in a common vertex, edge or face F is counted
+ * chi(F) = 1 times (1, 2 - 1, 3 - 3 + 1, 4 - 4 + 1), and E itself
+ * V - E + F - 1 = 1 times (Euler: V - E + F = 2 for every polyhedron).  So
+ * the formula is exact on conforming meshes.  S_f is q_E plus the quality
+ * of the neighbour across f, so faces need no sums of their own; 2-D edges
+ * are the "faces" of planar elements the same way.
+ *
+ * Where the mesh is not conforming around E (a tet edge on a hex face
+ * diagonal, duplicate elements, three elements on one face), the formula
+ * would miscount.  getme__adj_build proves it for every element once: it
+ * evaluates both the formula and the true union with a pseudo-random 64-bit
+ * integer per element in place of q (exact integer arithmetic), and marks
+ * the elements where they differ "irregular"; those keep the exact union
+ * walk (weights.c).  The element counts |N(E)| come from that walk too, so
+ * they are exact everywhere.
+ */
+#ifndef GETME_ADJACENCY_H
+#define GETME_ADJACENCY_H
+
+#include "workspace.h"
+
+typedef struct getme_adj {
+    int64_t eoff[GETME_NUM_TYPES]; /* eid index of type t's first element  */
+    int64_t foff[GETME_NUM_TYPES]; /* fnb index of type t's first element  */
+    int32_t *eid;       /* 3-D types: the global id of each element edge   */
+    int32_t *fnb;       /* the element across each face (2-D: edge), -1    */
+    int32_t *count;     /* ne: |N(E)|, exact                               */
+    uint8_t *irregular; /* ne: 1 = use the union walk for this element     */
+    int32_t num_irregular;
+    int32_t num_edges;  /* 3-D only                                        */
+    double *nsum;       /* nn: S_v at the current qualities                */
+    double *esum;       /* num_edges: S_e at the current qualities         */
+} getme_adj;
+
+/* Build everything above for ws (parallel, deterministic).  GETME_OK or
+   GETME_ERR_NOMEM. */
+getme_status getme__adj_build(getme_adj *adj, const getme_ws *ws);
+void getme__adj_free(getme_adj *adj);
+
+/* S_v and S_e of every node and edge from q: a colour-ordered scatter, so
+   sums are added in an order independent of the thread count. */
+void getme__adj_sums_all(getme_adj *adj, const getme_ws *ws, const double *q);
+
+/* The edge ids of element e (type t): getme__edges[t].num_edges of them. */
+static inline const int32_t *getme__adj_edges(const getme_adj *adj,
+                                              const getme_ws *ws, int t,
+                                              int32_t e)
+{
+    return adj->eid + adj->eoff[t] +
+           (int64_t)(e - ws->tstart[t]) * getme__edges[t].num_edges;
+}
+
+/* Sum of q over N(e) for a regular element e of type t (see above). */
+static inline double getme__adj_nsum(const getme_adj *adj,
+                                     const getme_ws *ws, const double *q,
+                                     int t, int32_t e)
+{
+    const int32_t *c = getme__ws_nodes(ws, t, e);
+    const getme_face_table *ft = &getme__faces[t];
+    const int32_t *f = adj->fnb + adj->foff[t] +
+                       (int64_t)(e - ws->tstart[t]) * ft->num_faces;
+    int nv = getme__nv[t];
+    double sv = 0.0, sf = 0.0, se = 0.0;
+    for (int i = 0; i < nv; i++)
+        sv += adj->nsum[c[i]];
+    for (int k = 0; k < ft->num_faces; k++)
+        sf += f[k] >= 0 ? q[f[k]] : 0.0;
+    if (ws->dim == 2) /* sum_e S_e = nv q_E + sf, plus q_E once */
+        return sv - (double)(nv - 1) * q[e] - sf;
+    const getme_edge_table *et = &getme__edges[t];
+    const int32_t *id = getme__adj_edges(adj, ws, t, e);
+    for (int k = 0; k < et->num_edges; k++)
+        se += adj->esum[id[k]];
+    return sv - se + (double)(ft->num_faces - 1) * q[e] + sf;
+}
+
+#endif /* GETME_ADJACENCY_H */

@@ -1,0 +1,317 @@
+/*
+ * test_adjacency.c -- the Eq. 9 neighbour sums by inclusion-exclusion
+ * (core/src/adjacency.h) against a brute-force walk over the union of the
+ * node stars, on conforming meshes of every type (where the formula must
+ * be exact for every element), and on non-conforming ones (where the
+ * elements it cannot count must be found and flagged).
+ *
+ * Built from the core's sources (not libgetme), because it checks private
+ * functions.
+ */
+#include "adjacency.h"
+#include "check.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- mesh builders ------------------------------------------------------ */
+
+typedef struct gen {
+    int dim;
+    double *xyz;
+    int32_t nn, cap_n;
+    int32_t *conn[GETME_NUM_TYPES];
+    int32_t count[GETME_NUM_TYPES], cap[GETME_NUM_TYPES];
+} gen;
+
+static int32_t add_node(gen *g, double x, double y, double z)
+{
+    if (g->nn == g->cap_n) {
+        g->cap_n = g->cap_n ? 2 * g->cap_n : 256;
+        g->xyz = realloc(g->xyz, (size_t)g->cap_n * 3 * sizeof *g->xyz);
+    }
+    g->xyz[3 * g->nn] = x, g->xyz[3 * g->nn + 1] = y, g->xyz[3 * g->nn + 2] = z;
+    return g->nn++;
+}
+
+static void add_elem(gen *g, int t, const int32_t *c)
+{
+    int nv = getme_type_num_nodes((getme_elem_type)t);
+    if (g->count[t] == g->cap[t]) {
+        g->cap[t] = g->cap[t] ? 2 * g->cap[t] : 256;
+        g->conn[t] = realloc(g->conn[t], (size_t)g->cap[t] * nv * sizeof(int32_t));
+    }
+    memcpy(g->conn[t] + (size_t)g->count[t] * nv, c, (size_t)nv * sizeof *c);
+    g->count[t]++;
+}
+
+static void free_gen(gen *g)
+{
+    free(g->xyz);
+    for (int t = 0; t < GETME_NUM_TYPES; t++)
+        free(g->conn[t]);
+}
+
+#define N 5
+static int32_t grid(int i, int j, int k) { return (k * (N + 1) + j) * (N + 1) + i; }
+
+static void grid_nodes(gen *g, int dim)
+{
+    g->dim = dim;
+    for (int k = 0; k <= (dim == 3 ? N : 0); k++)
+        for (int j = 0; j <= N; j++)
+            for (int i = 0; i <= N; i++)
+                add_node(g, i, j, k);
+}
+
+/* Corners of cell (i, j, k) in hex order. */
+static void cell(int i, int j, int k, int32_t v[8])
+{
+    v[0] = grid(i, j, k), v[1] = grid(i + 1, j, k);
+    v[2] = grid(i + 1, j + 1, k), v[3] = grid(i, j + 1, k);
+    v[4] = grid(i, j, k + 1), v[5] = grid(i + 1, j, k + 1);
+    v[6] = grid(i + 1, j + 1, k + 1), v[7] = grid(i, j + 1, k + 1);
+}
+
+/* Kuhn split of a cube into 6 tets around the diagonal 0-6: conforming
+   across cubes because every cube uses the same diagonal direction. */
+static void kuhn(gen *g, const int32_t v[8])
+{
+    static const int8_t tets[6][4] = {{0, 1, 2, 6}, {0, 2, 3, 6}, {0, 3, 7, 6},
+                                      {0, 7, 4, 6}, {0, 4, 5, 6}, {0, 5, 1, 6}};
+    for (int t = 0; t < 6; t++) {
+        int32_t c[4] = {v[tets[t][0]], v[tets[t][1]], v[tets[t][2]], v[tets[t][3]]};
+        add_elem(g, GETME_TET, c);
+    }
+}
+
+/* Hexes, prism columns and pyramid-split cells: all faces between cells
+   are the cells' quads (prisms' triangles meet prisms), so it conforms. */
+static void mixed_cell(gen *g, int i, int j, int k, const int32_t v[8])
+{
+    int kind = (i + j) % 3;
+    if (kind == 0) { /* two prisms: triangles in the xy faces */
+        int32_t a[6] = {v[0], v[1], v[2], v[4], v[5], v[6]};
+        int32_t b[6] = {v[0], v[2], v[3], v[4], v[6], v[7]};
+        add_elem(g, GETME_PRISM, a);
+        add_elem(g, GETME_PRISM, b);
+    } else if (kind == 1 && k % 2 == 0) { /* six pyramids to the centre */
+        int32_t c = add_node(g, i + 0.5, j + 0.5, k + 0.5);
+        static const int8_t faces[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                           {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+        for (int f = 0; f < 6; f++) {
+            int32_t p[5] = {v[faces[f][0]], v[faces[f][1]], v[faces[f][2]],
+                            v[faces[f][3]], c};
+            add_elem(g, GETME_PYRAMID, p);
+        }
+    } else {
+        add_elem(g, GETME_HEX, v);
+    }
+}
+
+static gen make(const char *kind)
+{
+    gen g;
+    memset(&g, 0, sizeof g);
+    if (!strcmp(kind, "tri") || !strcmp(kind, "quad") || !strcmp(kind, "tri+quad")) {
+        grid_nodes(&g, 2);
+        for (int j = 0; j < N; j++)
+            for (int i = 0; i < N; i++) {
+                int32_t a = grid(i, j, 0), b = grid(i + 1, j, 0);
+                int32_t c = grid(i + 1, j + 1, 0), d = grid(i, j + 1, 0);
+                int quads = !strcmp(kind, "quad") || (!strcmp(kind, "tri+quad") && (i + j) % 2);
+                if (quads) {
+                    int32_t q[4] = {a, b, c, d};
+                    add_elem(&g, GETME_QUAD, q);
+                } else {
+                    int32_t t1[3] = {a, b, c}, t2[3] = {a, c, d};
+                    add_elem(&g, GETME_TRI, t1);
+                    add_elem(&g, GETME_TRI, t2);
+                }
+            }
+        return g;
+    }
+    grid_nodes(&g, 3);
+    for (int k = 0; k < N; k++)
+        for (int j = 0; j < N; j++)
+            for (int i = 0; i < N; i++) {
+                int32_t v[8];
+                cell(i, j, k, v);
+                if (!strcmp(kind, "tet"))
+                    kuhn(&g, v);
+                else if (!strcmp(kind, "hex"))
+                    add_elem(&g, GETME_HEX, v);
+                else
+                    mixed_cell(&g, i, j, k, v);
+            }
+    return g;
+}
+
+static getme_mesh *to_mesh(const gen *g)
+{
+    getme_mesh *m = NULL;
+    CHECK(getme_mesh_create(&m, g->dim, g->nn, g->xyz) == GETME_OK);
+    for (int t = 0; t < GETME_NUM_TYPES; t++)
+        if (g->count[t])
+            CHECK(getme_mesh_add_elements(m, (getme_elem_type)t, g->count[t],
+                                          g->conn[t], NULL) == GETME_OK);
+    return m;
+}
+
+/* ---- brute force -------------------------------------------------------- */
+
+/* Sum and count of q over the union of the stars of e's nodes. */
+static double brute(const getme_ws *ws, const double *q, int32_t e,
+                    int32_t *count, uint32_t *mark, uint32_t now)
+{
+    int t = getme__ws_type(ws, e);
+    const int32_t *c = getme__ws_nodes(ws, t, e);
+    double s = 0.0;
+    *count = 0;
+    for (int i = 0; i < getme__nv[t]; i++)
+        for (int64_t k = ws->star_ptr[c[i]]; k < ws->star_ptr[c[i] + 1]; k++) {
+            int32_t n = ws->star[k];
+            if (mark[n] != now) {
+                mark[n] = now;
+                s += q[n];
+                (*count)++;
+            }
+        }
+    return s;
+}
+
+/* Build ws + adj for g with nt threads; check every regular element's
+   formula sum and count against the brute force; return the irregular
+   flags (caller frees) in ws element order, and the ws (caller frees). */
+static uint8_t *check_formula(const gen *g, int nt, getme_ws *ws,
+                              getme_mesh **mesh_out)
+{
+    getme_mesh *mesh = to_mesh(g);
+    CHECK(getme__ws_build(ws, mesh, 1, nt) == GETME_OK);
+    getme_adj adj;
+    CHECK(getme__adj_build(&adj, ws) == GETME_OK);
+    double *q = malloc((size_t)ws->ne * sizeof *q);
+    uint32_t *mark = calloc((size_t)ws->ne, sizeof *mark);
+    srand(7);
+    for (int32_t e = 0; e < ws->ne; e++)
+        q[e] = 0.05 + 0.95 * rand() / (double)RAND_MAX;
+    getme__adj_sums_all(&adj, ws, q);
+    int exact = 1;
+    for (int32_t e = 0; e < ws->ne; e++) {
+        int32_t cnt;
+        double s = brute(ws, q, e, &cnt, mark, (uint32_t)e + 1);
+        if (adj.irregular[e])
+            continue;
+        double f = getme__adj_nsum(&adj, ws, q, getme__ws_type(ws, e), e);
+        if (fabs(f - s) > 1e-12 * s || adj.count[e] != cnt) {
+            exact = 0;
+            fprintf(stderr, "element %d: formula %.17g (count %d), union %.17g "
+                    "(count %d)\n", (int)e, f, (int)adj.count[e], s, (int)cnt);
+        }
+    }
+    CHECK(exact);
+    uint8_t *irr = malloc((size_t)ws->ne);
+    memcpy(irr, adj.irregular, (size_t)ws->ne);
+    getme__adj_free(&adj);
+    free(q), free(mark);
+    *mesh_out = mesh;
+    return irr;
+}
+
+/* Conforming meshes: every element regular, every sum exact, and the same
+   flags and sums for 1 and 2 threads. */
+static void check_conforming(const char *kind)
+{
+    gen g = make(kind);
+    for (int nt = 1; nt <= 2; nt++) {
+        getme_ws ws;
+        getme_mesh *mesh;
+        uint8_t *irr = check_formula(&g, nt, &ws, &mesh);
+        int32_t nirr = 0;
+        for (int32_t e = 0; e < ws.ne; e++)
+            nirr += irr[e];
+        if (nirr != 0)
+            fprintf(stderr, "%s: %d irregular elements\n", kind, (int)nirr);
+        CHECK_EQ_INT(nirr, 0);
+        free(irr);
+        getme__ws_free(&ws);
+        getme_mesh_free(mesh);
+    }
+    free_gen(&g);
+}
+
+/* Which caller elements did adj flag? */
+static int flagged(const getme_ws *ws, const uint8_t *irr, int32_t caller_elem)
+{
+    for (int32_t e = 0; e < ws->ne; e++)
+        if (ws->elem_orig[e] == caller_elem)
+            return irr[e];
+    return -1;
+}
+
+/* Non-conforming meshes: the elements the formula would miscount are
+   flagged (check_formula proves the others exact). */
+static void check_nonconforming(void)
+{
+    /* Three tets on one face (0,1,2), and a duplicate of the first. */
+    gen g;
+    memset(&g, 0, sizeof g);
+    g.dim = 3;
+    add_node(&g, 0, 0, 0), add_node(&g, 1, 0, 0), add_node(&g, 0, 1, 0);
+    add_node(&g, 0, 0, 1), add_node(&g, 0, 0, -1), add_node(&g, 1, 1, 1);
+    add_node(&g, 3, 3, 3);
+    int32_t t0[4] = {0, 1, 2, 3}, t1[4] = {0, 2, 1, 4}, t2[4] = {0, 1, 2, 5};
+    int32_t t3[4] = {3, 5, 6, 1};
+    add_elem(&g, GETME_TET, t0), add_elem(&g, GETME_TET, t1);
+    add_elem(&g, GETME_TET, t2), add_elem(&g, GETME_TET, t3);
+    getme_ws ws;
+    getme_mesh *mesh;
+    uint8_t *irr = check_formula(&g, 2, &ws, &mesh);
+    CHECK_EQ_INT(flagged(&ws, irr, 0), 1);
+    CHECK_EQ_INT(flagged(&ws, irr, 1), 1);
+    CHECK_EQ_INT(flagged(&ws, irr, 2), 1);
+    free(irr), getme__ws_free(&ws), getme_mesh_free(mesh), free_gen(&g);
+
+    memset(&g, 0, sizeof g);
+    g.dim = 3;
+    add_node(&g, 0, 0, 0), add_node(&g, 1, 0, 0), add_node(&g, 0, 1, 0);
+    add_node(&g, 0, 0, 1), add_node(&g, 2, 2, 2);
+    int32_t d0[4] = {0, 1, 2, 3}, d1[4] = {0, 1, 2, 3}, d2[4] = {1, 2, 3, 4};
+    add_elem(&g, GETME_TET, d0), add_elem(&g, GETME_TET, d1);
+    add_elem(&g, GETME_TET, d2);
+    irr = check_formula(&g, 1, &ws, &mesh);
+    CHECK_EQ_INT(flagged(&ws, irr, 0), 1); /* the duplicates */
+    CHECK_EQ_INT(flagged(&ws, irr, 1), 1);
+    free(irr), getme__ws_free(&ws), getme_mesh_free(mesh), free_gen(&g);
+
+    /* A tet whose edge is the diagonal 4-6 of a hex's top face: neither
+       the hex nor the tet has that pair as a common edge or face. */
+    memset(&g, 0, sizeof g);
+    g.dim = 3;
+    int32_t h[8];
+    for (int k = 0; k < 2; k++)
+        for (int j = 0; j < 2; j++)
+            for (int i = 0; i < 2; i++)
+                add_node(&g, i, j, k);
+    int32_t order[8] = {0, 1, 3, 2, 4, 5, 7, 6}; /* lexicographic -> hex */
+    for (int i = 0; i < 8; i++)
+        h[i] = order[i];
+    add_elem(&g, GETME_HEX, h);
+    int32_t a = add_node(&g, 0.2, 0.8, 2), b = add_node(&g, 0.9, 0.1, 2.5);
+    int32_t tt[4] = {h[4], h[6], a, b};
+    add_elem(&g, GETME_TET, tt);
+    irr = check_formula(&g, 2, &ws, &mesh);
+    int32_t tet_caller = 0, hex_caller = 1; /* to_mesh adds types in enum order */
+    CHECK_EQ_INT(flagged(&ws, irr, hex_caller), 1);
+    CHECK_EQ_INT(flagged(&ws, irr, tet_caller), 1);
+    free(irr), getme__ws_free(&ws), getme_mesh_free(mesh), free_gen(&g);
+}
+
+int main(void)
+{
+    const char *kinds[] = {"tet", "hex", "mixed", "tri", "quad", "tri+quad"};
+    for (size_t i = 0; i < sizeof kinds / sizeof *kinds; i++)
+        check_conforming(kinds[i]);
+    check_nonconforming();
+    return check_summary("test_adjacency");
+}
