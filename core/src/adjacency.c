@@ -183,139 +183,6 @@ static void node_checks(const getme_ws *ws, uint64_t *rn)
     }
 }
 
-/* fnb value of a face shared by three or more elements, or by two
-   identical simplices: the formula cannot count those, so the element is
-   irregular (its weight walks the union instead). */
-#define FACE_IRREGULAR (-2)
-
-/* One side of a face seen from its lowest node: the other nodes, sorted
-   (-1 padded), and which element face it is. */
-typedef struct face_key {
-    int32_t k[3];
-    int32_t elem;
-    int32_t face;
-} face_key;
-
-static int key_less(const face_key *a, const face_key *b)
-{
-    for (int i = 0; i < 3; i++)
-        if (a->k[i] != b->k[i])
-            return a->k[i] < b->k[i];
-    return a->elem < b->elem;
-}
-
-static int key_same(const face_key *a, const face_key *b)
-{
-    return a->k[0] == b->k[0] && a->k[1] == b->k[1] && a->k[2] == b->k[2];
-}
-
-/* The faces whose lowest node is u, as keys in buf (sorted); returns how
-   many. */
-static int faces_at(const getme_ws *ws, int32_t u, face_key *buf)
-{
-    int m = 0;
-    for (int64_t s = ws->star_ptr[u]; s < ws->star_ptr[u + 1]; s++) {
-        int32_t n = ws->star[s];
-        int t = getme__ws_type(ws, n);
-        const int32_t *c = getme__ws_nodes(ws, t, n);
-        const getme_face_table *ft = &getme__faces[t];
-        for (int f = 0; f < ft->num_faces; f++) {
-            int32_t other[3] = {-1, -1, -1};
-            int no = 0, has_u = 0, lowest = 1;
-            for (int j = 0; j < ft->size[f]; j++) {
-                int32_t v = c[ft->node[f][j]];
-                if (v == u)
-                    has_u = 1;
-                else if (v < u)
-                    lowest = 0;
-                else if (no < 3)
-                    other[no++] = v;
-            }
-            if (!has_u || !lowest)
-                continue;
-            for (int i = 1; i < no; i++) /* sort the (at most 3) others */
-                for (int j = i; j > 0 && other[j - 1] > other[j]; j--) {
-                    int32_t tmp = other[j];
-                    other[j] = other[j - 1];
-                    other[j - 1] = tmp;
-                }
-            face_key *key = &buf[m];
-            for (int i = 0; i < 3; i++)
-                key->k[i] = i < no ? other[i] : -1;
-            key->elem = n;
-            key->face = f;
-            int j = m++;
-            for (; j > 0 && key_less(key, &buf[j - 1]); j--)
-                ;
-            if (j < m - 1) { /* insertion: keep buf sorted */
-                face_key tmp = *key;
-                memmove(&buf[j + 1], &buf[j], (size_t)(m - 1 - j) * sizeof *buf);
-                buf[j] = tmp;
-            }
-        }
-    }
-    return m;
-}
-
-/* Do simplices a and b have the same nodes?  (Then they are duplicates.) */
-static int same_simplex(const getme_ws *ws, int32_t a, int32_t b)
-{
-    int ta = getme__ws_type(ws, a), tb = getme__ws_type(ws, b);
-    if (ta != tb)
-        return 0;
-    const int32_t *ca = getme__ws_nodes(ws, ta, a), *cb = getme__ws_nodes(ws, tb, b);
-    for (int i = 0; i < getme__nv[ta]; i++)
-        if (local_index(cb, getme__nv[tb], ca[i]) < 0)
-            return 0;
-    return 1;
-}
-
-static int32_t *face_slot(const getme_adj *adj, const getme_ws *ws, int32_t e,
-                          int f)
-{
-    int t = getme__ws_type(ws, e);
-    return adj->fnb + adj->foff[t] +
-           (int64_t)(e - ws->tstart[t]) * getme__faces[t].num_faces + f;
-}
-
-/* Face neighbours: every face is met at its lowest node, where the sides
-   with the same other nodes are neighbours.  Each element face has one
-   lowest node, so each fnb entry is written by one loop iteration only. */
-static getme_status build_faces(getme_adj *adj, const getme_ws *ws)
-{
-    size_t bufsize = (size_t)ws->max_star * 6 + 1;
-    face_key *bufs = malloc((size_t)ws->nt * bufsize * sizeof *bufs);
-    if (!bufs)
-        return GETME_ERR_NOMEM;
-#pragma omp parallel for schedule(dynamic, 1024) num_threads(ws->nt)
-    for (int32_t u = 0; u < ws->nn; u++) {
-        face_key *buf = bufs + omp_get_thread_num() * bufsize;
-        int m = faces_at(ws, u, buf);
-        for (int a = 0; a < m;) {
-            int b = a + 1;
-            while (b < m && key_same(&buf[a], &buf[b]))
-                b++;
-            for (int i = a; i < b; i++) {
-                int32_t *slot = face_slot(adj, ws, buf[i].elem, buf[i].face);
-                if (b - a == 1)
-                    *slot = -1;
-                else if (b - a > 2)
-                    *slot = FACE_IRREGULAR;
-                else {
-                    int32_t other = buf[i == a ? a + 1 : a].elem;
-                    int simplex = ws->dim == 3 ? getme__ws_type(ws, other) == GETME_TET
-                                               : getme__ws_type(ws, other) == GETME_TRI;
-                    *slot = simplex && same_simplex(ws, buf[i].elem, other)
-                                ? FACE_IRREGULAR : other;
-                }
-            }
-            a = b;
-        }
-    }
-    free(bufs);
-    return GETME_OK;
-}
-
 /* |N(E)| by the same inclusion-exclusion, with element counts (node and
    edge degrees) in place of qualities; and irregular = a face the formula
    cannot handle. */
@@ -327,13 +194,14 @@ static void counts_and_flags(getme_adj *adj, const getme_ws *ws,
         int t = getme__ws_type(ws, e), nv = getme__nv[t];
         const int32_t *c = getme__ws_nodes(ws, t, e);
         const getme_face_table *ft = &getme__faces[t];
-        const int32_t *f = face_slot(adj, ws, e, 0);
+        const int32_t *f = adj->fnb + adj->foff[t] +
+                           (int64_t)(e - ws->tstart[t]) * ft->num_faces;
         int64_t cnt = 0, nb = 0, bad = 0;
         for (int i = 0; i < nv; i++)
             cnt += ws->star_ptr[c[i] + 1] - ws->star_ptr[c[i]];
         for (int k = 0; k < ft->num_faces; k++) {
             nb += f[k] >= 0;
-            bad |= f[k] == FACE_IRREGULAR;
+            bad |= f[k] == GETME_FACE_IRREGULAR;
         }
         if (ws->dim == 2) {
             cnt -= (nv - 1) + nb;
@@ -378,7 +246,8 @@ static void check_element(getme_adj *adj, const getme_ws *ws,
                 cnt++;
             }
         }
-    const int32_t *f = face_slot(adj, ws, e, 0);
+    const int32_t *f = adj->fnb + adj->foff[t] +
+                           (int64_t)(e - ws->tstart[t]) * ft->num_faces;
     uint64_t formula = 0, fs = 0;
     for (int i = 0; i < nv; i++)
         formula += rn[c[i]];
@@ -432,12 +301,7 @@ getme_status getme__adj_build(getme_adj *adj, const getme_ws *ws)
 {
     memset(adj, 0, sizeof *adj);
     size_t nn = (size_t)(ws->nn ? ws->nn : 1), ne = (size_t)(ws->ne ? ws->ne : 1);
-    int64_t ftotal = 0;
-    for (int t = 0; t < GETME_NUM_TYPES; t++) {
-        adj->foff[t] = ftotal;
-        ftotal += (int64_t)(ws->tstart[t + 1] - ws->tstart[t]) *
-                  getme__faces[t].num_faces;
-    }
+    int64_t ftotal = getme__ws_face_offsets(ws, adj->foff);
     /* Simplices meet only in common sub-faces (any 2 or 3 nodes of a tet
        are an edge or a face of it), so the formula can fail only where
        build_faces sees it; other types need the check. */
@@ -463,7 +327,7 @@ getme_status getme__adj_build(getme_adj *adj, const getme_ws *ws)
     } else if (check) {
         node_checks(ws, rn);
     }
-    if ((st = build_faces(adj, ws)) != GETME_OK)
+    if ((st = getme__ws_faces(ws, adj->foff, adj->fnb)) != GETME_OK)
         goto fail;
     counts_and_flags(adj, ws, edeg);
     if (check && (st = check_all(adj, ws, rn, re)) != GETME_OK)

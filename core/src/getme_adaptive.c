@@ -26,11 +26,26 @@
 #include "adjacency.h"
 #include "smooth_internal.h"
 
+#include <math.h>
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
 enum { MEAN_RUNNING, MIN_START, MIN_RUNNING };
+
+/* Eq. 9 weight of element e (type t) at the qualities run->q: from the
+   inclusion-exclusion sums (adjacency.h), inlined here because it runs
+   once per element and iteration, or by the union walk for the few
+   elements where that formula is not exact (weights.c). */
+static inline double weight(const getme_run *run, int t, int32_t e)
+{
+    const getme_adj *adj = run->adj;
+    if (adj->irregular[e])
+        return getme__weight_union(run, t, e);
+    const double *q = run->q;
+    return sqrt(getme__adj_nsum(adj, run->ws, q, t, e) /
+                ((double)adj->count[e] * q[e]));
+}
 
 /* AddTransformedElementNodesAndWeights for element e (type t). */
 static inline void add_transformed(getme_run *run, int t, int32_t e,
@@ -38,7 +53,7 @@ static inline void add_transformed(getme_run *run, int t, int32_t e,
 {
     const getme_ws *ws = run->ws;
     double x[3 * GETME_MAX_NV], y[3 * GETME_MAX_NV];
-    double w = getme__weight(run, t, e);
+    double w = weight(run, t, e);
     getme__ws_gather(ws, ws->x, t, e, x);
     getme__transform(t, x, sigma, y);
     const int32_t *c = getme__ws_nodes(ws, t, e);
@@ -59,7 +74,7 @@ static inline void add_transformed(getme_run *run, int t, int32_t e,
 static inline void add_untransformed(getme_run *run, int t, int32_t e)
 {
     const getme_ws *ws = run->ws;
-    double w = getme__weight(run, t, e);
+    double w = weight(run, t, e);
     const int32_t *c = getme__ws_nodes(ws, t, e);
     for (int i = 0; i < getme__nv[t]; i++) {
         int32_t n = c[i];

@@ -51,10 +51,9 @@ typedef struct getme_run {
 getme_status getme__run_alloc(getme_run *run);
 void getme__run_free(getme_run *run);
 
-/* Eq. 9 weight of element e (type t) at the qualities run->q (needs
-   run->adj with current sums, and run->stamps if any element is
-   irregular). */
-double getme__weight(const getme_run *run, int t, int32_t e);
+/* Eq. 9 weight of an irregular element (adjacency.h): walks the union of
+   its node stars (needs run->stamps). */
+double getme__weight_union(const getme_run *run, int t, int32_t e);
 
 /* Build run->nodes from run->in_t and run->elems (elements with a node in
    I_T), both ascending; deterministic. */

@@ -86,12 +86,7 @@ static double union_weight(const getme_ws *ws, const double *q, int t,
     return sqrt(((s0 + s1) + (s2 + s3)) / ((double)count * q[e]));
 }
 
-double getme__weight(const getme_run *run, int t, int32_t e)
+double getme__weight_union(const getme_run *run, int t, int32_t e)
 {
-    const getme_adj *adj = run->adj;
-    const double *q = run->q;
-    if (!adj->irregular[e])
-        return sqrt(getme__adj_nsum(adj, run->ws, q, t, e) /
-                    ((double)adj->count[e] * q[e]));
-    return union_weight(run->ws, q, t, e, &run->stamps[omp_get_thread_num()]);
+    return union_weight(run->ws, run->q, t, e, &run->stamps[omp_get_thread_num()]);
 }

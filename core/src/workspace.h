@@ -97,6 +97,24 @@ static inline double getme__ws_quality(const getme_ws *ws,
     return getme__quality(t, x);
 }
 
+/* ---- faces (faces.c) ---------------------------------------------------- */
+
+/* An out entry of getme__ws_faces for a face of three or more elements, or
+   of two identical simplices. */
+#define GETME_FACE_IRREGULAR (-2)
+
+/* Offsets of each type's first element in a per-face array (face f of
+   element e of type t at foff[t] + (e - tstart[t]) * num_faces + f);
+   returns the array's length. */
+int64_t getme__ws_face_offsets(const getme_ws *ws,
+                               int64_t foff[GETME_NUM_TYPES]);
+
+/* For every element face (2-D: edge): the element on its other side, -1
+   on the skin, or GETME_FACE_IRREGULAR.  Parallel and deterministic.
+   GETME_OK or GETME_ERR_NOMEM. */
+getme_status getme__ws_faces(const getme_ws *ws, const int64_t *foff,
+                             int32_t *out);
+
 /* Qualities of all elements at ws->x into q (parallel). */
 void getme__ws_qualities(const getme_ws *ws, double *q);
 
