@@ -55,10 +55,23 @@ static inline int edge_other(int t, int j, int li)
                                   : -1;
 }
 
-/* The upper neighbours of node u (other ends w > u of edges at u), sorted
-   and without repeats, into buf; returns how many.  An edge belongs to its
-   lower node, which is what makes the edge ids race-free to assign. */
-static int upper_neighbours(const getme_ws *ws, int32_t u, int32_t *buf)
+/* Slot of w in the list buf[0..*m) of node u's upper neighbours (the
+   other ends w > u of the edges at u), appended if new.  The lists are
+   short (~7 in a tet mesh), so a linear search beats sorting them. */
+static inline int slot_of(int32_t *buf, int *m, int32_t w)
+{
+    for (int i = 0; i < *m; i++)
+        if (buf[i] == w)
+            return i;
+    buf[*m] = w;
+    return (*m)++;
+}
+
+/* Every edge belongs to its lower node.  Visit the edges that node u owns,
+   element by element along its star: f(ctx, element, local edge, slot of
+   the edge in u's list).  Returns the length of u's list (its edges). */
+static int upper_edges(const getme_ws *ws, int32_t u, int32_t *buf,
+                       void (*f)(void *, int32_t, int, int, int), void *ctx)
 {
     int m = 0;
     for (int64_t k = ws->star_ptr[u]; k < ws->star_ptr[u + 1]; k++) {
@@ -68,40 +81,39 @@ static int upper_neighbours(const getme_ws *ws, int32_t u, int32_t *buf)
         int li = local_index(c, nv, u);
         for (int j = 0; j < getme__edges[t].num_edges; j++) {
             int o = edge_other(t, j, li);
-            if (o >= 0 && c[o] > u)
-                buf[m++] = c[o];
+            if (o >= 0 && c[o] > u) {
+                int slot = slot_of(buf, &m, c[o]);
+                if (f)
+                    f(ctx, n, t, j, slot);
+            }
         }
     }
-    for (int i = 1; i < m; i++) { /* insertion sort: lists are short */
-        int32_t v = buf[i];
-        int j = i;
-        for (; j > 0 && buf[j - 1] > v; j--)
-            buf[j] = buf[j - 1];
-        buf[j] = v;
-    }
-    int u_count = 0;
-    for (int i = 0; i < m; i++)
-        if (i == 0 || buf[i] != buf[i - 1])
-            buf[u_count++] = buf[i];
-    return u_count;
+    return m;
 }
 
-static int find_sorted(const int32_t *buf, int m, int32_t w)
+/* What the second pass over a node's edges fills in. */
+typedef struct edge_pass {
+    getme_adj *adj;
+    const getme_ws *ws;
+    int64_t first;  /* id of the node's first edge */
+    int32_t *edeg;
+    uint64_t *re;
+} edge_pass;
+
+static void assign_edge(void *ctx, int32_t n, int t, int j, int slot)
 {
-    int lo = 0, hi = m - 1;
-    while (lo < hi) {
-        int mid = (lo + hi) / 2;
-        if (buf[mid] < w)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo;
+    edge_pass *p = ctx;
+    int32_t id = (int32_t)(p->first + slot);
+    ((int32_t *)getme__adj_edges(p->adj, p->ws, t, n))[j] = id;
+    p->edeg[id]++;
+    if (p->re)
+        p->re[id] += check_value(n);
 }
 
-/* Edge ids of every element edge (3-D), how many elements have each edge
-   (edeg), and if rn is given the check-value sums of every node (rn) and
-   edge (re). */
+/* Edge ids of every element edge (3-D), numbered node by node (a node's
+   edges in the order its star meets them), how many elements have each
+   edge (edeg), and if rn is given the check-value sums of every node (rn)
+   and edge (re).  Each node writes only its own edges' entries. */
 static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
                                 int32_t **edeg_out, uint64_t *rn,
                                 uint64_t **re_out)
@@ -123,7 +135,8 @@ static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
     eptr[0] = 0;
 #pragma omp parallel for schedule(dynamic, 1024) num_threads(ws->nt)
     for (int32_t u = 0; u < ws->nn; u++)
-        eptr[u + 1] = upper_neighbours(ws, u, bufs + omp_get_thread_num() * bufsize);
+        eptr[u + 1] = upper_edges(ws, u, bufs + omp_get_thread_num() * bufsize,
+                                  NULL, NULL);
     for (int32_t u = 0; u < ws->nn; u++)
         eptr[u + 1] += eptr[u];
     if (eptr[ws->nn] > INT32_MAX) {
@@ -140,30 +153,14 @@ static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
     }
 #pragma omp parallel for schedule(dynamic, 1024) num_threads(ws->nt)
     for (int32_t u = 0; u < ws->nn; u++) {
-        int32_t *buf = bufs + omp_get_thread_num() * bufsize;
-        int m = upper_neighbours(ws, u, buf);
-        uint64_t r = 0;
-        for (int64_t k = ws->star_ptr[u]; k < ws->star_ptr[u + 1]; k++) {
-            int32_t n = ws->star[k];
-            int t = getme__ws_type(ws, n), nv = getme__nv[t];
-            const int32_t *c = getme__ws_nodes(ws, t, n);
-            int li = local_index(c, nv, u);
-            int32_t *row = (int32_t *)getme__adj_edges(adj, ws, t, n);
-            uint64_t rv = rn ? check_value(n) : 0;
-            r += rv;
-            for (int j = 0; j < getme__edges[t].num_edges; j++) {
-                int o = edge_other(t, j, li);
-                if (o < 0 || c[o] < u)
-                    continue;
-                int32_t id = (int32_t)(eptr[u] + find_sorted(buf, m, c[o]));
-                row[j] = id;
-                edeg[id]++;
-                if (re)
-                    re[id] += rv;
-            }
-        }
-        if (rn)
+        edge_pass p = {adj, ws, eptr[u], edeg, re};
+        upper_edges(ws, u, bufs + omp_get_thread_num() * bufsize, assign_edge, &p);
+        if (rn) {
+            uint64_t r = 0;
+            for (int64_t k = ws->star_ptr[u]; k < ws->star_ptr[u + 1]; k++)
+                r += check_value(ws->star[k]);
             rn[u] = r;
+        }
     }
     free(eptr), free(bufs);
     *edeg_out = edeg;
@@ -342,11 +339,12 @@ fail:
     return st;
 }
 
-/* S_v and S_e contributions of the elements of one block. */
-static void add_block_sums(getme_adj *adj, const getme_ws *ws, const double *q,
-                           int32_t e0, int32_t e1)
+/* S_v and S_e contributions of the elements [e0, e1), all of type t (a
+   constant in each copy, see GETME_FOR_TYPE). */
+static inline void add_block_sums(int t, getme_adj *adj, const getme_ws *ws,
+                                  const double *q, int32_t e0, int32_t e1)
 {
-    int t = getme__ws_type(ws, e0), nv = getme__nv[t];
+    int nv = getme__nv[t];
     int ned = ws->dim == 3 ? getme__edges[t].num_edges : 0;
     for (int32_t e = e0; e < e1; e++) {
         double v = q[e];
@@ -374,7 +372,8 @@ void getme__adj_sums_all(getme_adj *adj, const getme_ws *ws, const double *q)
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nt)
         for (int32_t k = b0; k < b1; k++) {
             int32_t b = ws->colour_blocks[k];
-            add_block_sums(adj, ws, q, ws->block_start[b], ws->block_start[b + 1]);
+            GETME_FOR_TYPE(getme__ws_type(ws, ws->block_start[b]), add_block_sums,
+                           adj, ws, q, ws->block_start[b], ws->block_start[b + 1]);
         }
     }
 }

@@ -89,6 +89,18 @@ static inline void add_untransformed(getme_run *run, int t, int32_t e)
     }
 }
 
+/* The free elements of [e0, e1), all of type t, transformed; t is a
+   constant in each copy (GETME_FOR_TYPE). */
+static inline void transform_block(int t, getme_run *run, int32_t e0,
+                                   int32_t e1, double sigma, int32_t *count)
+{
+    for (int32_t e = e0; e < e1; e++)
+        if (run->ws->free_elem[e]) {
+            add_transformed(run, t, e, sigma);
+            (*count)++;
+        }
+}
+
 /* q_mean stage: every free element is transformed.  Blocks run colour by
    colour: blocks of one colour share no node, so they scatter without
    atomics, and each node receives its contributions in the same order
@@ -106,12 +118,8 @@ static int32_t scatter_all(getme_run *run, double sigma)
         for (int32_t k = b0; k < b1; k++) {
             int32_t b = ws->colour_blocks[k];
             int32_t e0 = ws->block_start[b], e1 = ws->block_start[b + 1];
-            int t = getme__ws_type(ws, e0);
-            for (int32_t e = e0; e < e1; e++)
-                if (ws->free_elem[e]) {
-                    add_transformed(run, t, e, sigma);
-                    count++;
-                }
+            GETME_FOR_TYPE(getme__ws_type(ws, e0), transform_block, run, e0,
+                           e1, sigma, &count);
         }
         total += count;
     }

@@ -23,6 +23,23 @@
 /* Nodes per type, indexed by getme_elem_type. */
 extern const int getme__nv[GETME_NUM_TYPES];
 
+/*
+ * Call f(t, args...) with t as a compile-time constant for each element
+ * type, so that the hot per-block loops get a specialised copy per type
+ * (node, edge and face counts known: loops unrolled, no table lookups).
+ */
+#define GETME_FOR_TYPE(t, f, ...)                                           \
+    do {                                                                    \
+        switch (t) {                                                        \
+        case GETME_TET: f(GETME_TET, __VA_ARGS__); break;                   \
+        case GETME_HEX: f(GETME_HEX, __VA_ARGS__); break;                   \
+        case GETME_PRISM: f(GETME_PRISM, __VA_ARGS__); break;               \
+        case GETME_PYRAMID: f(GETME_PYRAMID, __VA_ARGS__); break;           \
+        case GETME_TRI: f(GETME_TRI, __VA_ARGS__); break;                   \
+        default: f(GETME_QUAD, __VA_ARGS__); break;                         \
+        }                                                                   \
+    } while (0)
+
 /* Faces of volume types and edges of planar types (the (d-1)-dimensional
    sides of an element), as local node lists; and the edges of every type
    (tables.c). */

@@ -29,17 +29,23 @@ static const unsigned char tet_opposite[4][3] = {
 
 void getme__transform_tet(const double *x, double sigma, double *out)
 {
+    /* Normals first, then the four scale factors in one loop (vector
+       square roots and divisions), then the moves. */
+    double n[4][3], f[4];
     for (int i = 0; i < 4; i++) {
         const double *a = x + 3 * tet_opposite[i][0];
         const double *b = x + 3 * tet_opposite[i][1];
         const double *c = x + 3 * tet_opposite[i][2];
         double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
         double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-        double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
-                       u[0] * v[1] - u[1] * v[0]};
-        double f = sigma * getme__inv_sqrt_norm(n);
-        for (int d = 0; d < 3; d++)
-            out[3 * i + d] = x[3 * i + d] + f * n[d];
+        n[i][0] = u[1] * v[2] - u[2] * v[1];
+        n[i][1] = u[2] * v[0] - u[0] * v[2];
+        n[i][2] = u[0] * v[1] - u[1] * v[0];
     }
+    for (int i = 0; i < 4; i++)
+        f[i] = sigma * getme__inv_sqrt_norm(n[i]);
+    for (int i = 0; i < 4; i++)
+        for (int d = 0; d < 3; d++)
+            out[3 * i + d] = x[3 * i + d] + f[i] * n[i][d];
     getme__rescale3(out, x, 4, 6, tet_edges);
 }
