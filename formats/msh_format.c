@@ -1,24 +1,39 @@
 /*
- * msh_format.c -- the Gmsh MSH adapter (MSH 2.2 / 4.x, ASCII or binary),
- * built on Gmsh's own reader and writer through the C API and on
- * libgetme_gmsh's model extraction.
+ * msh_format.c -- the Gmsh MSH adapter (MSH 2.2 / 4.x, ASCII or binary).
  *
- * Gmsh is process-global: the adapter initializes it once if nobody did
- * (with General.Terminal = 0: adapters never print), opens each document as
- * its own Gmsh model, and removes that model on close, so several documents
- * can be opened one after the other in one process.  Options it changes
- * (Terminal, MshFileVersion, Binary, SaveAll) are restored after each call.
+ * Two readers:
+ *  - MSH 4.1 (ASCII or binary) is read natively by msh41_reader.c in one
+ *    streaming pass, without a Gmsh model (a Gmsh model of a 4M-tet mesh
+ *    costs about 1 GiB), and written by msh41_writer.c as a copy of the
+ *    input with new coordinates in $Nodes.  Fixed nodes, regions and
+ *    element order are those the Gmsh path gives for the same file.
+ *  - Everything else (MSH 2.2 / 4.0, and the 4.1 files the native reader
+ *    declines: parametric nodes, partitioned meshes, planar meshes outside
+ *    a plane z = const, element types it does not know...) goes through
+ *    Gmsh's own reader via the C API and libgetme_gmsh's model extraction.
+ * The environment variable GETME_MSH_READER=gmsh forces the Gmsh path,
+ * GETME_MSH_READER=native forces the native one (a file it declines is then
+ * an error); anything else, or unset, means "native if it can".  A
+ * document is written by the path that opened it.
  *
- * Writing keeps the input's MSH version and ASCII/binary flavour, its node
- * and element tags and its physical groups; only coordinates of moved nodes
- * differ.  MSH 4.x goes through Gmsh's writer (gmshWrite); when the input
- * has physical groups but also elements outside of them, Mesh.SaveAll is
- * set so that no element is dropped.  MSH 2.2 is written by copying the
- * input with new coordinates in $Nodes (see patch_msh2: Gmsh's MSH 2
- * writer would renumber the nodes).
+ * Gmsh path: Gmsh is process-global: the adapter initializes it once if
+ * nobody did (with General.Terminal = 0: adapters never print), opens each
+ * document as its own Gmsh model, and removes that model on close, so
+ * several documents can be opened one after the other in one process.
+ * Options it changes (Terminal, MshFileVersion, Binary, SaveAll) are
+ * restored after each call.
+ *
+ * Gmsh path writing keeps the input's MSH version and ASCII/binary flavour,
+ * its node and element tags and its physical groups; only coordinates of
+ * moved nodes differ.  MSH 4.x goes through Gmsh's writer (gmshWrite); when
+ * the input has physical groups but also elements outside of them,
+ * Mesh.SaveAll is set so that no element is dropped.  MSH 2.2 is written by
+ * copying the input with new coordinates in $Nodes (see patch_msh2: Gmsh's
+ * MSH 2 writer would renumber the nodes).
  */
 #include "getme_formats.h"
 #include "getme_gmsh.h"
+#include "msh41_internal.h"
 
 #include <gmshc.h>
 
@@ -29,6 +44,7 @@
 #include <string.h>
 
 typedef struct msh_impl {
+    msh41_doc *native;   /* set when the native MSH 4.1 reader opened it */
     getme_gmsh_model *model;
     char model_name[256];
     double version;      /* 2.2, 4.1 ... as in $MeshFormat */
@@ -266,6 +282,43 @@ static getme_io_status open_model(getme_doc *doc, msh_impl *impl)
     return GETME_IO_OK;
 }
 
+/* GETME_MSH_READER: 'g' = gmsh only, 'n' = native only, 0 = native if it
+   can, else Gmsh. */
+static char reader_choice(void)
+{
+    const char *v = getenv("GETME_MSH_READER");
+    if (v && strcmp(v, "gmsh") == 0)
+        return 'g';
+    if (v && strcmp(v, "native") == 0)
+        return 'n';
+    return 0;
+}
+
+/* The native reader; *done = 0 if it declined the file (doc untouched). */
+static getme_io_status open_native(getme_doc *doc, msh_impl *impl,
+                                   const getme_doc_options *opts, char choice,
+                                   int *done)
+{
+    char why[160] = "";
+    int eligible = 1;
+    *done = 1;
+    if (impl->version != 4.1)
+        snprintf(why, sizeof why, "MSH %g", impl->version);
+    getme_io_status st =
+        impl->version == 4.1
+            ? msh41_open(doc, opts, &impl->native, &eligible, why, sizeof why)
+            : GETME_IO_OK;
+    if (impl->version == 4.1 && eligible)
+        return st;
+    if (choice == 'n')
+        return getme_doc_fail(doc, GETME_IO_ERR_UNSUPPORTED,
+                              "'%s': the native MSH reader reads MSH 4.1 "
+                              "only, without %s (GETME_MSH_READER=native)",
+                              doc->path, why);
+    *done = 0;
+    return GETME_IO_OK;
+}
+
 static getme_io_status msh_open(getme_doc *doc, const getme_doc_options *opts)
 {
     msh_impl *impl = calloc(1, sizeof *impl);
@@ -275,6 +328,13 @@ static getme_io_status msh_open(getme_doc *doc, const getme_doc_options *opts)
     getme_io_status st = read_header(doc, impl);
     if (st != GETME_IO_OK)
         return st;
+    char choice = reader_choice();
+    int done = 0;
+    if (choice != 'g') {
+        st = open_native(doc, impl, opts, choice, &done);
+        if (done)
+            return st;
+    }
     saved_options saved;
     quiet_begin(&saved);
     st = open_model(doc, impl);
@@ -474,6 +534,8 @@ static getme_io_status write_model(getme_doc *doc, msh_impl *impl,
 static getme_io_status msh_write(getme_doc *doc, const char *out_path)
 {
     msh_impl *impl = doc->impl;
+    if (impl && impl->native && doc->mesh)
+        return msh41_write(doc, impl->native, out_path);
     if (!impl || !impl->model || !doc->mesh)
         return getme_doc_fail(doc, GETME_IO_ERR_INTERNAL,
                               "MSH document is not open");
@@ -501,10 +563,14 @@ static void msh_close(getme_doc *doc)
         gmshModelRemove(&ierr);
     }
     getme_gmsh_model_free(impl->model);
+    msh41_free(impl->native);
     free(impl);
     doc->impl = NULL;
 }
 
 const getme_format getme_format_msh = {
-    "msh", "Gmsh MSH 2.2/4.1, ASCII or binary (via the Gmsh SDK)", msh_probe,
+    "msh",
+    "Gmsh MSH 2.2/4.1, ASCII or binary (4.1 read natively, others via the "
+    "Gmsh SDK)",
+    msh_probe,
     msh_open, msh_write, msh_close};

@@ -1,0 +1,156 @@
+/*
+ * msh41_input.c -- buffered reading of an MSH file for the native MSH 4.1
+ * path: tokens and lines for the ASCII parts, byte records for the binary
+ * parts, with an optional echo of every consumed byte into an output file.
+ *
+ * stdio's getc would do, but the echo needs to see the bytes in blocks
+ * (one fwrite per buffer, not one per byte), so we keep our own 1 MiB
+ * buffer and flush the consumed part of it to the echo file whenever it
+ * is refilled or the echo is switched.
+ */
+#include "msh41_internal.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#define IN_CHUNK (1u << 20)
+
+int msh41_in_open(msh41_input *in, const char *path)
+{
+    memset(in, 0, sizeof *in);
+    in->line = 1;
+    in->f = fopen(path, "rb");
+    in->buf = malloc(IN_CHUNK);
+    if (in->f && in->buf)
+        return 0;
+    msh41_in_close(in);
+    return -1;
+}
+
+static void echo_flush(msh41_input *in)
+{
+    if (in->echo && in->pos > in->echo_from &&
+        fwrite(in->buf + in->echo_from, 1, in->pos - in->echo_from,
+               in->echo) != in->pos - in->echo_from)
+        in->werr = 1;
+    in->echo_from = in->pos;
+}
+
+void msh41_in_close(msh41_input *in)
+{
+    echo_flush(in);
+    if (in->f)
+        fclose(in->f);
+    free(in->buf);
+    in->f = NULL;
+    in->buf = NULL;
+}
+
+void msh41_in_echo(msh41_input *in, FILE *out)
+{
+    echo_flush(in);
+    in->echo = out;
+    in->echo_from = in->pos;
+}
+
+int64_t msh41_in_offset(const msh41_input *in)
+{
+    return in->base + (int64_t)in->pos;
+}
+
+/* Refill once the buffer is used up: 0, or -1 at end of file. */
+static int refill(msh41_input *in)
+{
+    if (in->pos < in->len)
+        return 0;
+    echo_flush(in);
+    in->base += (int64_t)in->len;
+    in->pos = in->echo_from = 0;
+    in->len = in->f ? fread(in->buf, 1, IN_CHUNK, in->f) : 0;
+    return in->len ? 0 : -1;
+}
+
+int msh41_in_peek(msh41_input *in)
+{
+    return refill(in) ? -1 : in->buf[in->pos];
+}
+
+int msh41_in_getc(msh41_input *in)
+{
+    if (refill(in))
+        return -1;
+    int c = in->buf[in->pos++];
+    in->line += c == '\n';
+    return c;
+}
+
+int msh41_in_read(msh41_input *in, void *dst, size_t n)
+{
+    unsigned char *d = dst;
+    while (n) {
+        if (refill(in))
+            return -1;
+        size_t k = in->len - in->pos < n ? in->len - in->pos : n;
+        if (d) {
+            memcpy(d, in->buf + in->pos, k);
+            d += k;
+        }
+        in->pos += k;
+        n -= k;
+    }
+    return 0;
+}
+
+int msh41_in_line(msh41_input *in, char *buf, size_t size)
+{
+    size_t n = 0;
+    int c = msh41_in_getc(in);
+    if (c < 0)
+        return -1;
+    for (; c >= 0 && c != '\n'; c = msh41_in_getc(in))
+        if (n + 1 < size)
+            buf[n++] = (char)c;
+    if (n && buf[n - 1] == '\r')
+        n--;
+    buf[n] = 0;
+    return 0;
+}
+
+static int is_space(int c)
+{
+    return c == ' ' || c == '\n' || c == '\r' || c == '\t' || c == '\f' ||
+           c == '\v';
+}
+
+void msh41_in_skip_space(msh41_input *in)
+{
+    int c;
+    while ((c = msh41_in_peek(in)) >= 0 && is_space(c))
+        msh41_in_getc(in);
+}
+
+int msh41_in_token(msh41_input *in, char *tok, size_t size)
+{
+    msh41_in_skip_space(in);
+    size_t n = 0;
+    int c, too_long = 0;
+    while ((c = msh41_in_peek(in)) >= 0 && !is_space(c)) {
+        if (n + 1 < size)
+            tok[n++] = (char)c;
+        else
+            too_long = 1;
+        in->pos++;
+    }
+    tok[n] = 0;
+    return too_long ? -1 : (int)n;
+}
+
+int msh41_in_eol(msh41_input *in)
+{
+    int c;
+    while ((c = msh41_in_peek(in)) == ' ' || c == '\t' || c == '\r')
+        in->pos++;
+    if (c == '\n')
+        msh41_in_getc(in);
+    return c == '\n' || c < 0;
+}

@@ -1,0 +1,187 @@
+/*
+ * msh41_internal.h -- the native MSH 4.1 path of the MSH adapter (private).
+ *
+ * msh_format.c tries this path first for MSH 4.1 files: it reads the file
+ * in one streaming pass without creating a Gmsh model (msh41_reader.c,
+ * msh41_build.c), and writes by copying the input with new coordinates in
+ * $Nodes (msh41_writer.c).  Files it does not handle (parametric nodes,
+ * partitioned meshes, big-endian binary, element types it does not know,
+ * planar meshes outside a plane z = const...) are declined as "not
+ * eligible" and go through Gmsh's reader instead.
+ *
+ * msh41_input is the buffered byte reader both sides share: ASCII tokens
+ * with line counting, binary records, and an optional echo that copies
+ * every consumed byte to an output file (that is how the writer copies
+ * the input byte for byte while parsing it).
+ */
+#ifndef GETME_MSH41_INTERNAL_H
+#define GETME_MSH41_INTERNAL_H
+
+#include "getme_formats.h"
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+/* ---- buffered input (msh41_input.c) ------------------------------------- */
+
+typedef struct msh41_input {
+    FILE *f;
+    unsigned char *buf;
+    size_t pos, len;     /* next byte, bytes in buf                   */
+    int64_t base;        /* file offset of buf[0]                     */
+    long line;           /* 1 + newlines consumed (ASCII messages)    */
+    FILE *echo;          /* consumed bytes are copied here if set     */
+    size_t echo_from;    /* first byte of buf not yet echoed          */
+    int werr;            /* an echo write failed                      */
+} msh41_input;
+
+int msh41_in_open(msh41_input *in, const char *path);
+void msh41_in_close(msh41_input *in);
+/* File offset of the next byte. */
+int64_t msh41_in_offset(const msh41_input *in);
+/* Next byte (-1 at end of file). */
+int msh41_in_getc(msh41_input *in);
+int msh41_in_peek(msh41_input *in);
+/* Exactly n bytes into dst (dst may be NULL: skip); 0 or -1 (short). */
+int msh41_in_read(msh41_input *in, void *dst, size_t n);
+/* One line without its end ("\n" or "\r\n"), cut to size-1 bytes (the
+   rest is consumed); -1 at end of file with nothing read. */
+int msh41_in_line(msh41_input *in, char *buf, size_t size);
+/* The next whitespace-separated token: its length, 0 at end of file, -1
+   if longer than size-1. */
+int msh41_in_token(msh41_input *in, char *tok, size_t size);
+/* Skip spaces, tabs and CRs; 1 if a newline (consumed) or the end of the
+   file follows, else 0. */
+int msh41_in_eol(msh41_input *in);
+/* Skip whitespace including newlines. */
+void msh41_in_skip_space(msh41_input *in);
+/* Start / stop copying consumed bytes to out (NULL stops). */
+void msh41_in_echo(msh41_input *in, FILE *out);
+
+/* ---- element types (msh41_reader.c) ------------------------------------- */
+
+/* Nodes per element of an MSH element type, 0 if this reader does not know
+   the type; *order gets its polynomial order (0 for points). */
+int msh41_type_nodes(int msh_type, int *order);
+/* "tetrahedron", "10-node tetrahedron"... as the Gmsh path words them. */
+void msh41_type_name(int msh_type, char *buf, size_t size);
+
+/* ---- node tag -> mesh node index ---------------------------------------- */
+
+typedef struct msh41_nodemap {
+    uint64_t max_tag;
+    int32_t *dense;       /* max_tag + 1 entries (-1: absent), or NULL   */
+    uint64_t *sorted_tag; /* sparse numbering: sorted tags...            */
+    int32_t *sorted_idx;  /* ... and their indices                       */
+    size_t n;
+} msh41_nodemap;
+
+/* Index of tag, -1 if absent. */
+int32_t msh41_map_find(const msh41_nodemap *map, uint64_t tag);
+void msh41_map_free(msh41_nodemap *map);
+
+/* ---- what stays open between reading and writing ------------------------ */
+
+typedef struct msh41_doc {
+    int binary;
+    int64_t nodes_offset;   /* first byte after the "$Nodes" line      */
+    int64_t size, mtime_ns; /* identity of the input when it was read  */
+    uint64_t dev, ino;
+    msh41_nodemap map;      /* node tag -> mesh node, -1 if not in it   */
+} msh41_doc;
+
+/*
+ * Read doc->path (MSH 4.1, header already checked by the caller) into
+ * doc->mesh / doc->elem_ids / doc->info and *out.  If the file is outside
+ * what this reader handles, *eligible is set to 0, why says what, the
+ * document is left as it was and GETME_IO_OK is returned.
+ */
+getme_io_status msh41_open(getme_doc *doc, const getme_doc_options *opts,
+                           msh41_doc **out, int *eligible, char *why,
+                           size_t why_size);
+getme_io_status msh41_write(getme_doc *doc, const msh41_doc *m,
+                            const char *out_path);
+void msh41_free(msh41_doc *m);
+
+
+/* ---- reader state (msh41_reader.c parses, msh41_build.c builds) -------- */
+
+/* Status of a reader step that declines the file (not an error: the
+   caller falls back to Gmsh's reader). */
+#define MSH41_DECLINED ((getme_io_status)99)
+
+typedef struct msh41_pname {  /* $PhysicalNames entry */
+    int dim, tag;
+    char *name;
+} msh41_pname;
+
+typedef struct msh41_entity { /* $Entities entry */
+    int dim, tag;
+    size_t phys_first, phys_count; /* into msh41_reader.phys */
+    int fix;                       /* in a group named by --fix */
+} msh41_entity;
+
+typedef struct msh41_nblock { /* one $Nodes entity block (file order) */
+    int dim, tag;
+    size_t first, count;
+} msh41_nblock;
+
+typedef struct msh41_eblock { /* one $Elements block of the top dimension */
+    int tag, type;            /* entity tag, MSH element type */
+    int32_t count;
+    int32_t *conn;            /* node indices (file order, later mesh);
+                                 NULL for a type GETMe cannot smooth */
+    int64_t *ids;             /* element tags */
+} msh41_eblock;
+
+enum { MSH41_USED = 1, MSH41_FIXGRP = 2 }; /* msh41_reader.flag bits */
+
+typedef struct msh41_reader {
+    getme_doc *doc;
+    const getme_doc_options *opts;
+    msh41_input in;
+    int binary;
+    int64_t file_size;
+    const char *section;      /* for messages */
+    char why[160];            /* why the file was declined */
+    msh41_pname *names;
+    size_t nnames;
+    msh41_entity *ents;       /* sorted by (dim, tag) */
+    size_t nents;
+    int *phys;
+    size_t nphys;
+    int *fix_found;           /* groups matched per --fix word */
+    int groups_ready, have_nodes, have_elements;
+    int64_t nodes_offset;
+    size_t nnodes;            /* file order: */
+    uint64_t *tags;
+    double *xyz;
+    uint8_t *flag;
+    msh41_nblock *nb;
+    size_t nnb;
+    msh41_nodemap map;        /* tag -> file index (later mesh index) */
+    msh41_eblock *eb;
+    size_t neb, cap_eb;
+    int top_dim;
+} msh41_reader;
+
+/* Error at the current position: "'file', line N: ..." (ASCII) or
+   "'file': ... (byte N)" (binary). */
+getme_io_status msh41_fail(msh41_reader *r, getme_io_status st,
+                           const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+getme_io_status msh41_decline(msh41_reader *r, const char *why);
+msh41_entity *msh41_find_entity(const msh41_reader *r, int dim, int tag);
+/* $PhysicalNames name of group (dim, tag), NULL if it has none. */
+const char *msh41_group_name(const msh41_reader *r, int dim, int tag);
+/* Everything after parsing: mesh, fixed nodes, regions, ids, info. */
+getme_io_status msh41_build(msh41_reader *r, msh41_doc *m);
+/* Node tag -> index of tags[0..n) (tag 0 and repeated tags refused). */
+getme_io_status msh41_map_build(msh41_reader *r, msh41_nodemap *map,
+                                const uint64_t *tags, size_t n);
+
+#endif /* GETME_MSH41_INTERNAL_H */

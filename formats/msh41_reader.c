@@ -1,0 +1,939 @@
+/*
+ * msh41_reader.c -- native streaming reader of Gmsh MSH 4.1 files (ASCII
+ * and binary): $MeshFormat, $PhysicalNames, $Entities, $Nodes, $Elements;
+ * every other section is skipped by scanning to its $End line.
+ *
+ * One pass, flat arrays only: node tags and coordinates in file order, one
+ * flag byte per node, and the connectivity of the blocks of the highest
+ * element dimension seen so far (lower-dimensional elements are checked
+ * and dropped: they stay in the file, which the writer copies).  What the
+ * mesh becomes is decided in msh41_build.c once the file is read.
+ *
+ * Binary numbers are little-endian with 8-byte size_t (data-size 8); they
+ * are decoded byte by byte so that the host's byte order does not matter.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "msh41_internal.h"
+
+#include <errno.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#define TOK 128
+
+/* ---- element types ------------------------------------------------------ */
+
+typedef struct type_info {
+    int type, nodes, order;
+    const char *family;
+} type_info;
+
+/* The MSH types Gmsh writes for meshes up to order 5 (Gmsh's
+   getElementProperties: family, order, nodes).  Other types make the
+   reader decline the file, so Gmsh's reader deals with them. */
+static const type_info TYPES[] = {
+    {1, 2, 1, "line"},           {2, 3, 1, "triangle"},
+    {3, 4, 1, "quadrilateral"},  {4, 4, 1, "tetrahedron"},
+    {5, 8, 1, "hexahedron"},     {6, 6, 1, "prism"},
+    {7, 5, 1, "pyramid"},        {8, 3, 2, "line"},
+    {9, 6, 2, "triangle"},       {10, 9, 2, "quadrilateral"},
+    {11, 10, 2, "tetrahedron"},  {12, 27, 2, "hexahedron"},
+    {13, 18, 2, "prism"},        {14, 14, 2, "pyramid"},
+    {15, 1, 0, "point"},         {16, 8, 2, "quadrilateral"},
+    {17, 20, 2, "hexahedron"},   {18, 15, 2, "prism"},
+    {19, 13, 2, "pyramid"},      {20, 9, 3, "triangle"},
+    {21, 10, 3, "triangle"},     {22, 12, 4, "triangle"},
+    {23, 15, 4, "triangle"},     {24, 15, 5, "triangle"},
+    {25, 21, 5, "triangle"},     {26, 4, 3, "line"},
+    {27, 5, 4, "line"},          {28, 6, 5, "line"},
+    {29, 20, 3, "tetrahedron"},  {30, 35, 4, "tetrahedron"},
+    {31, 56, 5, "tetrahedron"},  {92, 64, 3, "hexahedron"},
+    {93, 125, 4, "hexahedron"},
+};
+
+static const type_info *find_type(int msh_type)
+{
+    for (size_t i = 0; i < sizeof TYPES / sizeof *TYPES; i++)
+        if (TYPES[i].type == msh_type)
+            return &TYPES[i];
+    return NULL;
+}
+
+int msh41_type_nodes(int msh_type, int *order)
+{
+    const type_info *t = find_type(msh_type);
+    if (order)
+        *order = t ? t->order : 0;
+    return t ? t->nodes : 0;
+}
+
+void msh41_type_name(int msh_type, char *buf, size_t size)
+{
+    const type_info *t = find_type(msh_type);
+    if (!t)
+        snprintf(buf, size, "element type %d", msh_type);
+    else if (t->order > 1)
+        snprintf(buf, size, "%d-node %s", t->nodes, t->family);
+    else
+        snprintf(buf, size, "%s", t->family);
+}
+
+/* ---- messages ----------------------------------------------------------- */
+
+getme_io_status msh41_fail(msh41_reader *r, getme_io_status st,
+                           const char *fmt, ...)
+{
+    char msg[768];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    if (r->binary)
+        return getme_doc_fail(r->doc, st, "'%s': %s (byte %lld)",
+                              r->doc->path, msg,
+                              (long long)msh41_in_offset(&r->in));
+    return getme_doc_fail(r->doc, st, "'%s', line %ld: %s", r->doc->path,
+                          r->in.line, msg);
+}
+
+getme_io_status msh41_decline(msh41_reader *r, const char *why)
+{
+    snprintf(r->why, sizeof r->why, "%s", why);
+    return MSH41_DECLINED;
+}
+
+/* For checks made after a whole line was read: name that line, not the
+   next one. */
+static getme_io_status line_fail(msh41_reader *r, getme_io_status st,
+                                 const char *msg)
+{
+    long saved = r->in.line;
+    r->in.line -= r->in.line > 1;
+    msh41_fail(r, st, "%s", msg);
+    r->in.line = saved;
+    return st;
+}
+
+static getme_io_status eof_error(msh41_reader *r)
+{
+    return msh41_fail(r, GETME_IO_ERR_PARSE,
+                      "unexpected end of file in $%s (truncated file?)",
+                      r->section);
+}
+
+static getme_io_status oom(msh41_reader *r)
+{
+    return getme_doc_fail(r->doc, GETME_IO_ERR_INTERNAL,
+                          "'%s': out of memory", r->doc->path);
+}
+
+/* ---- numbers ------------------------------------------------------------ */
+
+static uint64_t le64(const unsigned char *b)
+{
+    uint64_t v = 0;
+    for (int i = 7; i >= 0; i--)
+        v = v << 8 | b[i];
+    return v;
+}
+
+static int32_t le32(const unsigned char *b)
+{
+    uint32_t v = (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 |
+                 (uint32_t)b[3] << 24;
+    return (int32_t)v; /* two's complement on every host gcc targets */
+}
+
+/* The next ASCII token, or an error naming what was expected. */
+static getme_io_status token(msh41_reader *r, char *tok, const char *what)
+{
+    int n = msh41_in_token(&r->in, tok, TOK);
+    if (n == 0)
+        return eof_error(r);
+    if (n < 0)
+        return msh41_fail(r, GETME_IO_ERR_PARSE, "%s too long in $%s", what,
+                          r->section);
+    return GETME_IO_OK;
+}
+
+static int parse_u64(const char *s, uint64_t *v)
+{
+    uint64_t x = 0;
+    if (*s == '+')
+        s++;
+    if (!*s)
+        return -1;
+    for (; *s; s++) {
+        if (*s < '0' || *s > '9' || x > (UINT64_MAX - 9) / 10)
+            return -1;
+        x = 10 * x + (uint64_t)(*s - '0');
+    }
+    *v = x;
+    return 0;
+}
+
+static getme_io_status read_u64(msh41_reader *r, uint64_t *v,
+                                const char *what)
+{
+    if (r->binary) {
+        unsigned char b[8];
+        if (msh41_in_read(&r->in, b, 8))
+            return eof_error(r);
+        *v = le64(b);
+        return GETME_IO_OK;
+    }
+    char tok[TOK];
+    getme_io_status st = token(r, tok, what);
+    if (st == GETME_IO_OK && parse_u64(tok, v))
+        st = msh41_fail(r, GETME_IO_ERR_PARSE, "bad %s '%s' in $%s", what,
+                        tok, r->section);
+    return st;
+}
+
+static getme_io_status read_int(msh41_reader *r, int *v, const char *what)
+{
+    if (r->binary) {
+        unsigned char b[4];
+        if (msh41_in_read(&r->in, b, 4))
+            return eof_error(r);
+        *v = le32(b);
+        return GETME_IO_OK;
+    }
+    char tok[TOK];
+    getme_io_status st = token(r, tok, what);
+    if (st != GETME_IO_OK)
+        return st;
+    uint64_t x;
+    int neg = tok[0] == '-';
+    if (parse_u64(tok + neg, &x) || x > (uint64_t)INT32_MAX)
+        return msh41_fail(r, GETME_IO_ERR_PARSE, "bad %s '%s' in $%s", what,
+                          tok, r->section);
+    *v = neg ? -(int)x : (int)x;
+    return GETME_IO_OK;
+}
+
+static getme_io_status read_double(msh41_reader *r, double *v)
+{
+    if (r->binary) {
+        unsigned char b[8];
+        if (msh41_in_read(&r->in, b, 8))
+            return eof_error(r);
+        uint64_t bits = le64(b);
+        memcpy(v, &bits, sizeof *v);
+        return GETME_IO_OK;
+    }
+    char tok[TOK], *end;
+    getme_io_status st = token(r, tok, "number");
+    if (st != GETME_IO_OK)
+        return st;
+    errno = 0;
+    *v = strtod(tok, &end);
+    if (*end || end == tok)
+        return msh41_fail(r, GETME_IO_ERR_PARSE, "bad number '%s' in $%s",
+                          tok, r->section);
+    return GETME_IO_OK;
+}
+
+/* A count that must fit in the file (each item takes at least min_bytes):
+   refuses absurd counts before anything is allocated for them. */
+static getme_io_status read_count(msh41_reader *r, uint64_t *v,
+                                  const char *what, uint64_t min_bytes)
+{
+    getme_io_status st = read_u64(r, v, what);
+    if (st == GETME_IO_OK && *v > (uint64_t)r->file_size / min_bytes)
+        st = msh41_fail(r, GETME_IO_ERR_PARSE,
+                        "%s %llu is more than the file can hold", what,
+                        (unsigned long long)*v);
+    return st;
+}
+
+/* ---- section frame ------------------------------------------------------ */
+
+/* After a section's data: the "$End<name>" line (binary data ends with a
+   newline before it). */
+static getme_io_status expect_end(msh41_reader *r)
+{
+    char line[TOK], want[64];
+    snprintf(want, sizeof want, "$End%s", r->section);
+    msh41_in_skip_space(&r->in);
+    if (msh41_in_line(&r->in, line, sizeof line) || strcmp(line, want) != 0) {
+        char msg[160];
+        snprintf(msg, sizeof msg,
+                 "expected %s (wrong count or truncated data in $%s)", want,
+                 r->section);
+        return line_fail(r, GETME_IO_ERR_PARSE, msg);
+    }
+    return GETME_IO_OK;
+}
+
+/* Sections we do not need ($Periodic, $NodeData, $GhostElements...): scan
+   their lines to "$End<name>".  Binary payloads are scanned as lines too;
+   a payload holding exactly "\n$EndName\n" is not a concern in practice,
+   and computing the size of every kind of section would tie this reader
+   to each of their layouts. */
+static getme_io_status skip_section(msh41_reader *r, const char *name)
+{
+    char line[TOK], want[TOK + 8];
+    snprintf(want, sizeof want, "$End%s", name);
+    while (msh41_in_line(&r->in, line, sizeof line) == 0)
+        if (strcmp(line, want) == 0)
+            return GETME_IO_OK;
+    return msh41_fail(r, GETME_IO_ERR_PARSE, "no %s before the end of the file",
+                      want);
+}
+
+/* ---- $MeshFormat -------------------------------------------------------- */
+
+static getme_io_status read_format(msh41_reader *r)
+{
+    char line[TOK];
+    double version = 0;
+    int file_type = -1, data_size = 0;
+    r->section = "MeshFormat";
+    if (msh41_in_line(&r->in, line, sizeof line) ||
+        strcmp(line, "$MeshFormat") != 0 ||
+        msh41_in_line(&r->in, line, sizeof line) ||
+        sscanf(line, "%lf %d %d", &version, &file_type, &data_size) != 3 ||
+        (file_type != 0 && file_type != 1))
+        return line_fail(r, GETME_IO_ERR_PARSE,
+                         "bad $MeshFormat header (want \"4.1 0|1 8\")");
+    if (version != 4.1)
+        return msh41_decline(r, "not MSH 4.1");
+    r->binary = file_type == 1;
+    if (r->binary && data_size != 8)
+        return msh41_fail(r, GETME_IO_ERR_UNSUPPORTED,
+                          "binary MSH with data size %d: only 8-byte size_t "
+                          "is supported",
+                          data_size);
+    if (r->binary) {
+        unsigned char one[4];
+        if (msh41_in_read(&r->in, one, 4))
+            return eof_error(r);
+        if (le32(one) == 0x01000000)
+            return msh41_decline(r, "big-endian binary file");
+        if (le32(one) != 1)
+            return msh41_fail(r, GETME_IO_ERR_PARSE,
+                              "bad endianness marker in $MeshFormat");
+    }
+    return expect_end(r);
+}
+
+/* ---- $PhysicalNames (ASCII in both flavours) ----------------------------- */
+
+static getme_io_status read_name(msh41_reader *r, msh41_pname *p)
+{
+    char line[1024];
+    msh41_in_skip_space(&r->in);
+    if (msh41_in_line(&r->in, line, sizeof line))
+        return eof_error(r);
+    int used = 0;
+    char *q1 = strchr(line, '"'), *q2 = q1 ? strrchr(line, '"') : NULL;
+    if (sscanf(line, "%d %d %n", &p->dim, &p->tag, &used) < 2 || !q1 ||
+        q2 == q1)
+        return line_fail(r, GETME_IO_ERR_PARSE,
+                         "bad physical name line (want: dim tag \"name\")");
+    p->name = malloc((size_t)(q2 - q1));
+    if (!p->name)
+        return oom(r);
+    memcpy(p->name, q1 + 1, (size_t)(q2 - q1 - 1));
+    p->name[q2 - q1 - 1] = 0;
+    return GETME_IO_OK;
+}
+
+static getme_io_status read_physical_names(msh41_reader *r)
+{
+    char line[TOK];
+    unsigned long long n = 0;
+    r->section = "PhysicalNames";
+    int save = r->binary;
+    r->binary = 0; /* text even in binary files */
+    getme_io_status st = GETME_IO_OK;
+    msh41_in_skip_space(&r->in);
+    if (msh41_in_line(&r->in, line, sizeof line) ||
+        sscanf(line, "%llu", &n) != 1 || n > (uint64_t)r->file_size / 6)
+        st = line_fail(r, GETME_IO_ERR_PARSE, "bad number of names");
+    if (st == GETME_IO_OK && r->names == NULL && n > 0) {
+        r->names = calloc((size_t)n, sizeof *r->names);
+        if (!r->names)
+            st = oom(r);
+    } else if (st == GETME_IO_OK && n > 0) {
+        st = msh41_fail(r, GETME_IO_ERR_PARSE, "second $PhysicalNames");
+    }
+    for (size_t i = 0; st == GETME_IO_OK && i < n; i++) {
+        st = read_name(r, &r->names[i]);
+        r->nnames += st == GETME_IO_OK;
+    }
+    if (st == GETME_IO_OK)
+        st = expect_end(r);
+    r->binary = save;
+    return st;
+}
+
+/* ---- $Entities ---------------------------------------------------------- */
+
+static getme_io_status add_phys(msh41_reader *r, int tag, size_t *cap)
+{
+    if (r->nphys == *cap) {
+        size_t ncap = *cap ? 2 * *cap : 64;
+        int *np = realloc(r->phys, ncap * sizeof *np);
+        if (!np)
+            return oom(r);
+        r->phys = np;
+        *cap = ncap;
+    }
+    r->phys[r->nphys++] = tag;
+    return GETME_IO_OK;
+}
+
+/* One entity: tag, box (a point for dim 0), physical tags, bounding
+   entities (skipped). */
+static getme_io_status read_entity(msh41_reader *r, int dim, msh41_entity *e,
+                                   size_t *cap)
+{
+    uint64_t n = 0;
+    double skip;
+    e->dim = dim;
+    getme_io_status st = read_int(r, &e->tag, "entity tag");
+    for (int k = 0; k < (dim ? 6 : 3) && st == GETME_IO_OK; k++)
+        st = read_double(r, &skip);
+    if (st == GETME_IO_OK)
+        st = read_count(r, &n, "number of physical tags", 2);
+    e->phys_first = r->nphys;
+    e->phys_count = (size_t)n;
+    for (uint64_t i = 0; i < n && st == GETME_IO_OK; i++) {
+        int tag = 0;
+        st = read_int(r, &tag, "physical tag");
+        if (st == GETME_IO_OK)
+            st = add_phys(r, tag, cap);
+    }
+    if (dim > 0 && st == GETME_IO_OK)
+        st = read_count(r, &n, "number of bounding entities", 2);
+    for (uint64_t i = 0; dim > 0 && i < n && st == GETME_IO_OK; i++) {
+        int tag = 0;
+        st = read_int(r, &tag, "bounding entity tag");
+    }
+    return st;
+}
+
+static int cmp_entity(const void *a, const void *b)
+{
+    const msh41_entity *x = a, *y = b;
+    if (x->dim != y->dim)
+        return x->dim < y->dim ? -1 : 1;
+    return (x->tag > y->tag) - (x->tag < y->tag);
+}
+
+msh41_entity *msh41_find_entity(const msh41_reader *r, int dim, int tag)
+{
+    msh41_entity key;
+    key.dim = dim;
+    key.tag = tag;
+    return r->nents ? bsearch(&key, r->ents, r->nents, sizeof key, cmp_entity)
+                    : NULL;
+}
+
+static getme_io_status read_entities(msh41_reader *r)
+{
+    uint64_t count[4], total = 0;
+    size_t cap = 0;
+    r->section = "Entities";
+    if (r->ents || r->have_nodes)
+        return msh41_decline(r, "$Entities repeated or after $Nodes");
+    getme_io_status st = GETME_IO_OK;
+    for (int d = 0; d < 4 && st == GETME_IO_OK; d++) {
+        st = read_count(r, &count[d], "number of entities", 8);
+        total += st == GETME_IO_OK ? count[d] : 0;
+    }
+    if (st == GETME_IO_OK && total > 0) {
+        r->ents = calloc((size_t)total, sizeof *r->ents);
+        if (!r->ents)
+            st = oom(r);
+    }
+    for (int d = 0; d < 4 && st == GETME_IO_OK; d++)
+        for (uint64_t i = 0; i < count[d] && st == GETME_IO_OK; i++) {
+            st = read_entity(r, d, &r->ents[r->nents], &cap);
+            r->nents += st == GETME_IO_OK;
+        }
+    if (st == GETME_IO_OK)
+        st = expect_end(r);
+    if (st == GETME_IO_OK && r->nents) {
+        qsort(r->ents, r->nents, sizeof *r->ents, cmp_entity);
+        for (size_t i = 1; i < r->nents; i++)
+            if (cmp_entity(&r->ents[i - 1], &r->ents[i]) == 0)
+                return msh41_fail(r, GETME_IO_ERR_PARSE,
+                                  "entity (%d, %d) is defined twice",
+                                  r->ents[i].dim, r->ents[i].tag);
+    }
+    return st;
+}
+
+/* ---- --fix groups ------------------------------------------------------- */
+
+const char *msh41_group_name(const msh41_reader *r, int dim, int tag)
+{
+    const char *name = NULL; /* the last definition wins, as in Gmsh */
+    for (size_t i = 0; i < r->nnames; i++)
+        if (r->names[i].dim == dim && r->names[i].tag == tag)
+            name = r->names[i].name;
+    return name;
+}
+
+/* Mark the entities of the groups each --fix word names (groups are
+   (dim, physical tag) pairs that some entity carries). */
+static getme_io_status prepare_groups(msh41_reader *r)
+{
+    int nfix = r->opts ? r->opts->num_fix : 0;
+    if (r->groups_ready || nfix == 0) {
+        r->groups_ready = 1;
+        return GETME_IO_OK;
+    }
+    r->groups_ready = 1;
+    r->fix_found = calloc((size_t)nfix, sizeof *r->fix_found);
+    if (!r->fix_found)
+        return oom(r);
+    for (int w = 0; w < nfix; w++) {
+        const char *word = r->opts->fix[w];
+        int dim, tag, used = 0;
+        int by_tag = sscanf(word, "%d:%d%n", &dim, &tag, &used) == 2 &&
+                     word[used] == 0;
+        for (size_t i = 0; i < r->nents; i++) {
+            msh41_entity *e = &r->ents[i];
+            for (size_t k = 0; k < e->phys_count; k++) {
+                int p = r->phys[e->phys_first + k];
+                const char *name = by_tag ? NULL
+                                          : msh41_group_name(r, e->dim, p);
+                int match = by_tag ? (e->dim == dim && p == tag)
+                                   : (name && strcmp(name, word) == 0);
+                if (match) {
+                    e->fix = 1;
+                    r->fix_found[w]++;
+                }
+            }
+        }
+    }
+    return GETME_IO_OK;
+}
+
+/* ---- $Nodes ------------------------------------------------------------- */
+
+static getme_io_status alloc_nodes(msh41_reader *r, uint64_t nblocks,
+                                   uint64_t n)
+{
+    if (n > (uint64_t)INT32_MAX)
+        return msh41_fail(r, GETME_IO_ERR_UNSUPPORTED,
+                          "%llu nodes: more than 2^31-1 are not supported",
+                          (unsigned long long)n);
+    size_t k = n ? (size_t)n : 1;
+    r->tags = malloc(k * sizeof *r->tags);
+    r->xyz = malloc(3 * k * sizeof *r->xyz);
+    r->flag = calloc(k, 1);
+    r->nb = malloc((nblocks ? (size_t)nblocks : 1) * sizeof *r->nb);
+    if (!r->tags || !r->xyz || !r->flag || !r->nb)
+        return oom(r);
+    return GETME_IO_OK;
+}
+
+/* Node tags of one block: binary as one array, decoded in place. */
+static getme_io_status read_node_tags(msh41_reader *r, uint64_t *tags,
+                                      size_t n)
+{
+    if (!r->binary) {
+        getme_io_status st = GETME_IO_OK;
+        for (size_t i = 0; i < n && st == GETME_IO_OK; i++)
+            st = read_u64(r, &tags[i], "node tag");
+        return st;
+    }
+    if (msh41_in_read(&r->in, tags, n * 8))
+        return eof_error(r);
+    for (size_t i = 0; i < n; i++)
+        tags[i] = le64((const unsigned char *)&tags[i]);
+    return GETME_IO_OK;
+}
+
+/* Coordinates of one block.  ASCII: one node per line, which the writer
+   relies on (anything else is declined). */
+static getme_io_status read_node_coords(msh41_reader *r, double *xyz,
+                                        size_t n)
+{
+    if (r->binary) {
+        if (msh41_in_read(&r->in, xyz, 3 * n * 8))
+            return eof_error(r);
+        for (size_t i = 0; i < 3 * n; i++) {
+            uint64_t bits = le64((const unsigned char *)&xyz[i]);
+            memcpy(&xyz[i], &bits, sizeof bits);
+        }
+        return GETME_IO_OK;
+    }
+    getme_io_status st = GETME_IO_OK;
+    for (size_t i = 0; i < n && st == GETME_IO_OK; i++) {
+        for (int k = 0; k < 3 && st == GETME_IO_OK; k++)
+            st = read_double(r, &xyz[3 * i + k]);
+        if (st == GETME_IO_OK && !msh41_in_eol(&r->in))
+            st = msh41_decline(r, "node coordinates not one node per line");
+    }
+    return st;
+}
+
+static getme_io_status read_node_block(msh41_reader *r, size_t *filled)
+{
+    msh41_nblock *b = &r->nb[r->nnb];
+    int param = 0;
+    uint64_t count = 0;
+    getme_io_status st = read_int(r, &b->dim, "entity dimension");
+    if (st == GETME_IO_OK)
+        st = read_int(r, &b->tag, "entity tag");
+    if (st == GETME_IO_OK)
+        st = read_int(r, &param, "parametric flag");
+    if (st == GETME_IO_OK)
+        st = read_u64(r, &count, "number of nodes in block");
+    if (st != GETME_IO_OK)
+        return st;
+    if (b->dim < 0 || b->dim > 3 || param < 0 || param > 1)
+        return msh41_fail(r, GETME_IO_ERR_PARSE,
+                          "bad node block header (dimension %d, parametric "
+                          "%d)",
+                          b->dim, param);
+    if (param)
+        return msh41_decline(r, "parametric nodes");
+    if (count > r->nnodes - *filled)
+        return msh41_fail(r, GETME_IO_ERR_PARSE,
+                          "node blocks hold more nodes than the %zu declared",
+                          r->nnodes);
+    b->first = *filled;
+    b->count = (size_t)count;
+    st = read_node_tags(r, r->tags + b->first, b->count);
+    if (st == GETME_IO_OK)
+        st = read_node_coords(r, r->xyz + 3 * b->first, b->count);
+    /* A point's group fixes the point's node (Gmsh: mesh_vertices[0]). */
+    const msh41_entity *e = msh41_find_entity(r, b->dim, b->tag);
+    if (st == GETME_IO_OK && b->dim == 0 && e && e->fix && b->count)
+        r->flag[b->first] |= MSH41_FIXGRP;
+    *filled += b->count;
+    r->nnb++;
+    return st;
+}
+
+static getme_io_status read_nodes(msh41_reader *r)
+{
+    uint64_t nblocks = 0, n = 0, lo, hi;
+    r->section = "Nodes";
+    if (r->have_nodes)
+        return msh41_decline(r, "several $Nodes sections");
+    r->have_nodes = 1;
+    r->nodes_offset = msh41_in_offset(&r->in);
+    getme_io_status st = prepare_groups(r);
+    if (st == GETME_IO_OK)
+        st = read_count(r, &nblocks, "number of node blocks", 8);
+    if (st == GETME_IO_OK)
+        st = read_count(r, &n, "number of nodes", 8);
+    if (st == GETME_IO_OK)
+        st = read_u64(r, &lo, "minimum node tag");
+    if (st == GETME_IO_OK)
+        st = read_u64(r, &hi, "maximum node tag");
+    if (st == GETME_IO_OK)
+        st = alloc_nodes(r, nblocks, n);
+    r->nnodes = st == GETME_IO_OK ? (size_t)n : 0;
+    size_t filled = 0;
+    for (uint64_t b = 0; b < nblocks && st == GETME_IO_OK; b++)
+        st = read_node_block(r, &filled);
+    if (st == GETME_IO_OK && filled != r->nnodes)
+        st = msh41_fail(r, GETME_IO_ERR_PARSE,
+                        "$Nodes declares %zu nodes, its blocks hold %zu",
+                        r->nnodes, filled);
+    if (st == GETME_IO_OK)
+        st = expect_end(r);
+    if (st == GETME_IO_OK)
+        st = msh41_map_build(r, &r->map, r->tags, r->nnodes);
+    return st;
+}
+
+/* ---- $Elements ---------------------------------------------------------- */
+
+static void drop_blocks(msh41_reader *r)
+{
+    for (size_t i = 0; i < r->neb; i++) {
+        free(r->eb[i].conn);
+        free(r->eb[i].ids);
+    }
+    r->neb = 0;
+}
+
+/* A block of the (so far) highest dimension, with room for its elements
+   if GETMe can smooth its type. */
+static getme_io_status new_eblock(msh41_reader *r, int dim, int tag,
+                                  int type, uint64_t count, int nv,
+                                  msh41_eblock **out)
+{
+    if (dim > r->top_dim)
+        drop_blocks(r);
+    r->top_dim = dim;
+    if (r->neb == r->cap_eb) {
+        size_t cap = r->cap_eb ? 2 * r->cap_eb : 16;
+        msh41_eblock *nb = realloc(r->eb, cap * sizeof *nb);
+        if (!nb)
+            return oom(r);
+        r->eb = nb;
+        r->cap_eb = cap;
+    }
+    if (count > (uint64_t)INT32_MAX)
+        return msh41_fail(r, GETME_IO_ERR_UNSUPPORTED,
+                          "More than 2^31-1 elements are not supported");
+    msh41_eblock *b = &r->eb[r->neb++];
+    memset(b, 0, sizeof *b);
+    b->tag = tag;
+    b->type = type;
+    b->count = (int32_t)count;
+    int order = 0;
+    msh41_type_nodes(type, &order);
+    int linear = order == 1 && ((dim == 3 && type >= 4 && type <= 7) ||
+                                (dim == 2 && (type == 2 || type == 3)));
+    if (linear) {
+        b->conn = malloc((size_t)count * (size_t)nv * sizeof *b->conn);
+        b->ids = malloc((size_t)count * sizeof *b->ids);
+        if (!b->conn || !b->ids)
+            return oom(r);
+    }
+    *out = b;
+    return GETME_IO_OK;
+}
+
+/* One element: rec = tag + nv node tags.  Nodes must exist (as for Gmsh's
+   reader); kept blocks store file indices, --fix groups flag nodes. */
+static getme_io_status take_element(msh41_reader *r, msh41_eblock *b,
+                                    size_t i, const uint64_t *rec, int nv,
+                                    int fix)
+{
+    for (int k = 0; k < nv; k++) {
+        int32_t idx = msh41_map_find(&r->map, rec[1 + k]);
+        if (idx < 0)
+            return msh41_fail(r, GETME_IO_ERR_PARSE,
+                              "element %llu uses node %llu, which is not in "
+                              "$Nodes",
+                              (unsigned long long)rec[0],
+                              (unsigned long long)rec[1 + k]);
+        if (fix)
+            r->flag[idx] |= MSH41_FIXGRP;
+        if (b && b->conn)
+            b->conn[i * (size_t)nv + (size_t)k] = idx;
+    }
+    if (b && b->ids)
+        b->ids[i] = (int64_t)rec[0];
+    return GETME_IO_OK;
+}
+
+/* Binary elements are read a chunk of records at a time. */
+#define REC_CHUNK 4096
+
+static getme_io_status read_binary_elements(msh41_reader *r, msh41_eblock *b,
+                                            uint64_t count, int nv, int fix)
+{
+    size_t rec = (size_t)nv + 1;
+    uint64_t *buf = malloc(REC_CHUNK * rec * sizeof *buf);
+    if (!buf)
+        return oom(r);
+    getme_io_status st = GETME_IO_OK;
+    for (uint64_t i0 = 0; i0 < count && st == GETME_IO_OK; i0 += REC_CHUNK) {
+        size_t k = count - i0 < REC_CHUNK ? (size_t)(count - i0) : REC_CHUNK;
+        if (msh41_in_read(&r->in, buf, k * rec * 8)) {
+            st = eof_error(r);
+            break;
+        }
+        for (size_t j = 0; j < k * rec; j++)
+            buf[j] = le64((const unsigned char *)&buf[j]);
+        for (size_t j = 0; j < k && st == GETME_IO_OK; j++)
+            st = take_element(r, b, (size_t)i0 + j, buf + j * rec, nv, fix);
+    }
+    free(buf);
+    return st;
+}
+
+static getme_io_status read_ascii_elements(msh41_reader *r, msh41_eblock *b,
+                                           uint64_t count, int nv, int fix)
+{
+    uint64_t rec[128];
+    getme_io_status st = GETME_IO_OK;
+    for (uint64_t i = 0; i < count && st == GETME_IO_OK; i++) {
+        st = read_u64(r, &rec[0], "element tag");
+        for (int k = 0; k < nv && st == GETME_IO_OK; k++)
+            st = read_u64(r, &rec[1 + k], "node tag");
+        if (st == GETME_IO_OK)
+            st = take_element(r, b, (size_t)i, rec, nv, fix);
+    }
+    return st;
+}
+
+static getme_io_status read_element_block(msh41_reader *r)
+{
+    int dim = 0, tag = 0, type = 0;
+    uint64_t count = 0;
+    getme_io_status st = read_int(r, &dim, "entity dimension");
+    if (st == GETME_IO_OK)
+        st = read_int(r, &tag, "entity tag");
+    if (st == GETME_IO_OK)
+        st = read_int(r, &type, "element type");
+    if (st != GETME_IO_OK)
+        return st;
+    int nv = msh41_type_nodes(type, NULL);
+    if (nv == 0)
+        return msh41_decline(r, "an element type this reader does not know");
+    st = read_count(r, &count, "number of elements in block",
+                    (uint64_t)(nv + 1) * (r->binary ? 8 : 2));
+    if (st != GETME_IO_OK)
+        return st;
+    if (dim < 0 || dim > 3)
+        return msh41_fail(r, GETME_IO_ERR_PARSE,
+                          "bad element block dimension %d", dim);
+    const msh41_entity *e = msh41_find_entity(r, dim, tag);
+    msh41_eblock *b = NULL;
+    if (dim >= 2 && dim >= r->top_dim && count > 0)
+        st = new_eblock(r, dim, tag, type, count, nv, &b);
+    if (st != GETME_IO_OK)
+        return st;
+    int fix = e && e->fix;
+    return r->binary ? read_binary_elements(r, b, count, nv, fix)
+                     : read_ascii_elements(r, b, count, nv, fix);
+}
+
+static getme_io_status read_elements(msh41_reader *r)
+{
+    uint64_t nblocks = 0, n, lo, hi;
+    r->section = "Elements";
+    if (!r->have_nodes)
+        return msh41_fail(r, GETME_IO_ERR_PARSE, "$Elements before $Nodes");
+    if (r->have_elements)
+        return msh41_decline(r, "several $Elements sections");
+    r->have_elements = 1;
+    getme_io_status st = read_count(r, &nblocks, "number of element blocks", 8);
+    if (st == GETME_IO_OK)
+        st = read_count(r, &n, "number of elements", 8);
+    if (st == GETME_IO_OK)
+        st = read_u64(r, &lo, "minimum element tag");
+    if (st == GETME_IO_OK)
+        st = read_u64(r, &hi, "maximum element tag");
+    for (uint64_t b = 0; b < nblocks && st == GETME_IO_OK; b++)
+        st = read_element_block(r);
+    if (st == GETME_IO_OK)
+        st = expect_end(r);
+    return st;
+}
+
+/* ---- the file ----------------------------------------------------------- */
+
+static getme_io_status read_section(msh41_reader *r, const char *name)
+{
+    if (strcmp(name, "PhysicalNames") == 0)
+        return read_physical_names(r);
+    if (strcmp(name, "Entities") == 0)
+        return read_entities(r);
+    if (strcmp(name, "Nodes") == 0)
+        return read_nodes(r);
+    if (strcmp(name, "Elements") == 0)
+        return read_elements(r);
+    if (strcmp(name, "PartitionedEntities") == 0)
+        return msh41_decline(r, "partitioned mesh");
+    if (strcmp(name, "MeshFormat") == 0) {
+        r->section = "MeshFormat";
+        return msh41_fail(r, GETME_IO_ERR_PARSE, "second $MeshFormat");
+    }
+    return skip_section(r, name);
+}
+
+static getme_io_status read_file(msh41_reader *r)
+{
+    getme_io_status st = read_format(r);
+    char line[TOK];
+    while (st == GETME_IO_OK && msh41_in_line(&r->in, line, sizeof line) == 0)
+        if (line[0] == '$') /* Gmsh ignores anything between sections */
+            st = read_section(r, line + 1);
+    return st;
+}
+
+static void reader_free(msh41_reader *r)
+{
+    msh41_in_close(&r->in);
+    for (size_t i = 0; i < r->nnames; i++)
+        free(r->names[i].name);
+    free(r->names);
+    free(r->ents);
+    free(r->phys);
+    free(r->fix_found);
+    free(r->tags);
+    free(r->xyz);
+    free(r->flag);
+    free(r->nb);
+    msh41_map_free(&r->map);
+    drop_blocks(r);
+    free(r->eb);
+}
+
+static void remember_identity(msh41_doc *m, FILE *f)
+{
+    struct stat sb;
+    if (fstat(fileno(f), &sb) != 0)
+        return;
+    m->size = (int64_t)sb.st_size;
+    m->mtime_ns = (int64_t)sb.st_mtim.tv_sec * 1000000000 + sb.st_mtim.tv_nsec;
+    m->dev = (uint64_t)sb.st_dev;
+    m->ino = (uint64_t)sb.st_ino;
+}
+
+/* Undo a partial open so that the Gmsh path starts from a clean doc. */
+static void reset_doc(getme_doc *doc)
+{
+    getme_mesh_free(doc->mesh);
+    doc->mesh = NULL;
+    free(doc->elem_ids);
+    doc->elem_ids = NULL;
+    doc->info[0] = 0;
+    doc->error[0] = 0;
+}
+
+getme_io_status msh41_open(getme_doc *doc, const getme_doc_options *opts,
+                           msh41_doc **out, int *eligible, char *why,
+                           size_t why_size)
+{
+    msh41_reader r;
+    memset(&r, 0, sizeof r);
+    r.doc = doc;
+    r.opts = opts;
+    *out = NULL;
+    *eligible = 1;
+    msh41_doc *m = calloc(1, sizeof *m);
+    if (!m)
+        return getme_doc_fail(doc, GETME_IO_ERR_INTERNAL, "Out of memory");
+    if (msh41_in_open(&r.in, doc->path)) {
+        free(m);
+        return getme_doc_fail(doc, GETME_IO_ERR_OPEN, "Cannot open '%s': %s",
+                              doc->path, strerror(errno));
+    }
+    remember_identity(m, r.in.f);
+    r.file_size = m->size > 0 ? m->size : 1;
+    getme_io_status st = read_file(&r);
+    if (st == GETME_IO_OK)
+        st = msh41_build(&r, m);
+    m->binary = r.binary;
+    m->nodes_offset = r.nodes_offset;
+    reader_free(&r);
+    if (st == MSH41_DECLINED) {
+        *eligible = 0;
+        snprintf(why, why_size, "%s", r.why);
+        reset_doc(doc);
+        st = GETME_IO_OK;
+    }
+    if (st != GETME_IO_OK || !*eligible) {
+        msh41_free(m);
+        return st;
+    }
+    *out = m;
+    return GETME_IO_OK;
+}
+
+void msh41_free(msh41_doc *m)
+{
+    if (!m)
+        return;
+    msh41_map_free(&m->map);
+    free(m);
+}
