@@ -13,7 +13,10 @@ cached too.  Every method then runs in its own process under /usr/bin/time
 on the same distorted file; its output file is read back with meshio and
 measured here in numpy (quality.py, skin.py), never trusted from the tool.
 Results: tables on stdout, bench-<size>.{txt,csv,json} and PNG plots in
---out (default bench/results/<size>).  Docs: docs/bench.md.
+--out (default bench/results/<size>); under each case's table a "Cost and
+scaling" table gives ns per element-iteration and the 2-thread speedup
+(cost.py).  bench/scaling.py compares those across sizes.  Docs:
+docs/bench.md.
 
 Exit status: 0 all runs fine, 1 a run failed or gave an invalid mesh where
 it must not, 2 usage, 3 a required tool is missing.
@@ -29,6 +32,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 
+import cost  # noqa: E402
 import meshes  # noqa: E402
 import methods as M  # noqa: E402
 import runner  # noqa: E402
@@ -216,6 +220,7 @@ def run_method(ctx, case, method, src, ref, params=(), tag=None):
     if row.get("seconds") is None:
         row["seconds"] = r.wall
     measure(row, ref, dst)
+    row.update(cost.cost_fields(row))
     same = r.last_json().get("same_connectivity")
     if row["topology"].startswith("yes (reconnected)") and same:
         # Gmsh renumbered the nodes but kept the connectivity
@@ -318,13 +323,36 @@ def bench_case(ctx, case, meta):
              f"{init['q_min_star']:.4f}, q_mean {init['q_mean']:.4f}"]
     failed = any(check_row(r, notes) for r in rows[1:]
                  if not r["status"].startswith("skipped"))
-    text = tables.format_table(title, rows, notes)
+    speedup = add_speedups(rows[1:])
+    text = tables.format_table(title, rows, notes) + "\n\n" + cost_table(
+        f"Cost and scaling, {case}-{ctx.args.size}", rows[1:], speedup)
     print(text + "\n", flush=True)
     case_out = {"title": title, "mesh": os.path.basename(src),
                 "distorted": os.path.basename(dist), "generated": gen_st,
                 "initial": init, "initial_row": rows[0], "rows": rows[1:],
-                "text": text}
+                "speedup_2t": speedup, "text": text}
     return case_out, failed
+
+
+def add_speedups(rows):
+    """time(1 thread) / time(2 threads) per getme method, also put on the
+    2-thread rows (for the CSV)."""
+    speedup = cost.speedups(rows)
+    for row in rows:
+        s = speedup.get(cost.smoother(row) or "")
+        if s and row.get("threads") == 2:
+            row["speedup_2t"] = s.get("total")
+            row["speedup_2t_stage1"] = s.get("stage1")
+    return speedup
+
+
+def cost_table(title, rows, speedup):
+    """Time per element-iteration of getme's own methods, the 2-thread
+    speedup under it (cost.py says how each number is made)."""
+    ours = [r for r in rows if cost.is_smoother(r)]
+    if not ours:
+        return title + ": no getme runs"
+    return tables.format_cost_table(title, ours, [cost.speedup_note(speedup)])
 
 
 def merge_previous(path, cases):

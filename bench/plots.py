@@ -61,3 +61,31 @@ def plot_histogram(case, path):
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def plot_scaling(summary, path, cpu):
+    """ns per element-iteration of GETMe adaptive's stage 1 against the
+    element count (log x), one line per case and thread count."""
+    fig, ax = plt.subplots(figsize=(7.5, 4.5))
+    colors = {}
+    for s in summary:
+        if s["field"] != "ns_el_it_stage1":
+            continue
+        color = colors.setdefault(s["case"], f"C{len(colors)}")
+        sizes = sorted(s["values"], key=s["elements"].get)
+        x = [s["elements"][z] for z in sizes]
+        y = [s["values"][z] for z in sizes]
+        ax.plot(x, y, "-o" if s["threads"] == 1 else "--s", color=color, lw=1.4, ms=5,
+                label=f"{s['case']}, {s['threads']} thread{'s' * (s['threads'] > 1)}")
+        for xi, yi, z in zip(x, y, sizes):
+            ax.annotate(z, (xi, yi), textcoords="offset points", xytext=(4, 4), fontsize=7)
+    ax.set_xscale("log")
+    ax.set_ylim(bottom=0)
+    ax.set_xlabel("elements")
+    ax.set_ylabel("ns per element-iteration, GETMe stage 1")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
+    ax.set_title(f"getme stage-1 cost against mesh size\n{cpu}", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

@@ -10,6 +10,7 @@ COLUMNS = [  # (header, row key, format)
     ("dMem GiB", "delta_gib", "{:.3f}"),
     ("Time s", "seconds", "{:.2f}"),
     ("Iter", "iterations", "{}"),
+    ("ns/el-it", "ns_el_it", "{:.1f}"),
     ("q*min", "q_min_star", "{:.4f}"),
     ("q_mean", "q_mean", "{:.4f}"),
     ("#q<=0.4", "n_le_04", "{}"),
@@ -24,7 +25,20 @@ CSV_FIELDS = ["size", "case", "method", "label", "status", "peak_gib",
               "delta_gib", "seconds", "wall", "iterations_mean",
               "iterations_min", "q_min_star", "q_min", "q_mean", "n_le_04",
               "n_lt_01", "invalid", "elements", "nodes", "free_nodes",
-              "topology", "report_q_min_star", "report_q_mean"]
+              "topology", "report_q_min_star", "report_q_mean", "threads",
+              "ns_el_it", "stage1_iterations", "stage1_seconds",
+              "ns_el_it_stage1", "speedup_2t", "speedup_2t_stage1"]
+
+COST_COLUMNS = [  # the "Cost and scaling" table of getme's own methods
+    ("Method", "label", "{}"),
+    ("Elements", "elements", "{}"),
+    ("Time s", "seconds", "{:.2f}"),
+    ("Iter", "iterations", "{}"),
+    ("ns/el-it", "ns_el_it", "{:.1f}"),
+    ("Stage-1 it", "stage1_iterations", "{}"),
+    ("ns/el-it (stage 1)", "ns_el_it_stage1", "{:.1f}"),
+    ("Speedup 1/2 thr", "speedup_2t", "{:.2f}x"),
+]
 
 
 def _cell(row, key, fmt):
@@ -37,25 +51,34 @@ def _cell(row, key, fmt):
         return str(value)
 
 
-def format_table(title, rows, notes=()):
-    """Fixed-width text table with a title line and note lines under it."""
-    cells = [[h for h, _, _ in COLUMNS]]
+def format_table(title, rows, notes=(), columns=COLUMNS, last_text=True):
+    """Fixed-width text table with a title line and note lines under it
+    (numbers right-aligned; the first column and, if last_text, the last
+    are text, left-aligned)."""
+    cells = [[h for h, _, _ in columns]]
     for row in rows:
         if row.get("status", "ok") != "ok":
-            cells.append([row["label"], row["status"]] + [""] * (len(COLUMNS) - 2))
+            cells.append([row["label"], row["status"]] + [""] * (len(columns) - 2))
         else:
-            cells.append([_cell(row, k, f) for _, k, f in COLUMNS])
-    widths = [max(len(r[i]) for r in cells if i < len(r)) for i in range(len(COLUMNS))]
-    widths[1] = max(len(COLUMNS[1][0]), 7)  # status text may overflow
+            cells.append([_cell(row, k, f) for _, k, f in columns])
+    widths = [max(len(r[i]) for r in cells if i < len(r)) for i in range(len(columns))]
+    widths[1] = max(len(columns[1][0]), 7)  # status text may overflow
     lines = [title]
     for r in cells:
         parts = [r[0].ljust(widths[0])]
-        # numbers right-aligned, the text columns (first, last) left-aligned
-        parts += [c.rjust(w) for c, w in zip(r[1:-1], widths[1:-1])]
-        parts.append(r[-1])
+        numbers = slice(1, -1) if last_text else slice(1, None)
+        parts += [c.rjust(w) for c, w in zip(r[numbers], widths[numbers])]
+        if last_text:
+            parts.append(r[-1])
         lines.append("  ".join(parts).rstrip())
     lines.extend(notes)
     return "\n".join(lines)
+
+
+def format_cost_table(title, rows, notes=()):
+    """The small "Cost and scaling" table: time per element-iteration of
+    getme's own methods (see cost.py)."""
+    return format_table(title, rows, notes, columns=COST_COLUMNS, last_text=False)
 
 
 def write_csv(path, rows):
