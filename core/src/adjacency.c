@@ -17,7 +17,8 @@
 
 void getme__adj_free(getme_adj *adj)
 {
-    free(adj->eid);
+    free(adj->eptr);
+    free(adj->eslot);
     free(adj->fnb);
     free(adj->count);
     free(adj->irregular);
@@ -104,7 +105,8 @@ static void assign_edge(void *ctx, int32_t n, int t, int j, int slot)
 {
     edge_pass *p = ctx;
     int32_t id = (int32_t)(p->first + slot);
-    ((int32_t *)getme__adj_edges(p->adj, p->ws, t, n))[j] = id;
+    getme__adj_slots(p->adj, p->ws, t, n)[j] =
+        (uint8_t)(slot < GETME_NO_SLOT ? slot : GETME_NO_SLOT);
     p->edeg[id]++;
     if (p->re)
         p->re[id] += check_value(n);
@@ -125,10 +127,11 @@ static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
                  getme__edges[t].num_edges;
     }
     int64_t *eptr = malloc(((size_t)ws->nn + 1) * sizeof *eptr);
-    adj->eid = malloc((size_t)(total ? total : 1) * sizeof *adj->eid);
+    adj->eptr = malloc(((size_t)ws->nn + 1) * sizeof *adj->eptr);
+    adj->eslot = malloc((size_t)(total ? total : 1));
     size_t bufsize = (size_t)ws->max_star * 4 + 1;
     int32_t *bufs = malloc((size_t)ws->nt * bufsize * sizeof *bufs);
-    if (!eptr || !adj->eid || !bufs) {
+    if (!eptr || !adj->eptr || !adj->eslot || !bufs) {
         free(eptr), free(bufs);
         return GETME_ERR_NOMEM;
     }
@@ -144,6 +147,8 @@ static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
         return GETME_ERR_NOMEM;
     }
     adj->num_edges = (int32_t)eptr[ws->nn];
+    for (int32_t u = 0; u <= ws->nn; u++)
+        adj->eptr[u] = (int32_t)eptr[u];
     size_t nedge = (size_t)(adj->num_edges ? adj->num_edges : 1);
     int32_t *edeg = calloc(nedge, sizeof *edeg);
     uint64_t *re = rn ? calloc(nedge, sizeof *re) : NULL;
@@ -203,12 +208,15 @@ static void counts_and_flags(getme_adj *adj, const getme_ws *ws,
         if (ws->dim == 2) {
             cnt -= (nv - 1) + nb;
         } else {
-            const int32_t *id = getme__adj_edges(adj, ws, t, e);
-            for (int j = 0; j < getme__edges[t].num_edges; j++)
-                cnt -= edeg[id[j]];
+            const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
+            for (int j = 0; j < getme__edges[t].num_edges; j++) {
+                bad |= slot[j] == GETME_NO_SLOT;
+                cnt -= edeg[getme__adj_edge(adj, c, t, j, slot[j])];
+            }
             cnt += (ft->num_faces - 1) + nb;
         }
-        adj->count[e] = (int32_t)cnt;
+        bad |= cnt > UINT16_MAX;
+        adj->count[e] = (uint16_t)(bad ? 0 : cnt);
         adj->irregular[e] = (uint8_t)(bad != 0);
     }
 }
@@ -254,14 +262,14 @@ static void check_element(getme_adj *adj, const getme_ws *ws,
     if (ws->dim == 2) {
         formula -= (uint64_t)(nv - 1) * self + fs;
     } else {
-        const int32_t *id = getme__adj_edges(adj, ws, t, e);
+        const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
         for (int j = 0; j < getme__edges[t].num_edges; j++)
-            formula -= re[id[j]];
+            formula -= re[getme__adj_edge(adj, c, t, j, slot[j])];
         formula += (uint64_t)(ft->num_faces - 1) * self + fs;
     }
-    if (formula != truth)
+    if (formula != truth || cnt > UINT16_MAX)
         adj->irregular[e] = 1;
-    adj->count[e] = cnt;
+    adj->count[e] = (uint16_t)(adj->irregular[e] ? 0 : cnt);
 }
 
 static getme_status check_all(getme_adj *adj, const getme_ws *ws,
@@ -352,10 +360,11 @@ static inline void add_block_sums(int t, getme_adj *adj, const getme_ws *ws,
         for (int i = 0; i < nv; i++)
             adj->nsum[c[i]] += v;
         if (ned == 0)
-            continue; /* planar: no edge sums (and no eid array) */
-        const int32_t *id = getme__adj_edges(adj, ws, t, e);
+            continue; /* planar: no edge sums (and no edge arrays) */
+        const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
         for (int j = 0; j < ned; j++)
-            adj->esum[id[j]] += v;
+            if (slot[j] != GETME_NO_SLOT)
+                adj->esum[getme__adj_edge(adj, c, t, j, slot[j])] += v;
     }
 }
 

@@ -192,6 +192,20 @@ static int cmp_int32(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* Room for n entries in run->tlist; 0, or -1 if out of memory. */
+static int tlist_reserve(getme_run *run, int64_t n)
+{
+    if (n <= run->cap_t)
+        return 0;
+    int64_t cap = n > 2 * run->cap_t ? n : 2 * run->cap_t;
+    int32_t *p = realloc(run->tlist, (size_t)cap * sizeof *p);
+    if (!p)
+        return -1;
+    run->tlist = p;
+    run->cap_t = cap;
+    return 0;
+}
+
 /* After an iteration of the q*_min stage: bring the Eq. 9 sums up to date
    by the quality changes of the elements that moved (run->elems; their old
    qualities are in run->qold), and the list of elements with q <= q_t
@@ -199,11 +213,13 @@ static int cmp_int32(const void *a, const void *b)
    updated serially in list order, so they do not depend on the thread
    count; each cycle start recomputes them from scratch, which bounds the
    rounding drift of the updates. */
-static void update_after(getme_run *run, double qt)
+static getme_status update_after(getme_run *run, double qt)
 {
     const getme_ws *ws = run->ws;
     getme_adj *adj = run->adj;
-    for (int32_t k = 0; k < run->num_elems; k++) {
+    if (!run->qold) /* no room for the old qualities: recompute all sums */
+        getme__adj_sums_all(adj, ws, run->q);
+    for (int32_t k = 0; run->qold && k < run->num_elems; k++) {
         int32_t e = run->elems[k];
         double d = run->q[e] - run->qold[k];
         if (d == 0.0)
@@ -213,12 +229,15 @@ static void update_after(getme_run *run, double qt)
         for (int i = 0; i < getme__nv[t]; i++)
             adj->nsum[c[i]] += d;
         if (ws->dim == 3) {
-            const int32_t *id = getme__adj_edges(adj, ws, t, e);
+            const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
             for (int j = 0; j < getme__edges[t].num_edges; j++)
-                adj->esum[id[j]] += d;
+                if (slot[j] != GETME_NO_SLOT)
+                    adj->esum[getme__adj_edge(adj, c, t, j, slot[j])] += d;
         }
     }
 
+    if (tlist_reserve(run, (int64_t)run->num_t + run->num_elems) != 0)
+        return GETME_ERR_NOMEM;
     int32_t n = 0;
     for (int32_t k = 0; k < run->num_t; k++) {
         int32_t e = run->tlist[k];
@@ -236,19 +255,27 @@ static void update_after(getme_run *run, double qt)
     }
     qsort(run->tlist, (size_t)n, sizeof *run->tlist, cmp_int32);
     run->num_t = n;
+    return GETME_OK;
 }
 
-/* A new cycle's transformation list: the free elements with q <= q_t. */
-static void start_tlist(getme_run *run, double qt)
+/* A new cycle's transformation list: the free elements with q <= q_t.
+   GETME_OK or GETME_ERR_NOMEM. */
+static getme_status start_tlist(getme_run *run, double qt)
 {
     const getme_ws *ws = run->ws;
     int32_t n = 0;
     for (int32_t e = 0; e < ws->ne; e++) {
         run->tflag[e] = ws->free_elem[e] && run->q[e] <= qt;
+        n += run->tflag[e];
+    }
+    if (tlist_reserve(run, n) != 0)
+        return GETME_ERR_NOMEM;
+    n = 0;
+    for (int32_t e = 0; e < ws->ne; e++)
         if (run->tflag[e])
             run->tlist[n++] = e;
-    }
     run->num_t = n;
+    return GETME_OK;
 }
 
 /* ComputeNewNodes: p-hat = weighted sum / weight sum, for I_T. */
@@ -265,9 +292,22 @@ static void compute_new_nodes(getme_run *run)
     }
 }
 
+/* Room for the old qualities of run->num_elems elements in run->qold,
+   or run->qold = NULL (update_after then recomputes all sums). */
+static void qold_reserve(getme_run *run)
+{
+    if (run->num_elems <= run->cap_qold && run->qold)
+        return;
+    free(run->qold);
+    run->cap_qold = 2 * (int64_t)run->num_elems;
+    run->qold = malloc((size_t)run->cap_qold * sizeof *run->qold);
+    if (!run->qold)
+        run->cap_qold = 0;
+}
+
 /* One iteration of the main loop (Fig. 3 lines 5-9). */
-static void iterate(getme_run *run, double qt, const double *R, int nR,
-                    int32_t *num_transformed, int32_t *num_relaxed)
+static getme_status iterate(getme_run *run, double qt, const double *R, int nR,
+                            int32_t *num_transformed, int32_t *num_relaxed)
 {
     double sigma = run->params->sigma;
     if (qt >= 1.0) {
@@ -277,13 +317,14 @@ static void iterate(getme_run *run, double qt, const double *R, int nR,
         *num_transformed = scatter_some(run, qt, sigma);
     }
     compute_new_nodes(run);
-    if (qt < 1.0)
-        for (int32_t k = 0; k < run->num_elems; k++)
+    if (qt < 1.0) {
+        qold_reserve(run);
+        for (int32_t k = 0; run->qold && k < run->num_elems; k++)
             run->qold[k] = run->q[run->elems[k]];
+    }
     *num_relaxed = getme__relax(run, R, nR);
     getme__reset_nodes(run);
-    if (qt < 1.0)
-        update_after(run, qt);
+    return qt < 1.0 ? update_after(run, qt) : GETME_OK;
 }
 
 /* Swap a <= b for quickselect. */
@@ -329,33 +370,71 @@ static double select_kth(double *v, int32_t n, int32_t k)
     return v[k];
 }
 
+static inline uint64_t bits_of(double v)
+{
+    uint64_t b;
+    memcpy(&b, &v, sizeof b);
+    return b;
+}
+
 /* DetermineTransformationThreshold: the quality at position
    fraction * n of the sorted qualities of the elements with a free node
-   (elements without one can never change, so they would only dilute it). */
-static double determine_threshold(getme_run *run, double *scratch)
+   (elements without one can never change, so they would only dilute it).
+   Without copying all n qualities: they are positive, so their bit
+   patterns sort like their values; a histogram of the top 16 bits, then
+   of the next 16 inside the chosen bin, leaves a handful of candidates for
+   the quickselect.  Returns -1 if out of memory. */
+static double determine_threshold(getme_run *run)
 {
     const getme_ws *ws = run->ws;
-    int32_t n = 0;
-    for (int32_t e = 0; e < ws->ne; e++)
-        if (ws->free_elem[e])
-            scratch[n++] = run->q[e];
+    int32_t n = ws->num_free_elem;
     if (n == 0)
         return 0.0;
     double pos = run->params->threshold_fraction * (double)n;
-    int32_t k = pos >= (double)(n - 1) ? n - 1 : pos <= 0.0 ? 0 : (int32_t)pos;
-    return select_kth(scratch, n, k);
+    int64_t k = pos >= (double)(n - 1) ? n - 1 : pos <= 0.0 ? 0 : (int64_t)pos;
+    int64_t *hist = malloc(65536 * sizeof *hist);
+    if (!hist)
+        return -1.0;
+    uint64_t prefix = 0, mask = 0;
+    int64_t in_bin = n;
+    for (int shift = 48; shift >= 32; shift -= 16) {
+        memset(hist, 0, 65536 * sizeof *hist);
+        for (int32_t e = 0; e < ws->ne; e++) {
+            uint64_t b = bits_of(run->q[e]);
+            if (ws->free_elem[e] && (b & mask) == prefix)
+                hist[(b >> shift) & 0xffff]++;
+        }
+        int64_t below = 0;
+        int bin = 0;
+        while (below + hist[bin] <= k)
+            below += hist[bin++];
+        k -= below;
+        in_bin = hist[bin];
+        prefix |= (uint64_t)bin << shift;
+        mask |= (uint64_t)0xffff << shift;
+    }
+    free(hist);
+    double *cand = malloc((size_t)in_bin * sizeof *cand);
+    if (!cand)
+        return -1.0;
+    int32_t m = 0;
+    for (int32_t e = 0; e < ws->ne; e++)
+        if (ws->free_elem[e] && (bits_of(run->q[e]) & mask) == prefix)
+            cand[m++] = run->q[e];
+    double qt = select_kth(cand, m, (int32_t)k);
+    free(cand);
+    return qt;
 }
 
-/* The method's own scratch: the q*_min stage's element list, and the
-   per-thread stamps of the union walk if some element needs it. */
+/* The method's own scratch: the q*_min stage's element flags (its lists
+   grow as needed), and the per-thread stamps of the union walk if some
+   element needs it. */
 static getme_status alloc_adaptive(getme_run *run)
 {
     const getme_ws *ws = run->ws;
     size_t ne = (size_t)(ws->ne ? ws->ne : 1);
-    run->tlist = malloc((size_t)(ws->num_free_elem ? ws->num_free_elem : 1) *
-                        sizeof *run->tlist);
     run->tflag = calloc(ne, 1);
-    if (!run->tlist || !run->tflag)
+    if (!run->tflag)
         return GETME_ERR_NOMEM;
     if (run->adj->num_irregular == 0)
         return GETME_OK;
@@ -372,6 +451,8 @@ static void free_adaptive(getme_run *run)
 {
     free(run->tlist);
     free(run->tflag);
+    free(run->qold);
+    run->qold = NULL, run->cap_qold = 0, run->cap_t = 0;
     if (run->stamps)
         for (int t = 0; t < run->ws->nt; t++)
             free(run->stamps[t].mark);
@@ -384,21 +465,14 @@ getme_status getme__adaptive(getme_run *run)
     getme_ws *ws = run->ws;
     const getme_params *p = run->params;
     getme_result *res = run->result;
-    double *scratch = NULL, *best = NULL;
-    getme_adj adj;
-    getme_status st = getme__adj_build(&adj, ws);
+    double *best = NULL;
+    getme_status st = alloc_adaptive(run);
     if (st != GETME_OK)
-        return st;
-    run->adj = &adj;
-    if ((st = alloc_adaptive(run)) != GETME_OK)
         goto done;
     st = GETME_ERR_NOMEM;
-    scratch = malloc((size_t)(ws->num_free_elem ? ws->num_free_elem : 1) *
-                     sizeof *scratch);
     best = p->keep_best ? malloc((size_t)ws->nn * 3 * sizeof *best) : NULL;
-    if (!scratch || (p->keep_best && !best))
+    if (p->keep_best && !best)
         goto done;
-    run->qold = scratch; /* free between cycle starts */
     lists_all(run);
 
     double q_mean = res->q_mean_initial, q_min = res->q_min_star_initial;
@@ -415,7 +489,8 @@ getme_status getme__adaptive(getme_run *run)
         int32_t ntrans, nrelax;
         getme_stage stage = state == MEAN_RUNNING ? GETME_STAGE_MEAN
                                                   : GETME_STAGE_MIN;
-        iterate(run, qt, R, nR, &ntrans, &nrelax);
+        if ((st = iterate(run, qt, R, nR, &ntrans, &nrelax)) != GETME_OK)
+            break;
         double prev_mean = q_mean, prev_min = q_min;
         getme__ws_summary(ws, run->q, &q_mean, &q_min, NULL);
         res->iterations = it;
@@ -462,8 +537,11 @@ getme_status getme__adaptive(getme_run *run)
             record = best_min;
             state = MIN_RUNNING;
             counter = 0;
-            qt = determine_threshold(run, scratch);
-            start_tlist(run, qt);
+            qt = determine_threshold(run);
+            if (qt < 0.0 || (st = start_tlist(run, qt)) != GETME_OK) {
+                st = GETME_ERR_NOMEM;
+                break;
+            }
             getme__adj_sums_all(run->adj, ws, run->q);
             have_cycle = 1;
             res->cycles_min++;
@@ -479,10 +557,7 @@ getme_status getme__adaptive(getme_run *run)
     getme__ws_summary(ws, run->q, &res->q_mean, &res->q_min_star, &res->q_min);
     res->threshold = qt;
 done:
-    free(scratch);
     free(best);
     free_adaptive(run);
-    getme__adj_free(&adj);
-    run->adj = NULL;
     return st;
 }

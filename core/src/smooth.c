@@ -2,6 +2,7 @@
  * smooth.c -- getme_smooth(): check the input, build the workspace, run a
  * method, write the coordinates back, fill the result.
  */
+#include "adjacency.h"
 #include "smooth_internal.h"
 
 #include <omp.h>
@@ -192,7 +193,16 @@ getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
         return getme__fail(mesh, st, "out of memory building the workspace");
     getme_run run;
     memset(&run, 0, sizeof run);
+    getme_adj adj;
+    memset(&adj, 0, sizeof adj);
     run.ws = &ws;
+    if (params->method == GETME_METHOD_ADAPTIVE &&
+        (st = getme__adj_build(&adj, &ws)) != GETME_OK) {
+        getme__fail(mesh, st, "out of memory for the neighbour sums of %d "
+                              "elements", (int)ws.ne);
+        goto done;
+    }
+    run.adj = &adj;
     run.params = params;
     run.result = result;
     run.t0 = t0;
@@ -223,6 +233,7 @@ getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
         getme__fail(mesh, st, "%s", getme_status_string(st));
 done:
     getme__run_free(&run);
+    getme__adj_free(&adj);
     getme__ws_free(&ws);
     result->seconds = omp_get_wtime() - t0;
     return st;

@@ -43,9 +43,11 @@ typedef struct getme_run {
     getme_stamp *stamps;/* one per thread, only if adj has irregular ones   */
     int32_t *tlist;     /* q*_min stage: the elements with q <= q_t, sorted */
     int32_t num_t;
+    int64_t cap_t;      /* room in tlist                                    */
     uint8_t *tflag;     /* ne: element is in tlist                          */
     double *qold;       /* q*_min stage: qualities of run->elems before the
-                           relaxation step                                  */
+                           relaxation step (NULL: sums are recomputed)      */
+    int64_t cap_qold;
 } getme_run;
 
 getme_status getme__run_alloc(getme_run *run);
@@ -78,6 +80,8 @@ int getme__report(getme_run *run, int iteration, getme_stage stage, int cycle,
                   double q_min_star, double q_mean, double threshold,
                   int32_t num_transformed, int32_t num_relaxed);
 
+/* GETMe adaptive; run->adj must be built (getme_smooth does it before the
+   run's arrays, so that its temporaries do not add to the peak). */
 getme_status getme__adaptive(getme_run *run);
 getme_status getme__laplace(getme_run *run);
 
