@@ -63,9 +63,6 @@ extern const getme_edge_table getme__edges[GETME_NUM_TYPES];
 double getme__quality(int type, const double *x);
 
 double getme__quality_tet(const double *x);
-/* The qualities of n <= 8 tets (x: 12 doubles each) into q[0..n): the same
-   values as getme__quality_tet, computed in vector lanes. */
-void getme__quality_tet8(const double *x, int n, double *q);
 double getme__quality_hex(const double *x);
 double getme__quality_prism(const double *x);
 double getme__quality_pyramid(const double *x);

@@ -166,28 +166,6 @@ double getme__quality_tet(const double *x)
     return valid_or_zero(det > 0.0, ratio3(det, frob2));
 }
 
-void getme__quality_tet8(const double *x, int n, double *q)
-{
-    double det[8], frob2[8], c[8];
-    for (int l = 0; l < 8; l++) {
-        /* lanes past n repeat the first tet: valid numbers, result unused */
-        const double *p = x + 12 * (l < n ? l : 0);
-        double e1[3], e2[3], e3[3], s2[3], s3[3];
-        edge(p, 0, 1, e1);
-        edge(p, 0, 2, e2);
-        edge(p, 0, 3, e3);
-        for (int k = 0; k < 3; k++) {
-            s2[k] = (2.0 * e2[k] - e1[k]) * GETME_INV_SQRT3;
-            s3[k] = (3.0 * e3[k] - e1[k] - e2[k]) * GETME_INV_SQRT6;
-        }
-        det[l] = GETME_SQRT2 * det3(e1, e2, e3);
-        frob2[l] = dot3(e1, e1) + dot3(s2, s2) + dot3(s3, s3);
-    }
-    cube_root8(det, c);
-    for (int l = 0; l < n; l++)
-        q[l] = valid_or_zero(det[l] > 0.0, 3.0 * c[l] * c[l] / frob2[l]);
-}
-
 /* ---- hexahedron --------------------------------------------------------- */
 
 /* The paper's N^hex, zero-based; det = +1 on the unit cube in Gmsh order.
