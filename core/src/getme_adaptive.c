@@ -299,32 +299,37 @@ static void qold_reserve(getme_run *run)
     if (run->num_elems <= run->cap_qold && run->qold)
         return;
     free(run->qold);
-    run->cap_qold = 2 * (int64_t)run->num_elems;
+    run->cap_qold = 2 * (int64_t)run->num_elems + 64;
     run->qold = malloc((size_t)run->cap_qold * sizeof *run->qold);
     if (!run->qold)
         run->cap_qold = 0;
 }
 
-/* One iteration of the main loop (Fig. 3 lines 5-9). */
-static getme_status iterate(getme_run *run, double qt, const double *R, int nR,
+/* One iteration of the main loop (Fig. 3 lines 5-9).  mean_stage: the
+   q_mean stage, where every free element is transformed over the lists
+   lists_all() built; otherwise the elements with q <= qt (run->tlist).
+   Decided by the stage, not by qt: a q*_min cycle's qt can be 1 on a
+   mesh that is mostly perfect, and must still use its own lists. */
+static getme_status iterate(getme_run *run, int mean_stage, double qt,
+                            const double *R, int nR,
                             int32_t *num_transformed, int32_t *num_relaxed)
 {
     double sigma = run->params->sigma;
-    if (qt >= 1.0) {
+    if (mean_stage) {
         getme__adj_sums_all(run->adj, run->ws, run->q);
         *num_transformed = scatter_all(run, sigma);
     } else {
         *num_transformed = scatter_some(run, qt, sigma);
     }
     compute_new_nodes(run);
-    if (qt < 1.0) {
+    if (!mean_stage) {
         qold_reserve(run);
         for (int32_t k = 0; run->qold && k < run->num_elems; k++)
             run->qold[k] = run->q[run->elems[k]];
     }
     *num_relaxed = getme__relax(run, R, nR);
     getme__reset_nodes(run);
-    return qt < 1.0 ? update_after(run, qt) : GETME_OK;
+    return mean_stage ? GETME_OK : update_after(run, qt);
 }
 
 /* Swap a <= b for quickselect. */
@@ -489,7 +494,8 @@ getme_status getme__adaptive(getme_run *run)
         int32_t ntrans, nrelax;
         getme_stage stage = state == MEAN_RUNNING ? GETME_STAGE_MEAN
                                                   : GETME_STAGE_MIN;
-        if ((st = iterate(run, qt, R, nR, &ntrans, &nrelax)) != GETME_OK)
+        if ((st = iterate(run, state == MEAN_RUNNING, qt, R, nR, &ntrans,
+                          &nrelax)) != GETME_OK)
             break;
         double prev_mean = q_mean, prev_min = q_min;
         getme__ws_summary(ws, run->q, &q_mean, &q_min, NULL);

@@ -8,7 +8,7 @@
  * its 1.6 GiB).  We need no table: on conforming meshes the sum comes from
  * per-node, per-edge and per-face sums by inclusion-exclusion
  * (adjacency.h), about 15 loads per tet instead of a walk over ~96 star
- * entries (measured: 160 ns -> see README "Performance").
+ * entries (measured on 190k tets, 1 thread: 236 ns -> 50 ns per weight).
  *
  * Elements where that formula is not exact (adjacency.c finds them once)
  * walk the union of the stars of their nodes instead: a per-thread stamp

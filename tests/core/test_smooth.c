@@ -278,10 +278,64 @@ static void check_all_fixed(void)
     getme_mesh_free(m);
 }
 
+/* A mostly perfect mesh, a 20^3 hex grid with one interior node moved,
+   smoothed with threshold_fraction = 1: every q*_min cycle then transforms
+   every free element (q_t = the best quality, within 1e-12 of 1 here), so
+   the q*_min stage's own lists (built from the stars, grown as needed) hold
+   the whole mesh.  It must end valid, improve q*_min, and not depend on
+   the thread count. */
+static void check_mostly_perfect(void)
+{
+    enum { M = 20 };
+    int32_t nn = (M + 1) * (M + 1) * (M + 1), ne = M * M * M;
+    double *xyz = malloc((size_t)nn * 3 * sizeof *xyz);
+    int32_t *hex = malloc((size_t)ne * 8 * sizeof *hex);
+    for (int k = 0; k <= M; k++)
+        for (int j = 0; j <= M; j++)
+            for (int i = 0; i <= M; i++) {
+                int32_t v = (k * (M + 1) + j) * (M + 1) + i;
+                xyz[3 * v] = i, xyz[3 * v + 1] = j, xyz[3 * v + 2] = k;
+            }
+    int32_t moved = (10 * (M + 1) + 10) * (M + 1) + 10;
+    xyz[3 * moved] += 0.3, xyz[3 * moved + 1] -= 0.2, xyz[3 * moved + 2] += 0.25;
+    int32_t e = 0;
+    for (int k = 0; k < M; k++)
+        for (int j = 0; j < M; j++)
+            for (int i = 0; i < M; i++, e++) {
+                int32_t a = (k * (M + 1) + j) * (M + 1) + i, s = M + 1, l = s * s;
+                int32_t c[8] = {a, a + 1, a + s + 1, a + s,
+                                a + l, a + l + 1, a + l + s + 1, a + l + s};
+                memcpy(hex + 8 * e, c, sizeof c);
+            }
+    double *out[2];
+    getme_result r[2];
+    for (int t = 0; t < 2; t++) {
+        getme_mesh *m = NULL;
+        CHECK(getme_mesh_create(&m, 3, nn, xyz) == GETME_OK);
+        CHECK(getme_mesh_add_elements(m, GETME_HEX, ne, hex, NULL) == GETME_OK);
+        CHECK(getme_mesh_fix_boundary(m, GETME_FIX_SKIN, NULL) == GETME_OK);
+        getme_params p;
+        getme_params_init(&p);
+        p.num_threads = t + 1;
+        p.threshold_fraction = 1.0;
+        CHECK(getme_smooth(m, &p, &r[t]) == GETME_OK);
+        CHECK(r[t].threshold > 1.0 - 1e-9); /* all free elements transformed */
+        CHECK(r[t].cycles_min >= 1);
+        CHECK(r[t].q_min > 0.0);
+        CHECK(r[t].q_min_star > r[t].q_min_star_initial);
+        out[t] = malloc((size_t)nn * 3 * sizeof *out[t]);
+        memcpy(out[t], getme_mesh_coords(m), (size_t)nn * 3 * sizeof *out[t]);
+        getme_mesh_free(m);
+    }
+    CHECK(!memcmp(out[0], out[1], (size_t)nn * 3 * sizeof *out[0]));
+    free(out[0]), free(out[1]), free(xyz), free(hex);
+}
+
 int main(void)
 {
     check_errors();
     check_all_fixed();
+    check_mostly_perfect();
     check_kind(0, "tet");
     check_kind(1, "hex");
     check_kind(2, "mixed");
