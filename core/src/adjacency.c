@@ -38,14 +38,6 @@ static inline uint64_t check_value(int32_t n)
     return z ^ (z >> 31);
 }
 
-static inline int local_index(const int32_t *c, int nv, int32_t u)
-{
-    for (int i = 0; i < nv; i++)
-        if (c[i] == u)
-            return i;
-    return -1;
-}
-
 /* Other end of local edge j of a type-t element at local node li, or -1 if
    the edge does not touch li. */
 static inline int edge_other(int t, int j, int li)
@@ -79,7 +71,7 @@ static int upper_edges(const getme_ws *ws, int32_t u, int32_t *buf,
         int32_t n = ws->star[k];
         int t = getme__ws_type(ws, n), nv = getme__nv[t];
         const int32_t *c = getme__ws_nodes(ws, t, n);
-        int li = local_index(c, nv, u);
+        int li = getme__local_index(c, nv, u);
         for (int j = 0; j < getme__edges[t].num_edges; j++) {
             int o = edge_other(t, j, li);
             if (o >= 0 && c[o] > u) {
@@ -114,10 +106,10 @@ static void assign_edge(void *ctx, int32_t n, int t, int j, int slot)
 
 /* Edge ids of every element edge (3-D), numbered node by node (a node's
    edges in the order its star meets them), how many elements have each
-   edge (edeg), and if rn is given the check-value sums of every node (rn)
-   and edge (re).  Each node writes only its own edges' entries. */
+   edge (edeg), and if checks is set the check-value sums of every edge
+   (re).  Each node writes only its own edges' entries. */
 static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
-                                int32_t **edeg_out, uint64_t *rn,
+                                int32_t **edeg_out, int checks,
                                 uint64_t **re_out)
 {
     int64_t total = 0;
@@ -151,8 +143,8 @@ static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
         adj->eptr[u] = (int32_t)eptr[u];
     size_t nedge = (size_t)(adj->num_edges ? adj->num_edges : 1);
     int32_t *edeg = calloc(nedge, sizeof *edeg);
-    uint64_t *re = rn ? calloc(nedge, sizeof *re) : NULL;
-    if (!edeg || (rn && !re)) {
+    uint64_t *re = checks ? calloc(nedge, sizeof *re) : NULL;
+    if (!edeg || (checks && !re)) {
         free(eptr), free(bufs), free(edeg), free(re);
         return GETME_ERR_NOMEM;
     }
@@ -160,12 +152,6 @@ static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
     for (int32_t u = 0; u < ws->nn; u++) {
         edge_pass p = {adj, ws, eptr[u], edeg, re};
         upper_edges(ws, u, bufs + omp_get_thread_num() * bufsize, assign_edge, &p);
-        if (rn) {
-            uint64_t r = 0;
-            for (int64_t k = ws->star_ptr[u]; k < ws->star_ptr[u + 1]; k++)
-                r += check_value(ws->star[k]);
-            rn[u] = r;
-        }
     }
     free(eptr), free(bufs);
     *edeg_out = edeg;
@@ -173,7 +159,7 @@ static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
     return GETME_OK;
 }
 
-/* Check-value node sums for planar meshes (no edge ids needed). */
+/* Check-value sums of every node's star. */
 static void node_checks(const getme_ws *ws, uint64_t *rn)
 {
 #pragma omp parallel for schedule(static) num_threads(ws->nt)
@@ -196,8 +182,7 @@ static void counts_and_flags(getme_adj *adj, const getme_ws *ws,
         int t = getme__ws_type(ws, e), nv = getme__nv[t];
         const int32_t *c = getme__ws_nodes(ws, t, e);
         const getme_face_table *ft = &getme__faces[t];
-        const int32_t *f = adj->fnb + adj->foff[t] +
-                           (int64_t)(e - ws->tstart[t]) * ft->num_faces;
+        const int32_t *f = getme__adj_faces(adj, ws, t, e);
         int64_t cnt = 0, nb = 0, bad = 0;
         for (int i = 0; i < nv; i++)
             cnt += ws->star_ptr[c[i] + 1] - ws->star_ptr[c[i]];
@@ -251,8 +236,7 @@ static void check_element(getme_adj *adj, const getme_ws *ws,
                 cnt++;
             }
         }
-    const int32_t *f = adj->fnb + adj->foff[t] +
-                           (int64_t)(e - ws->tstart[t]) * ft->num_faces;
+    const int32_t *f = getme__adj_faces(adj, ws, t, e);
     uint64_t formula = 0, fs = 0;
     for (int i = 0; i < nv; i++)
         formula += rn[c[i]];
@@ -322,16 +306,16 @@ getme_status getme__adj_build(getme_adj *adj, const getme_ws *ws)
         (check && !rn))
         goto fail;
     if (ws->dim == 3) {
-        if ((st = build_edges(adj, ws, &edeg, rn, &re)) != GETME_OK)
+        if ((st = build_edges(adj, ws, &edeg, check, &re)) != GETME_OK)
             goto fail;
         st = GETME_ERR_NOMEM;
         adj->esum = malloc((size_t)(adj->num_edges ? adj->num_edges : 1) *
                            sizeof *adj->esum);
         if (!adj->esum)
             goto fail;
-    } else if (check) {
-        node_checks(ws, rn);
     }
+    if (check)
+        node_checks(ws, rn);
     if ((st = getme__ws_faces(ws, adj->foff, adj->fnb)) != GETME_OK)
         goto fail;
     counts_and_flags(adj, ws, edeg);

@@ -71,6 +71,15 @@ static inline uint8_t *getme__adj_slots(const getme_adj *adj,
            (int64_t)(e - ws->tstart[t]) * getme__edges[t].num_edges;
 }
 
+/* The face neighbours of element e (type t): getme__faces[t].num_faces. */
+static inline const int32_t *getme__adj_faces(const getme_adj *adj,
+                                              const getme_ws *ws, int t,
+                                              int32_t e)
+{
+    return adj->fnb + adj->foff[t] +
+           (int64_t)(e - ws->tstart[t]) * getme__faces[t].num_faces;
+}
+
 /* Id of local edge j of element e (nodes c, type t), given its slot. */
 static inline int32_t getme__adj_edge(const getme_adj *adj, const int32_t *c,
                                       int t, int j, uint8_t slot)
@@ -86,8 +95,7 @@ static inline double getme__adj_nsum(const getme_adj *adj,
 {
     const int32_t *c = getme__ws_nodes(ws, t, e);
     const getme_face_table *ft = &getme__faces[t];
-    const int32_t *f = adj->fnb + adj->foff[t] +
-                       (int64_t)(e - ws->tstart[t]) * ft->num_faces;
+    const int32_t *f = getme__adj_faces(adj, ws, t, e);
     int nv = getme__nv[t];
     double sv = 0.0, sf = 0.0, se = 0.0;
     for (int i = 0; i < nv; i++)

@@ -75,14 +75,6 @@ static inline int key_same(const face_key *a, const face_key *b)
     return a->k[0] == b->k[0] && a->k[1] == b->k[1] && a->k[2] == b->k[2];
 }
 
-static inline int local_index(const int32_t *c, int nv, int32_t u)
-{
-    for (int i = 0; i < nv; i++)
-        if (c[i] == u)
-            return i;
-    return -1;
-}
-
 /* The faces whose lowest node is u, as sorted keys in buf; returns how
    many. */
 static int faces_at(const getme_ws *ws,
@@ -94,7 +86,7 @@ static int faces_at(const getme_ws *ws,
         int32_t n = ws->star[s];
         int t = getme__ws_type(ws, n);
         const int32_t *c = getme__ws_nodes(ws, t, n);
-        const corner_faces *cf = &table[t][local_index(c, getme__nv[t], u)];
+        const corner_faces *cf = &table[t][getme__local_index(c, getme__nv[t], u)];
         for (int k = 0; k < cf->num; k++) {
             int32_t o[3] = {-1, -1, -1};
             int lowest = 1;
@@ -128,7 +120,7 @@ static int same_simplex(const getme_ws *ws, int32_t a, int32_t b)
         return 0;
     const int32_t *ca = getme__ws_nodes(ws, ta, a), *cb = getme__ws_nodes(ws, tb, b);
     for (int i = 0; i < getme__nv[ta]; i++)
-        if (local_index(cb, getme__nv[tb], ca[i]) < 0)
+        if (getme__local_index(cb, getme__nv[tb], ca[i]) < 0)
             return 0;
     return 1;
 }

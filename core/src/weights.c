@@ -20,9 +20,8 @@
 #include "adjacency.h"
 #include "smooth_internal.h"
 
-#include <omp.h>
-
 #include <math.h>
+#include <omp.h>
 #include <stdint.h>
 #include <string.h>
 

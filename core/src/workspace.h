@@ -73,6 +73,15 @@ static inline const int32_t *getme__ws_nodes(const getme_ws *ws, int t,
     return ws->conn + ws->coff[t] + (int64_t)(e - ws->tstart[t]) * getme__nv[t];
 }
 
+/* Position of node u among the nv nodes c of an element, or -1. */
+static inline int getme__local_index(const int32_t *c, int nv, int32_t u)
+{
+    for (int i = 0; i < nv; i++)
+        if (c[i] == u)
+            return i;
+    return -1;
+}
+
 /* Gather element e (type t) coordinates from coords into x. */
 static inline void getme__ws_gather(const getme_ws *ws, const double *coords,
                                     int t, int32_t e, double *x)
