@@ -59,11 +59,28 @@ typedef struct cli_history {
     int count, cap;
 } cli_history;
 
+/* The worst elements of a document (worst.c). */
+typedef struct cli_worst_list {
+    getme_worst_element *items;
+    int32_t count;
+} cli_worst_list;
+
+long long cli_element_tag(const getme_doc *doc, int32_t e);
+/* Fill w with the max_count worst elements; 0, or -1 after printing an
+   error.  Free w->items. */
+int cli_worst(getme_doc *doc, int32_t max_count, unsigned flags,
+              cli_worst_list *w);
+/* which: "" or " with a free node". */
+void cli_print_worst(const cli_log *log, const getme_doc *doc,
+                     const cli_worst_list *w, const char *which);
+void cli_json_worst(FILE *f, const getme_doc *doc, const cli_worst_list *w);
+
 int cli_write_report(const char *path, const char *input, const char *output,
                      const getme_params *params, getme_mesh *mesh,
                      const getme_quality_stats *before,
                      const getme_quality_stats *after,
                      const getme_result *result, const cli_history *history,
-                     const char *format_name);
+                     const getme_doc *doc, const cli_worst_list *worst,
+                     const cli_worst_list *worst_free);
 
 #endif /* GETME_CLI_H */

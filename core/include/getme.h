@@ -230,6 +230,54 @@ GETME_API getme_status getme_mesh_quality_stats(getme_mesh *mesh, int type,
 GETME_API getme_status getme_mesh_element_qualities(getme_mesh *mesh,
                                                     double *q);
 
+/* ---- the worst elements and why they stay bad -------------------------- */
+
+typedef enum getme_worst_reason {
+    GETME_WORST_IMPROVABLE = 0,   /* a node move that raises it exists: the
+                                     smoother stopped on its limits          */
+    GETME_WORST_ALL_FIXED = 1,    /* every node fixed (skin, fixed sets): no
+                                     node move can change it; a topological
+                                     optimiser (Gmsh's optimize) can         */
+    GETME_WORST_INTERFACE = 2,    /* every node fixed, some only because they
+                                     lie on a region interface (freeing
+                                     interfaces would let it move)          */
+    GETME_WORST_LOCAL_OPTIMUM = 3 /* each free node, and all of them
+                                     together, at a local optimum: no small
+                                     move raises the worst quality of the
+                                     elements around them                   */
+} getme_worst_reason;
+
+typedef struct getme_worst_element {
+    int32_t element;          /* caller's element index                     */
+    getme_elem_type type;
+    double quality;           /* mean ratio                                  */
+    double corner_sj;         /* worst corner scaled Jacobian (hex, prism,
+                                 pyramid, quad; 1 for tets and triangles)    */
+    int num_nodes, num_free;  /* its nodes, and how many are free            */
+    getme_worst_reason reason;
+} getme_worst_element;
+
+/* Flags of getme_mesh_worst_elements(). */
+enum {
+    GETME_WORST_FREE_ONLY = 1 /* only elements with at least one free node */
+};
+
+/*
+ * The max_count elements of lowest quality (ties by index), worst first,
+ * into out[0..*count), each with the reason it cannot improve further
+ * (getme_worst_reason): all elements, or with GETME_WORST_FREE_ONLY only
+ * those with a free node (the ones behind q*_min).  The probes move no
+ * node: the mesh is unchanged bit for bit.
+ */
+GETME_API getme_status getme_mesh_worst_elements(getme_mesh *mesh,
+                                                 int32_t max_count,
+                                                 unsigned flags,
+                                                 getme_worst_element *out,
+                                                 int32_t *count);
+
+/* A static English description of a reason ("all nodes fixed", ...). */
+GETME_API const char *getme_worst_reason_string(getme_worst_reason reason);
+
 /* ------------------------------------------------------------------------ */
 /* Smoothing parameters                                                     */
 /* ------------------------------------------------------------------------ */
@@ -242,19 +290,24 @@ typedef enum getme_method {
 typedef enum getme_stage {
     GETME_STAGE_MEAN = 1,   /* q_mean oriented first stage                    */
     GETME_STAGE_MIN = 2,    /* q*_min oriented cycles                         */
-    GETME_STAGE_LAPLACE = 3 /* smart Laplace iteration                        */
+    GETME_STAGE_LAPLACE = 3,/* smart Laplace iteration                        */
+    GETME_STAGE_FINISH = 4  /* a pass of the finishing step (params.finish)   */
 } getme_stage;
 
 /* What the progress callback sees after every iteration. */
 typedef struct getme_progress {
-    int iteration;          /* 1-based, over both stages                     */
+    int iteration;          /* 1-based, over both stages; in the finishing
+                               step the pass number                          */
     getme_stage stage;
     int cycle;              /* q*_min cycle number (0 in the first stage)    */
     double q_min_star;      /* after this iteration                          */
     double q_mean;
-    double threshold;       /* transformation threshold q_t in force          */
-    int32_t num_transformed;/* elements transformed this iteration            */
-    int32_t num_relaxed;    /* nodes that needed more than one relaxation step*/
+    double threshold;       /* transformation threshold q_t in force (finish:
+                               the quality bound of the pass's elements)     */
+    int32_t num_transformed;/* elements transformed this iteration (finish:
+                               elements worked on)                           */
+    int32_t num_relaxed;    /* nodes that needed more than one relaxation step
+                               (finish: elements whose quality rose)         */
     double elapsed;         /* seconds since getme_smooth() started           */
 } getme_progress;
 
@@ -285,6 +338,32 @@ typedef struct getme_params {
                                   Threshold), see README for the choice      */
     int keep_best;             /* 1: end on the coordinates with the best
                                   q*_min seen in the q*_min stage            */
+    int finish;                /* 1: after the q*_min stage, the finishing
+                                  step: worst elements first, local max-min
+                                  optimisation of their free nodes; q*_min
+                                  never decreases in it (README "Method
+                                  notes").  0: the paper's method alone     */
+    double finish_fraction;    /* 0.001: each finishing pass works on the
+                                  elements below the quality at this
+                                  position of the sorted free elements (at
+                                  least 64 elements), worst first           */
+    int finish_max_passes;     /* 100: at most this many finishing passes;
+                                  they stop earlier once a pass raises
+                                  q*_min by no more than min_tol            */
+    int corner_guard;          /* 1: the corner guard.  A hex, prism,
+                                  pyramid or quad whose worst corner scaled
+                                  Jacobian would fall below both its old
+                                  value and the floor counts as invalid in
+                                  the relaxation (and the finishing step),
+                                  so the mesh's worst corner never ends
+                                  below the floor.  The floor is the
+                                  input's worst corner, or corner_floor if
+                                  that is higher                            */
+    double corner_floor;       /* 0: see corner_guard; in [-1, 1].  Raising
+                                  it protects corners more but blocks moves
+                                  that pass through a bad corner: on the
+                                  benchmark's distorted hexes 0.2 ends at
+                                  q*_min 0.12 against 0.85 with 0          */
     int num_threads;           /* 0: OpenMP default                          */
     int renumber;              /* 1: reorder internally for cache locality
                                   (results stay bit-identical for any thread
@@ -300,8 +379,9 @@ GETME_API void getme_params_init(getme_params *params);
 /*
  * Set a numeric parameter by name: "method" (0 adaptive, 1 laplace),
  * "max_iter", "tol", "sigma", "max_no_min_improve", "min_tol",
- * "threshold_fraction",
- * "keep_best", "num_threads", "renumber".  Returns GETME_ERR_ARGUMENT for
+ * "threshold_fraction", "keep_best", "finish", "finish_fraction",
+ * "finish_max_passes", "corner_guard", "corner_floor", "num_threads",
+ * "renumber".  Returns GETME_ERR_ARGUMENT for
  * an unknown name or a value out of range.  For bindings (Python, CLI).
  */
 GETME_API getme_status getme_params_set(getme_params *params, const char *name,
@@ -330,6 +410,11 @@ typedef struct getme_result {
     int iterations_mean;      /* first (q_mean) stage, or Laplace iterations  */
     int iterations_min;       /* q*_min stage                                 */
     int cycles_min;           /* q*_min cycles                                */
+    int passes_finish;        /* finishing passes (params.finish)             */
+    int32_t moved_finish;     /* elements the finishing step improved        */
+    double corner_sj_initial; /* worst corner scaled Jacobian of the hexes,
+                                 prisms, pyramids and quads (1 if none)      */
+    double corner_sj;         /* the same after smoothing                    */
     double q_min_star_initial, q_mean_initial;
     double q_min_star, q_mean, q_min;
     double threshold;         /* last transformation threshold q_t           */

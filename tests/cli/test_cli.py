@@ -176,7 +176,24 @@ def mesh_case(case):
           "report's qmean equals the independent one")
     check(rep["iterations"]["mean_stage"] > 0 and rep["iterations"]["min_stage"] > 0,
           "both stages ran")
-    check(len(rep["history"]) == rep["iterations"]["total"], "one history record per iteration")
+    its = [h for h in rep["history"] if h["stage"] != 4]
+    passes = [h for h in rep["history"] if h["stage"] == 4]
+    check(len(its) == rep["iterations"]["total"], "one history record per iteration")
+    check(len(passes) == rep["iterations"]["finish_passes"], "one history record per finishing pass")
+    # The finishing step never lowers q*min: its passes climb from where the
+    # q*min stage (with keep_best) ended, and the result is the last pass.
+    qs = [h["q_min_star"] for h in passes]
+    check(all(b >= a for a, b in zip(qs, qs[1:])), "q*min never decreases over the finishing passes")
+    check(not qs or abs(qs[-1] - rep["after"]["q_min_star"]) < 1e-12, "the result is the last pass's q*min")
+    # The worst elements of the report, checked against the output's own
+    # qualities: the worst overall is the minimum over all elements.
+    worst = rep["worst_elements"]
+    check(len(worst) == min(10, rep["after"]["elements"]) and
+          abs(worst[0]["quality"] - rep["after"]["q_min"]) < 1e-12, "worst element = qmin")
+    check(all(a["quality"] <= b["quality"] for a, b in zip(worst, worst[1:])), "worst first")
+    wf = rep["worst_free_elements"]
+    check(wf and abs(wf[0]["quality"] - rep["after"]["q_min_star"]) < 1e-12 and
+          all(w["free_nodes"] > 0 for w in wf), "worst element with a free node = q*min")
     print(f"{case}: {', '.join(f'{k} {len(q0[k])}' for k in kinds)}; q*min {mn0:.4f} -> "
           f"getme {mn1:.4f} (laplace {mnl:.4f}); qmean {mean0:.4f} -> {mean1:.4f} "
           f"(laplace {meanl:.4f}); iterations {rep['iterations']['mean_stage']}/"
