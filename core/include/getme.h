@@ -269,7 +269,10 @@ GETME_API getme_status getme_mesh_element_qualities(getme_mesh *mesh,
  *                        the product of the 2 edge lengths at the node;
  *                   quad min over the 4 corners of cross of the 2 unit
  *                        edge vectors.
- *                   Range [-1, 1].  0 for a zero-length edge.
+ *                   Range [-1, 1]; prism [-2/sqrt3, 1] and pyramid
+ *                   [-sqrt2, 1] (a fully inverted element's worst corner
+ *                   can be its right-angled one).  0 for a zero-length
+ *                   edge.
  *  GAMMA            Gmsh's gamma (its "gamma" element quality, 4.8.4):
  *                   tet 3 r/R (inscribed / circumscribed sphere radius),
  *                   tri 2 r/R (circles), both unsigned in [0, 1];
