@@ -222,6 +222,8 @@ static int run(smooth_args *a)
 
     getme_quality_stats before = doc->stats, after;
     cli_print_stats(log, "Quality before", &before);
+    cli_measures mbefore, mafter;
+    cli_measures_log(log, mesh, "Measures before", &mbefore);
 
     cli_history history = {0};
     progress_state ps = {log, &history};
@@ -254,6 +256,7 @@ static int run(smooth_args *a)
              res.cycles_min);
     getme_mesh_quality_stats(mesh, -1, &after);
     cli_print_stats(log, "Quality after ", &after);
+    cli_measures_log(log, mesh, "Measures after ", &mafter);
 
     cli_info(log, "Writing '%s'...", a->output);
     getme_io_status ios = getme_doc_write(doc, a->output);
@@ -266,7 +269,7 @@ static int run(smooth_args *a)
     if (a->report &&
         cli_write_report(a->report, a->input, a->output, &a->params, mesh,
                          &before, &after, &res, &history,
-                         doc->format->name) != 0) {
+                         doc->format->name, &mbefore, &mafter) != 0) {
         cli_error("%s: cannot write the report", a->report);
         code = GETME_IO_ERR_WRITE;
     }

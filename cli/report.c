@@ -51,7 +51,8 @@ int cli_write_report(const char *path, const char *input, const char *output,
                      const getme_params *p, getme_mesh *mesh,
                      const getme_quality_stats *before,
                      const getme_quality_stats *after, const getme_result *r,
-                     const cli_history *h, const char *format_name)
+                     const cli_history *h, const char *format_name,
+                     const cli_measures *mb, const cli_measures *ma)
 {
     FILE *f = fopen(path, "w");
     if (!f)
@@ -86,6 +87,11 @@ int cli_write_report(const char *path, const char *input, const char *output,
     json_stats(f, before);
     fputs(",\n  \"after\": ", f);
     json_stats(f, after);
+    fputs(",\n  \"measures\": {\"before\": ", f);
+    cli_json_measures(f, mb);
+    fputs(",\n    \"after\": ", f);
+    cli_json_measures(f, ma);
+    fputc('}', f);
     fprintf(f, ",\n  \"iterations\": {\"total\": %d, \"mean_stage\": %d, "
                "\"min_stage\": %d, \"min_cycles\": %d},\n",
             r->iterations, r->iterations_mean, r->iterations_min, r->cycles_min);
