@@ -177,6 +177,21 @@ def mesh_case(case):
     check(rep["iterations"]["mean_stage"] > 0 and rep["iterations"]["min_stage"] > 0,
           "both stages ran")
     check(len(rep["history"]) == rep["iterations"]["total"], "one history record per iteration")
+    # the analysts' measures (docs/quality.md): per type, before and after
+    meas = rep["measures"]
+    for k in kinds:
+        b, a = meas["before"][k], meas["after"][k]
+        check(a["sicn"]["elements"] == len(q1[k]) and sum(a["sicn"]["histogram"]) == len(q1[k]),
+              f"{k}: SICN counted for every element")
+        check(a["sicn"]["min"] > b["sicn"]["min"] and a["scaled_jacobian"]["min"] > 0,
+              f"{k}: SICN min improved, scaled Jacobian positive after smoothing")
+        check(abs(a["mean_ratio"]["min"] - min(q1[k])) < 1e-9,
+              f"{k}: report's per-type mean ratio min equals the independent one")
+        check(("gamma" in a) == (k not in ("hex", "pyramid")), f"{k}: gamma only where Gmsh has one")
+    p = run("quality", out1)
+    for k in kinds:
+        check(f"{k} SICN: min" in p.stdout and f"{k} scaled Jacobian: min" in p.stdout,
+              f"getme quality prints the {k} measures")
     print(f"{case}: {', '.join(f'{k} {len(q0[k])}' for k in kinds)}; q*min {mn0:.4f} -> "
           f"getme {mn1:.4f} (laplace {mnl:.4f}); qmean {mean0:.4f} -> {mean1:.4f} "
           f"(laplace {meanl:.4f}); iterations {rep['iterations']['mean_stage']}/"
