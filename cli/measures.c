@@ -9,16 +9,7 @@
 
 int cli_measures_compute(getme_mesh *mesh, cli_measures *m)
 {
-    memset(m, 0, sizeof *m);
-    for (int t = 0; t < GETME_NUM_TYPES; t++) {
-        if (!getme_mesh_num_elements_of_type(mesh, (getme_elem_type)t))
-            continue;
-        for (int k = 0; k < GETME_NUM_MEASURES; k++)
-            if (getme_mesh_measure_stats(mesh, t, (getme_measure)k,
-                                         &m->stats[t][k]) != GETME_OK)
-                return -1;
-    }
-    return 0;
+    return getme_mesh_measure_all(mesh, &m->stats[0][0]) == GETME_OK ? 0 : -1;
 }
 
 /* "min dihedral" / "min angle" (planar), "scaled Jacobian", ... */

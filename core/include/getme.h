@@ -343,6 +343,16 @@ GETME_API getme_status getme_mesh_measure_stats(getme_mesh *mesh, int type,
                                                 getme_measure measure,
                                                 getme_measure_stats *stats);
 
+/*
+ * Every measure of every element type at once: stats[type *
+ * GETME_NUM_MEASURES + measure] (GETME_NUM_TYPES * GETME_NUM_MEASURES
+ * entries) as getme_mesh_measure_stats(mesh, type, measure) gives them,
+ * num_elements 0 for absent types and undefined measures.  One pass over
+ * the elements per measure.
+ */
+GETME_API getme_status getme_mesh_measure_all(getme_mesh *mesh,
+                                              getme_measure_stats *stats);
+
 /* One measure of every element (num_elements doubles; NaN where not
    defined) into values. */
 GETME_API getme_status getme_mesh_element_measures(getme_mesh *mesh,

@@ -531,6 +531,40 @@ static void add_stat(getme_measure_stats *s, double v, int32_t e, double *sum)
     s->histogram[bin >= GETME_HIST_BINS ? GETME_HIST_BINS - 1 : bin]++;
 }
 
+static void init_stats(getme_measure_stats *s, int m)
+{
+    memset(s, 0, sizeof *s);
+    s->min_element = s->max_element = -1;
+    getme_measure_range((getme_measure)m, &s->hist_lo, &s->hist_hi);
+}
+
+/* Reduce the values v of one measure serially in element order (the same
+   sums for any thread count): into out[type] for each type if per_type,
+   else all into out[0]. */
+static void reduce(const getme_mesh *mesh, const double *v, int per_type,
+                   getme_measure_stats *out, int stride)
+{
+    double sum[GETME_NUM_TYPES] = {0};
+    for (int b = 0; b < mesh->num_blocks; b++) {
+        const getme_block *bl = &mesh->blocks[b];
+        int slot = per_type ? bl->type : 0;
+        for (int32_t e = bl->first; e < bl->first + bl->count; e++)
+            if (!isnan(v[e]))
+                add_stat(&out[slot * stride], v[e], e, &sum[slot]);
+    }
+    for (int t = 0; t < GETME_NUM_TYPES; t++) {
+        getme_measure_stats *s = &out[t * stride];
+        if (t < (per_type ? GETME_NUM_TYPES : 1) && s->num_elements)
+            s->mean = sum[t] / (double)s->num_elements;
+    }
+}
+
+static double *values_buffer(getme_mesh *mesh)
+{
+    return malloc((size_t)(mesh->num_elements ? mesh->num_elements : 1) *
+                  sizeof(double));
+}
+
 getme_status getme_mesh_measure_stats(getme_mesh *mesh, int type,
                                       getme_measure measure_id,
                                       getme_measure_stats *s)
@@ -538,20 +572,30 @@ getme_status getme_mesh_measure_stats(getme_mesh *mesh, int type,
     if (!mesh || !s || type < -1 || type >= GETME_NUM_TYPES ||
         (unsigned)measure_id >= (unsigned)GETME_NUM_MEASURES)
         return GETME_ERR_ARGUMENT;
-    memset(s, 0, sizeof *s);
-    s->min_element = s->max_element = -1;
-    getme_measure_range(measure_id, &s->hist_lo, &s->hist_hi);
-    double *v = malloc((size_t)(mesh->num_elements ? mesh->num_elements : 1) *
-                       sizeof *v);
+    init_stats(s, (int)measure_id);
+    double *v = values_buffer(mesh);
     if (!v)
         return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
     block_values(mesh, type, (int)measure_id, v);
-    /* serial in element order: the same sum for any thread count */
-    double sum = 0.0;
-    for (int32_t e = 0; e < mesh->num_elements; e++)
-        if (!isnan(v[e]))
-            add_stat(s, v[e], e, &sum);
-    s->mean = s->num_elements ? sum / (double)s->num_elements : 0.0;
+    reduce(mesh, v, 0, s, 0);
+    free(v);
+    return GETME_OK;
+}
+
+getme_status getme_mesh_measure_all(getme_mesh *mesh,
+                                    getme_measure_stats *stats)
+{
+    if (!mesh || !stats)
+        return GETME_ERR_ARGUMENT;
+    for (int k = 0; k < GETME_NUM_TYPES * GETME_NUM_MEASURES; k++)
+        init_stats(&stats[k], k % GETME_NUM_MEASURES);
+    double *v = values_buffer(mesh);
+    if (!v)
+        return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
+    for (int m = 0; m < GETME_NUM_MEASURES; m++) {
+        block_values(mesh, -1, m, v);
+        reduce(mesh, v, 1, stats + m, GETME_NUM_MEASURES);
+    }
     free(v);
     return GETME_OK;
 }

@@ -338,6 +338,16 @@ static void test_mesh_stats(void)
     CHECK_EQ_INT(s.min_element, -1);
     CHECK_EQ_INT(getme_mesh_measure_stats(mesh, 6, GETME_MEASURE_SICN, &s), GETME_ERR_ARGUMENT);
     CHECK_EQ_INT(getme_mesh_measure_stats(mesh, -1, (getme_measure)7, &s), GETME_ERR_ARGUMENT);
+    /* all at once: the same as one by one */
+    getme_measure_stats all[GETME_NUM_TYPES * GETME_NUM_MEASURES];
+    CHECK_EQ_INT(getme_mesh_measure_all(mesh, all), GETME_OK);
+    for (int t = 0; t < GETME_NUM_TYPES; t++)
+        for (int k = 0; k < GETME_NUM_MEASURES; k++) {
+            CHECK_EQ_INT(getme_mesh_measure_stats(mesh, t, (getme_measure)k, &s), GETME_OK);
+            CHECK(memcmp(&s, &all[t * GETME_NUM_MEASURES + k], sizeof s) == 0);
+        }
+    CHECK_EQ_INT(all[GETME_TET * GETME_NUM_MEASURES + GETME_MEASURE_SICN].num_elements, 3);
+    CHECK_EQ_INT(getme_mesh_measure_all(mesh, NULL), GETME_ERR_ARGUMENT);
     getme_mesh_free(mesh);
 }
 
