@@ -94,25 +94,15 @@ static double len_xy(const double *x, int a, int b)
 /* ---- dihedral angles ---------------------------------------------------- */
 
 /*
- * Angle at edge a-b between the half-planes through the edge and the
- * points p and q: the components of p - a and q - a normal to the edge
- * (scaled by |e|^2, which spares a division and gives 0, not NaN, for a
- * zero-length edge), then atan2(|u x v|, u . v).
+ * The edge ends of a 3-D type: {a, b, p, q} for the edge a-b seen from a,
+ * p and q a's neighbours (other than b) in the two faces through the edge.
+ * Both ends of an edge are listed unless both faces are triangles (then
+ * they give the same angle).  Built from the face and edge tables.
  */
-static double edge_angle(const double *x, int a, int b, int p, int q)
-{
-    double e[3], dp[3], dq[3], u[3], v[3], w[3];
-    vsub(x, a, b, e);
-    vsub(x, a, p, dp);
-    vsub(x, a, q, dq);
-    double ee = vdot(e, e), pe = vdot(dp, e), qe = vdot(dq, e);
-    for (int c = 0; c < 3; c++) {
-        u[c] = dp[c] * ee - pe * e[c];
-        v[c] = dq[c] * ee - qe * e[c];
-    }
-    vcross(u, v, w);
-    return atan2(vnorm(w), vdot(u, v));
-}
+typedef struct dihedral_ends {
+    int n;
+    int8_t end[24][4];
+} dihedral_ends;
 
 /* The neighbour of node a in face f that is not b (-1 if a-b is not an
    edge of f). */
@@ -132,12 +122,11 @@ static int face_neighbour(const getme_face_table *ft, int f, int a, int b)
     return -1;
 }
 
-/* min and max dihedral angle of a 3-D element, radians. */
-static void dihedral3(int type, const double *x, double *lo, double *hi)
+static void dihedral_ends_of(int type, dihedral_ends *d)
 {
     const getme_face_table *ft = &getme__faces[type];
     const getme_edge_table *et = &getme__edges[type];
-    double mn = INFINITY, mx = -INFINITY;
+    d->n = 0;
     for (int k = 0; k < et->num_edges; k++) {
         int a = et->node[k][0], b = et->node[k][1];
         int pa[2], pb[2], n = 0;
@@ -148,14 +137,62 @@ static void dihedral3(int type, const double *x, double *lo, double *hi)
             pa[n] = na;
             pb[n++] = face_neighbour(ft, f, b, a);
         }
-        /* both ends: they differ only where a face is not planar */
-        double t1 = edge_angle(x, a, b, pa[0], pa[1]);
-        double t2 = edge_angle(x, b, a, pb[0], pb[1]);
-        mn = fmin(mn, fmin(t1, t2));
-        mx = fmax(mx, fmax(t1, t2));
+        int8_t *e = d->end[d->n++];
+        e[0] = (int8_t)a, e[1] = (int8_t)b, e[2] = (int8_t)pa[0], e[3] = (int8_t)pa[1];
+        if (pa[0] == pb[0] && pa[1] == pb[1])
+            continue; /* two triangles: the same half-planes from b */
+        e = d->end[d->n++];
+        e[0] = (int8_t)b, e[1] = (int8_t)a, e[2] = (int8_t)pb[0], e[3] = (int8_t)pb[1];
     }
-    *lo = mn;
-    *hi = mx;
+}
+
+/* atan2(|u x v|, u . v): the angle between u and v in [0, pi] */
+static double angle_between(const double u[3], const double v[3])
+{
+    double w[3];
+    vcross(u, v, w);
+    return atan2(vnorm(w), vdot(u, v));
+}
+
+/*
+ * min and max dihedral angle of a 3-D element, radians.  At the edge end
+ * {a, b, p, q}: u, v the components of p - a and q - a normal to the edge;
+ * the angle is that between u and v.  The ends are ranked by the cosine
+ * u.v / (|u| |v|) (1, i.e. angle 0, when u or v vanishes), and only the two
+ * extreme ones get the accurate atan2 form.
+ */
+static void dihedral3(const dihedral_ends *d, const double *x, double *lo,
+                      double *hi)
+{
+    double cmin = INFINITY, cmax = -INFINITY;
+    double umin[3] = {0}, vmin[3] = {0}, umax[3] = {0}, vmax[3] = {0};
+    for (int k = 0; k < d->n; k++) {
+        const int8_t *end = d->end[k];
+        double e[3], dp[3], dq[3], u[3], v[3];
+        vsub(x, end[0], end[1], e);
+        vsub(x, end[0], end[2], dp);
+        vsub(x, end[0], end[3], dq);
+        double ee = vdot(e, e), inv = ee > 0.0 ? 1.0 / ee : 0.0;
+        double pe = vdot(dp, e) * inv, qe = vdot(dq, e) * inv;
+        for (int c = 0; c < 3; c++) {
+            u[c] = dp[c] - pe * e[c];
+            v[c] = dq[c] - qe * e[c];
+        }
+        double den = sqrt(vdot(u, u) * vdot(v, v));
+        double cs = den > 0.0 ? vdot(u, v) / den : 1.0;
+        if (cs > cmax) { /* smallest angle so far */
+            cmax = cs;
+            memcpy(umax, u, sizeof u);
+            memcpy(vmax, v, sizeof v);
+        }
+        if (cs < cmin) { /* largest angle so far */
+            cmin = cs;
+            memcpy(umin, u, sizeof u);
+            memcpy(vmin, v, sizeof v);
+        }
+    }
+    *lo = angle_between(umax, vmax);
+    *hi = angle_between(umin, vmin);
 }
 
 /* min and max interior angle of a planar element, radians in [0, 2 pi). */
@@ -426,8 +463,11 @@ getme_status getme_measure_range(getme_measure measure, double *lo,
     return GETME_OK;
 }
 
-/* The measure of a known (type, measure) pair. */
-static double measure(int type, int m, const double *x)
+/* The measure m of a known (type, m) pair; de: the type's dihedral ends
+   (3-D types).  For MIN_DIHEDRAL, *max_angle (if not NULL) also receives
+   the max dihedral angle. */
+static double measure(int type, int m, const double *x,
+                      const dihedral_ends *de, double *max_angle)
 {
     int planar = type == GETME_TRI || type == GETME_QUAD;
     switch (m) {
@@ -439,7 +479,9 @@ static double measure(int type, int m, const double *x)
         if (planar)
             angles2(getme__nv[type], x, &lo, &hi);
         else
-            dihedral3(type, x, &lo, &hi);
+            dihedral3(de, x, &lo, &hi);
+        if (max_angle)
+            *max_angle = hi * RAD2DEG;
         return (m == GETME_MEASURE_MIN_DIHEDRAL ? lo : hi) * RAD2DEG;
     }
     case GETME_MEASURE_SCALED_JACOBIAN:
@@ -462,13 +504,19 @@ double getme_element_measure(getme_elem_type type, getme_measure m,
 {
     if (!xyz || !getme_measure_defined(type, m))
         return NAN;
-    return measure((int)type, (int)m, xyz);
+    dihedral_ends de;
+    if (getme_type_dim(type) == 3 && (m == GETME_MEASURE_MIN_DIHEDRAL ||
+                                      m == GETME_MEASURE_MAX_DIHEDRAL))
+        dihedral_ends_of((int)type, &de);
+    return measure((int)type, (int)m, xyz, &de, NULL);
 }
 
 /* ---- mesh-level --------------------------------------------------------- */
 
-/* The values of the blocks of one type (-1: all) into v, NaN elsewhere. */
-static void block_values(getme_mesh *mesh, int type, int m, double *v)
+/* The values of the blocks of one type (-1: all) into v, NaN elsewhere;
+   for MIN_DIHEDRAL also the max dihedral angles into v_max if not NULL. */
+static void block_values(getme_mesh *mesh, int type, int m, double *v,
+                         double *v_max)
 {
     if (mesh->mirror < 0)
         getme__detect_orientation(mesh);
@@ -479,10 +527,16 @@ static void block_values(getme_mesh *mesh, int type, int m, double *v)
         int skip = (type >= 0 && bl->type != type) ||
                    !getme_measure_defined((getme_elem_type)bl->type,
                                           (getme_measure)m);
+        dihedral_ends de;
+        if (getme_type_dim((getme_elem_type)bl->type) == 3)
+            dihedral_ends_of(bl->type, &de);
 #pragma omp parallel for schedule(static)
         for (int32_t e = 0; e < bl->count; e++) {
+            int32_t g = bl->first + e;
             if (skip) {
-                v[bl->first + e] = NAN;
+                v[g] = NAN;
+                if (v_max)
+                    v_max[g] = NAN;
                 continue;
             }
             double x[3 * GETME_MAX_NV];
@@ -493,7 +547,7 @@ static void block_values(getme_mesh *mesh, int type, int m, double *v)
                 x[3 * i + 1] = ysign * p[1];
                 x[3 * i + 2] = p[2];
             }
-            v[bl->first + e] = measure(bl->type, m, x);
+            v[g] = measure(bl->type, m, x, &de, v_max ? v_max + g : NULL);
         }
     }
 }
@@ -505,7 +559,7 @@ getme_status getme_mesh_element_measures(getme_mesh *mesh,
     if (!mesh || (unsigned)measure_id >= (unsigned)GETME_NUM_MEASURES ||
         (!values && mesh->num_elements))
         return GETME_ERR_ARGUMENT;
-    block_values(mesh, -1, (int)measure_id, values);
+    block_values(mesh, -1, (int)measure_id, values, NULL);
     return GETME_OK;
 }
 
@@ -576,7 +630,7 @@ getme_status getme_mesh_measure_stats(getme_mesh *mesh, int type,
     double *v = values_buffer(mesh);
     if (!v)
         return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
-    block_values(mesh, type, (int)measure_id, v);
+    block_values(mesh, type, (int)measure_id, v, NULL);
     reduce(mesh, v, 0, s, 0);
     free(v);
     return GETME_OK;
@@ -589,13 +643,23 @@ getme_status getme_mesh_measure_all(getme_mesh *mesh,
         return GETME_ERR_ARGUMENT;
     for (int k = 0; k < GETME_NUM_TYPES * GETME_NUM_MEASURES; k++)
         init_stats(&stats[k], k % GETME_NUM_MEASURES);
-    double *v = values_buffer(mesh);
-    if (!v)
+    double *v = values_buffer(mesh), *v_max = values_buffer(mesh);
+    if (!v || !v_max) {
+        free(v);
+        free(v_max);
         return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
+    }
     for (int m = 0; m < GETME_NUM_MEASURES; m++) {
-        block_values(mesh, -1, m, v);
+        if (m == GETME_MEASURE_MAX_DIHEDRAL)
+            continue; /* with the min, from the same pass */
+        int dihedral = m == GETME_MEASURE_MIN_DIHEDRAL;
+        block_values(mesh, -1, m, v, dihedral ? v_max : NULL);
         reduce(mesh, v, 1, stats + m, GETME_NUM_MEASURES);
+        if (dihedral)
+            reduce(mesh, v_max, 1, stats + GETME_MEASURE_MAX_DIHEDRAL,
+                   GETME_NUM_MEASURES);
     }
     free(v);
+    free(v_max);
     return GETME_OK;
 }

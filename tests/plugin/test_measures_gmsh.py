@@ -21,6 +21,9 @@ inverted ones).  Expected differences, asserted as such (docs/quality.md):
     clockwise triangle getme's SICN is the negative of Gmsh's.
 The mesh-level statistics of getme.quality() (min, mean) are checked
 against the same Gmsh values.  Prints the largest differences per type.
+Last, independently of Gmsh: the dihedral angles of random tets and of
+affine hexes and prisms (planar faces) against the angles of their face
+normals.
 """
 import os
 import re
@@ -215,6 +218,54 @@ def random_case(kind, rng):
     return compare(kind, f"{kind} random", x, gs, gg)
 
 
+# ---- dihedral angles against face normals (independent of Gmsh) ----------
+
+def normal_dihedrals(x, faces):
+    """min, max interior dihedral angle (degrees) of an element with planar
+    faces (local node lists), from the faces' normals: at an edge shared by
+    faces f and g, the angle between the half-planes = arccos of the normals
+    taken towards the element's inside."""
+    centre = x.mean(axis=0)
+    normals = []
+    for f in faces:
+        n = np.cross(x[f[1]] - x[f[0]], x[f[2]] - x[f[0]])
+        if np.dot(n, centre - x[f[0]]) < 0:
+            n = -n
+        normals.append(n / np.linalg.norm(n))
+    angles = []
+    for i, f in enumerate(faces):
+        for j in range(i + 1, len(faces)):
+            if len(set(f) & set(faces[j])) == 2:
+                c = np.clip(np.dot(normals[i], normals[j]), -1, 1)
+                angles.append(180.0 - np.degrees(np.arccos(c)))
+    return min(angles), max(angles)
+
+
+def dihedral_case(rng):
+    faces = {"tet": [(0, 1, 2), (0, 1, 3), (1, 2, 3), (0, 2, 3)],
+             "hex": [(0, 1, 2, 3), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5),
+                     (2, 3, 7, 6), (3, 0, 4, 7)],
+             "prism": [(0, 1, 2), (3, 4, 5), (0, 1, 4, 3), (1, 2, 5, 4),
+                       (2, 0, 3, 5)]}
+    for kind, fl in faces.items():
+        worst = 0.0
+        for _ in range(300):
+            # tets: any nodes; hex and prism: affine images of the regular
+            # element (planar faces)
+            if kind == "tet":
+                x = rng.standard_normal((4, 3))
+            else:
+                a = rng.standard_normal((3, 3))
+                if np.linalg.det(a) < 0:
+                    a[:, 0] = -a[:, 0]
+                x = np.array(REGULAR[kind]) @ a.T
+            lo, hi = normal_dihedrals(x, fl)
+            worst = max(worst, abs(lo - getme.element_measure(kind, "min_dihedral", x)),
+                        abs(hi - getme.element_measure(kind, "max_dihedral", x)))
+        check(worst < 1e-8, f"{kind}: dihedral angles equal the face-normal ones ({worst:.2g} deg)")
+        print(f"{kind}: dihedral angles vs face normals, max difference {worst:.2g} degrees")
+
+
 def main():
     gmsh.initialize()
     gmsh.option.setNumber("General.Terminal", 0)
@@ -228,6 +279,7 @@ def main():
         print("%-8s %9.2g %9.2g     %9.2g %9.2g     mesh %d/%d, random %d/400 (%d inverted)"
               % (kind, ms, mg, rs, rg, n, total, rn, neg), flush=True)
     gmsh.finalize()
+    dihedral_case(rng)
     print(f"{PASSED[0]} passed, {len(FAILS)} failed")
     return 1 if FAILS else 0
 
