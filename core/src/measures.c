@@ -523,7 +523,6 @@ static void block_values(getme_mesh *mesh, int type, int m, double *v,
     double ysign = mesh->mirror == 1 ? -1.0 : 1.0;
     for (int b = 0; b < mesh->num_blocks; b++) {
         const getme_block *bl = &mesh->blocks[b];
-        int nv = getme__nv[bl->type];
         int skip = (type >= 0 && bl->type != type) ||
                    !getme_measure_defined((getme_elem_type)bl->type,
                                           (getme_measure)m);
@@ -540,13 +539,7 @@ static void block_values(getme_mesh *mesh, int type, int m, double *v,
                 continue;
             }
             double x[3 * GETME_MAX_NV];
-            const int32_t *c = bl->conn + (int64_t)e * nv;
-            for (int i = 0; i < nv; i++) {
-                const double *p = mesh->coords + 3 * (int64_t)c[i];
-                x[3 * i] = p[0];
-                x[3 * i + 1] = ysign * p[1];
-                x[3 * i + 2] = p[2];
-            }
+            getme__gather_local(mesh, bl, e, ysign, x);
             v[g] = measure(bl->type, m, x, &de, v_max ? v_max + g : NULL);
         }
     }

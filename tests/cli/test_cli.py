@@ -48,6 +48,8 @@ def run(*args, expect=0):
 # apart from libgetme and checked against it by the bench_quality test) -----
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "bench"))
 from quality import element_quality  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from gmsh_helpers import structured_hex_volume, two_unit_boxes  # noqa: E402
 
 
 GMSH_TYPES = {4: "tet", 5: "hex", 6: "prism", 7: "pyramid", 2: "tri", 3: "quad"}
@@ -113,20 +115,12 @@ def make(case, path):
         gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 1)
         gm.mesh.generate(3)
     elif case == "mixed":
-        b1 = occ.addBox(0, 0, 0, 1, 1, 1)
-        b2 = occ.addBox(1, 0, 0, 1, 1, 1)
-        occ.fragment([(3, b1)], [(3, b2)])
-        occ.synchronize()
+        two_unit_boxes()
         top = [s for s in gm.getBoundary([(3, 2)], oriented=False)
                if abs(occ.getCenterOfMass(2, s[1])[2] - 1) < 1e-9][0]
         occ.extrude([top], 0, 0, 0.5, numElements=[3], recombine=True)
         occ.synchronize()
-        for c in gm.getEntities(1):
-            gm.mesh.setTransfiniteCurve(c[1], 7)
-        for s in gm.getBoundary([(3, 1)], oriented=False):
-            gm.mesh.setTransfiniteSurface(s[1])
-            gm.mesh.setRecombine(2, s[1])
-        gm.mesh.setTransfiniteVolume(1)
+        structured_hex_volume(1, 7)
         gm.mesh.generate(3)
     elif case in ("tri", "quad"):
         r = occ.addRectangle(0, 0, 0, 2, 1)

@@ -20,7 +20,6 @@
 #define TOL 1e-12
 #define PI 3.14159265358979323846
 #define DEG (180.0 / PI)
-#define S3_2 0.86602540378443864676 /* sqrt3/2 */
 
 enum { MR = GETME_MEASURE_MEAN_RATIO, DMIN = GETME_MEASURE_MIN_DIHEDRAL,
        DMAX = GETME_MEASURE_MAX_DIHEDRAL, SJ = GETME_MEASURE_SCALED_JACOBIAN,
@@ -31,24 +30,11 @@ static double m(getme_elem_type t, int measure, const double *x)
     return getme_element_measure(t, (getme_measure)measure, x);
 }
 
-/* ---- regular elements (all edges 1) ------------------------------------- */
-
-static const double reg_tet[] = {0, 0, 0, 1, 0, 0, 0.5, S3_2, 0,
-                                 0.5, 0.28867513459481288225,
-                                 0.81649658092772603273};
-static const double reg_hex[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0,
-                                 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1};
-static const double reg_prism[] = {0, 0, 0, 1, 0, 0, 0.5, S3_2, 0,
-                                   0, 0, 1, 1, 0, 1, 0.5, S3_2, 1};
-static const double reg_pyramid[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0,
-                                     0.5, 0.5, 0.70710678118654752440};
-static const double reg_tri[] = {0, 0, 0, 1, 0, 0, 0.5, S3_2, 0};
-static const double reg_quad[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+#include "regular_elements.h"
 
 static void test_regular(void)
 {
-    const double *reg[GETME_NUM_TYPES] = {reg_tet, reg_hex, reg_prism,
-                                          reg_pyramid, reg_tri, reg_quad};
+    const double *const *reg = regular;
     /* dihedral angles: tet acos(1/3); prism 60 (sides) and 90; pyramid
        base-side atan(sqrt2) = 54.7356, side-side acos(-1/3) = 109.4712;
        hex and quad 90; tri 60 */

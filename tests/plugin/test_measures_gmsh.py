@@ -35,6 +35,9 @@ import numpy as np
 
 import getme
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from gmsh_helpers import structured_hex_volume, two_unit_boxes  # noqa: E402
+
 FAILS = []
 PASSED = [0]
 GMSH_TYPE = {"tet": 4, "hex": 5, "prism": 6, "pyramid": 7, "tri": 2, "quad": 3}
@@ -157,16 +160,8 @@ def generate(kind):
         gm.mesh.generate(3)
     elif kind == "pyramid":
         # a transfinite hex box next to a tet box: pyramids in between
-        b1 = occ.addBox(0, 0, 0, 1, 1, 1)
-        b2 = occ.addBox(1, 0, 0, 1, 1, 1)
-        occ.fragment([(3, b1)], [(3, b2)])
-        occ.synchronize()
-        for c in gm.getEntities(1):
-            gm.mesh.setTransfiniteCurve(c[1], 5)
-        for s in gm.getBoundary([(3, 1)], oriented=False):
-            gm.mesh.setTransfiniteSurface(s[1])
-            gm.mesh.setRecombine(2, s[1])
-        gm.mesh.setTransfiniteVolume(1)
+        two_unit_boxes()
+        structured_hex_volume(1, 5)
         gm.mesh.generate(3)
     else:
         r = occ.addRectangle(0, 0, 0, 2, 1)
