@@ -35,27 +35,11 @@ void cli_print_measures(const cli_log *log, const char *title,
                         const cli_measures *m)
 {
     for (int t = 0; t < GETME_NUM_TYPES; t++) {
-        const getme_measure_stats *s = m->stats[t];
-        if (!s[GETME_MEASURE_MEAN_RATIO].num_elements)
-            continue;
         char line[512];
-        int planar = getme_type_dim((getme_elem_type)t) == 2;
-        int n = snprintf(line, sizeof line, "%s (%s): %s %.2f to %.2f deg",
-                         title, getme_type_name((getme_elem_type)t),
-                         planar ? "angles" : "dihedral",
-                         s[GETME_MEASURE_MIN_DIHEDRAL].min,
-                         s[GETME_MEASURE_MAX_DIHEDRAL].max);
-        for (int k = GETME_MEASURE_SCALED_JACOBIAN; k < GETME_NUM_MEASURES; k++) {
-            if (!s[k].num_elements || n >= (int)sizeof line)
-                continue;
-            n += snprintf(line + n, sizeof line - (size_t)n,
-                          ", %s min %.4f mean %.4f", label(t, k), s[k].min,
-                          s[k].mean);
-            if (s[k].num_negative && n < (int)sizeof line)
-                n += snprintf(line + n, sizeof line - (size_t)n,
-                              " (%lld negative)", (long long)s[k].num_negative);
-        }
-        cli_info(log, "%s", line);
+        if (getme_measure_summary((getme_elem_type)t, m->stats[t], line,
+                                  sizeof line) > 0)
+            cli_info(log, "%s (%s): %s", title,
+                     getme_type_name((getme_elem_type)t), line);
     }
 }
 

@@ -353,6 +353,19 @@ GETME_API getme_status getme_mesh_measure_stats(getme_mesh *mesh, int type,
 GETME_API getme_status getme_mesh_measure_all(getme_mesh *mesh,
                                               getme_measure_stats *stats);
 
+/*
+ * One line summarising the measures of one element type, for logs:
+ * "dihedral 12.34 to 160.21 deg, scaled Jacobian min 0.2342 mean 0.7812,
+ * gamma min 0.1012 mean 0.8011, SICN min 0.3101 mean 0.8327" ("angles" for
+ * planar types; " (N negative)" after a measure with negative values).
+ * stats: the type's GETME_NUM_MEASURES entries, e.g.
+ * &all[type * GETME_NUM_MEASURES] from getme_mesh_measure_all().  Writes
+ * "" if the type has no element.  Returns what snprintf returns.
+ */
+GETME_API int getme_measure_summary(getme_elem_type type,
+                                    const getme_measure_stats *stats,
+                                    char *buf, size_t size);
+
 /* One measure of every element (num_elements doubles; NaN where not
    defined) into values. */
 GETME_API getme_status getme_mesh_element_measures(getme_mesh *mesh,

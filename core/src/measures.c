@@ -10,6 +10,7 @@
 #include "internal.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -655,4 +656,34 @@ getme_status getme_mesh_measure_all(getme_mesh *mesh,
     free(v);
     free(v_max);
     return GETME_OK;
+}
+
+int getme_measure_summary(getme_elem_type type,
+                          const getme_measure_stats *s, char *buf,
+                          size_t size)
+{
+    static const char *const label[GETME_NUM_MEASURES] = {
+        "mean ratio", "min dihedral", "max dihedral", "scaled Jacobian",
+        "gamma", "SICN"};
+    if (!buf || !size)
+        return 0;
+    buf[0] = '\0';
+    if (!s || !s[GETME_MEASURE_MEAN_RATIO].num_elements)
+        return 0;
+    int n = snprintf(buf, size, "%s %.2f to %.2f deg",
+                     getme_type_dim(type) == 2 ? "angles" : "dihedral",
+                     s[GETME_MEASURE_MIN_DIHEDRAL].min,
+                     s[GETME_MEASURE_MAX_DIHEDRAL].max);
+    for (int k = GETME_MEASURE_SCALED_JACOBIAN; k < GETME_NUM_MEASURES; k++) {
+        if (!s[k].num_elements)
+            continue;
+        size_t used = (size_t)n < size ? (size_t)n : size - 1;
+        n += snprintf(buf + used, size - used, ", %s min %.4f mean %.4f",
+                      label[k], s[k].min, s[k].mean);
+        used = (size_t)n < size ? (size_t)n : size - 1;
+        if (s[k].num_negative)
+            n += snprintf(buf + used, size - used, " (%lld negative)",
+                          (long long)s[k].num_negative);
+    }
+    return n;
 }

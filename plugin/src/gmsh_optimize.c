@@ -122,6 +122,7 @@ static void log_start(gg_run *run)
            "(worst over elements with a free node):",
            r->before.q_min_star, r->before.q_mean);
     gg_log_histogram(&r->before);
+    gg_log_measures("before", r->measures_before);
 }
 
 static void log_end(gg_run *run)
@@ -131,6 +132,7 @@ static void log_end(gg_run *run)
     gg_log("info", "Optimization ends with worst = %.6g / average = %.6g:",
            r->after.q_min_star, r->after.q_mean);
     gg_log_histogram(&r->after);
+    gg_log_measures("after", r->measures_after);
     if (run->params.method == GETME_METHOD_SMART_LAPLACE)
         gg_log("info", "%d Laplace iterations, %ld nodes moved",
                res->iterations, (long)r->num_moved);

@@ -335,6 +335,26 @@ static void test_mesh_stats(void)
     CHECK_EQ_INT(all[GETME_TET * GETME_NUM_MEASURES + GETME_MEASURE_SICN].num_elements, 3);
     CHECK_EQ_INT(getme_mesh_measure_all(mesh, NULL), GETME_ERR_ARGUMENT);
     getme_mesh_free(mesh);
+
+    /* the log summary of one regular tet, and of the three tets above */
+    CHECK_EQ_INT(getme_mesh_create(&mesh, 3, 4, reg_tet), GETME_OK);
+    CHECK_EQ_INT(getme_mesh_add_elements(mesh, GETME_TET, 1, conn, NULL), GETME_OK);
+    CHECK_EQ_INT(getme_mesh_measure_all(mesh, all), GETME_OK);
+    char line[256];
+    const char *want = "dihedral 70.53 to 70.53 deg, scaled Jacobian min 1.0000 "
+                       "mean 1.0000, gamma min 1.0000 mean 1.0000, SICN min "
+                       "1.0000 mean 1.0000";
+    int n = getme_measure_summary(GETME_TET, all, line, sizeof line);
+    CHECK(strcmp(line, want) == 0);
+    CHECK_EQ_INT(n, (int)strlen(want));
+    /* truncated: still terminated, the full length returned */
+    char shortbuf[12];
+    CHECK_EQ_INT(getme_measure_summary(GETME_TET, all, shortbuf, sizeof shortbuf), n);
+    CHECK(strcmp(shortbuf, "dihedral 70") == 0);
+    /* no hex: empty */
+    CHECK_EQ_INT(getme_measure_summary(GETME_HEX, all + GETME_NUM_MEASURES, line, sizeof line), 0);
+    CHECK(line[0] == '\0');
+    getme_mesh_free(mesh);
 }
 
 /* A clockwise planar mesh is measured as its mirror image (positive), like
