@@ -330,7 +330,9 @@ typedef struct getme_measure_stats {
     double hist_lo, hist_hi;            /* getme_measure_range()            */
     int64_t histogram[GETME_HIST_BINS]; /* values in [lo, hi] per bin, in
                                            equal bins; values above hi in
-                                           the last one                     */
+                                           the last one (mean ratio: invalid
+                                           elements, 0, are in the first
+                                           bin, unlike getme_quality_stats) */
 } getme_measure_stats;
 
 /*
