@@ -244,6 +244,8 @@ static int run(smooth_args *a)
 
     getme_quality_stats before = doc->stats, after;
     cli_print_stats(log, "Quality before", &before);
+    cli_measures mbefore, mafter;
+    cli_measures_log(log, mesh, "Measures before", &mbefore);
 
     cli_history history = {0};
     cli_worst_list worst = {0}, worst_free = {0};
@@ -277,6 +279,7 @@ static int run(smooth_args *a)
              res.cycles_min);
     getme_mesh_quality_stats(mesh, -1, &after);
     cli_print_stats(log, "Quality after ", &after);
+    cli_measures_log(log, mesh, "Measures after ", &mafter);
     if (res.corner_sj_initial < 1.0 || res.corner_sj < 1.0)
         cli_info(log, "Worst corner scaled Jacobian (hex, prism, pyramid, "
                       "quad): %.4f before, %.4f after",
@@ -309,7 +312,7 @@ static int run(smooth_args *a)
     if (a->report &&
         cli_write_report(a->report, a->input, a->output, &a->params, mesh,
                          &before, &after, &res, &history, doc, &worst,
-                         &worst_free) != 0) {
+                         &worst_free, &mbefore, &mafter) != 0) {
         cli_error("%s: cannot write the report", a->report);
         code = GETME_IO_ERR_WRITE;
     }

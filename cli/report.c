@@ -53,7 +53,8 @@ int cli_write_report(const char *path, const char *input, const char *output,
                      const getme_quality_stats *after, const getme_result *r,
                      const cli_history *h, const getme_doc *doc,
                      const cli_worst_list *worst,
-                     const cli_worst_list *worst_free)
+                     const cli_worst_list *worst_free,
+                     const cli_measures *mb, const cli_measures *ma)
 {
     FILE *f = fopen(path, "w");
     if (!f)
@@ -92,6 +93,11 @@ int cli_write_report(const char *path, const char *input, const char *output,
     json_stats(f, before);
     fputs(",\n  \"after\": ", f);
     json_stats(f, after);
+    fputs(",\n  \"measures\": {\"before\": ", f);
+    cli_json_measures(f, mb);
+    fputs(",\n    \"after\": ", f);
+    cli_json_measures(f, ma);
+    fputc('}', f);
     fprintf(f, ",\n  \"iterations\": {\"total\": %d, \"mean_stage\": %d, "
                "\"min_stage\": %d, \"min_cycles\": %d, \"finish_passes\": %d, "
                "\"finish_improved\": %d},\n",

@@ -279,6 +279,150 @@ GETME_API getme_status getme_mesh_worst_elements(getme_mesh *mesh,
 GETME_API const char *getme_worst_reason_string(getme_worst_reason reason);
 
 /* ------------------------------------------------------------------------ */
+/* Quality measures for analysts (docs/quality.md)                          */
+/* ------------------------------------------------------------------------ */
+
+/*
+ * The shape measures FE analysts read, besides the smoother's own mean
+ * ratio.  Corners are the node simplices of getme_element_quality(): hex
+ * every node with its 3 edge neighbours, prism every node with its 2
+ * triangle neighbours and its vertical edge, pyramid the 4 base nodes with
+ * their 2 base neighbours and the apex, quad every node with its 2
+ * neighbours.  Planar types use x and y only and are oriented
+ * counter-clockwise in the xy plane (mesh statistics use the mesh's
+ * orientation, see getme.h conventions).
+ *
+ *  MEAN_RATIO       getme_element_quality(): (0, 1], 1 regular, 0 invalid.
+ *  MIN_DIHEDRAL,    degrees.  3-D: the interior angle between the two faces
+ *  MAX_DIHEDRAL     at each edge, measured at both ends of the edge (faces
+ *                   may be non-planar: at end a the half-planes through the
+ *                   edge and a's neighbour in each face), in [0, 180];
+ *                   regular tet 70.5288, hex 90, prism 60/90, pyramid
+ *                   54.7356/109.4712.  2-D: the interior angle at each
+ *                   corner, in [0, 360) (> 180 at a reflex corner).
+ *                   Unsigned: an inverted tet has the angles of its mirror
+ *                   image.
+ *  SCALED_JACOBIAN  Verdict / CUBIT corner-based, signed (never clamped at
+ *                   0), 1 for the regular element:
+ *                   tet  sqrt2 det(e01,e02,e03) / max over the 4 nodes of
+ *                        the product of the 3 edge lengths at the node;
+ *                   hex  min over the 8 corners and the centre (principal
+ *                        axes) of det of the 3 unit edge vectors;
+ *                   prism 2/sqrt3 * min over the 6 corners of det of the 3
+ *                        unit edge vectors;
+ *                   pyramid sqrt2 * min over the 4 base corners of det of
+ *                        the 3 unit edge vectors, capped at 1 (a pyramid
+ *                        taller than the regular one would reach sqrt2);
+ *                   tri  2/sqrt3 cross(e01,e02) / max over the 3 nodes of
+ *                        the product of the 2 edge lengths at the node;
+ *                   quad min over the 4 corners of cross of the 2 unit
+ *                        edge vectors.
+ *                   Range [-1, 1]; prism [-2/sqrt3, 1] and pyramid
+ *                   [-sqrt2, 1] (a fully inverted element's worst corner
+ *                   can be its right-angled one).  0 for a zero-length
+ *                   edge.
+ *  GAMMA            Gmsh's gamma (its "gamma" element quality, 4.8.4):
+ *                   tet 3 r/R (inscribed / circumscribed sphere radius),
+ *                   tri 2 r/R (circles), both unsigned in [0, 1];
+ *                   prism min over the 6 corners of |det| of the 3 unit
+ *                   edge vectors times 2/sqrt3 (unsigned);
+ *                   quad s (1 - max |90 - a_k| / 90), a_k the angles
+ *                   between consecutive edge vectors in degrees, s = -1 if
+ *                   a corner is inverted.  Not defined (NaN, not counted)
+ *                   for hex and pyramid: Gmsh 4.8.4 returns 0 for them.
+ *  SICN             Gmsh's signed inverse condition number ("minSICN"):
+ *                   min over the corners of n det(S) / (|S|_F |cof S|_F)
+ *                   (2-D: 2 det(S) / |S|_F^2), S the corner's edge matrix
+ *                   times the inverse of the regular element's (the
+ *                   mean ratio's W); in [-1, 1], negative if inverted.
+ *
+ * Values are NaN when the measure is not defined for the type.  A
+ * degenerate element gives 0 (SICN, gamma, scaled Jacobian), never NaN,
+ * for finite coordinates.
+ */
+typedef enum getme_measure {
+    GETME_MEASURE_MEAN_RATIO = 0,
+    GETME_MEASURE_MIN_DIHEDRAL = 1,
+    GETME_MEASURE_MAX_DIHEDRAL = 2,
+    GETME_MEASURE_SCALED_JACOBIAN = 3,
+    GETME_MEASURE_GAMMA = 4,
+    GETME_MEASURE_SICN = 5,
+    GETME_NUM_MEASURES = 6
+} getme_measure;
+
+/* "mean_ratio", "min_dihedral", "max_dihedral", "scaled_jacobian",
+   "gamma", "sicn"; "unknown" for anything else. */
+GETME_API const char *getme_measure_name(getme_measure measure);
+/* 1 if the measure is defined for the type, else 0. */
+GETME_API int getme_measure_defined(getme_elem_type type,
+                                    getme_measure measure);
+/* The histogram range of a measure: [0, 1] for mean ratio, gamma, SICN and
+   scaled Jacobian (negative values are counted apart), [0, 180] degrees
+   for the dihedral angles.  Returns GETME_ERR_ARGUMENT if unknown. */
+GETME_API getme_status getme_measure_range(getme_measure measure,
+                                           double *lo, double *hi);
+
+/* One measure of one element (nodes as for getme_element_quality()).
+   NaN if the measure is not defined for the type or an argument is bad. */
+GETME_API double getme_element_measure(getme_elem_type type,
+                                       getme_measure measure,
+                                       const double *xyz);
+
+typedef struct getme_measure_stats {
+    int64_t num_elements; /* elements counted (the measure is defined)      */
+    int64_t num_negative; /* of them with a value < 0 (inverted corner)     */
+    int64_t num_below;    /* value < hist_lo: not in the histogram          */
+    double min, max, mean;/* 0 if num_elements is 0; mean in element order  */
+    int32_t min_element;  /* global index of the first element with min,    */
+    int32_t max_element;  /* ... with max; -1 if none                       */
+    double hist_lo, hist_hi;            /* getme_measure_range()            */
+    int64_t histogram[GETME_HIST_BINS]; /* values in [lo, hi] per bin, in
+                                           equal bins; values above hi in
+                                           the last one (mean ratio: invalid
+                                           elements, 0, are in the first
+                                           bin, unlike getme_quality_stats) */
+} getme_measure_stats;
+
+/*
+ * Statistics of one measure over the elements of one type (0..5) or of all
+ * types (-1; types where the measure is not defined are skipped).  The
+ * values are computed in parallel and reduced in element order:
+ * bit-identical for any thread count.
+ */
+GETME_API getme_status getme_mesh_measure_stats(getme_mesh *mesh, int type,
+                                                getme_measure measure,
+                                                getme_measure_stats *stats);
+
+/*
+ * Every measure of every element type at once: stats[type *
+ * GETME_NUM_MEASURES + measure] (GETME_NUM_TYPES * GETME_NUM_MEASURES
+ * entries) as getme_mesh_measure_stats(mesh, type, measure) gives them,
+ * num_elements 0 for absent types and undefined measures.  One pass over
+ * the elements per measure.
+ */
+GETME_API getme_status getme_mesh_measure_all(getme_mesh *mesh,
+                                              getme_measure_stats *stats);
+
+/*
+ * One line summarising the measures of one element type, for logs:
+ * "dihedral 12.34 to 160.21 deg, scaled Jacobian min 0.2342 mean 0.7812,
+ * gamma min 0.1012 mean 0.8011, SICN min 0.3101 mean 0.8327" ("angles" for
+ * planar types; " (N negative)" after a measure with negative values).
+ * stats: the type's GETME_NUM_MEASURES entries, e.g.
+ * &all[type * GETME_NUM_MEASURES] from getme_mesh_measure_all().  Writes
+ * "" if the type has no element.  Returns what snprintf returns.
+ */
+GETME_API int getme_measure_summary(getme_elem_type type,
+                                    const getme_measure_stats *stats,
+                                    char *buf, size_t size);
+
+/* One measure of every element (num_elements doubles; NaN where not
+   defined) into values. */
+GETME_API getme_status getme_mesh_element_measures(getme_mesh *mesh,
+                                                   getme_measure measure,
+                                                   double *values);
+
+/* ------------------------------------------------------------------------ */
 /* Smoothing parameters                                                     */
 /* ------------------------------------------------------------------------ */
 

@@ -130,6 +130,22 @@ enum {
     GETME__FIXED_UNUSED = 8     /* used by no element                      */
 };
 
+/* Gather element e of block bl (local index) into x (nv triples) with y
+   times ysign: -1 for a mirrored planar mesh (mesh->mirror == 1), else 1. */
+static inline void getme__gather_local(const getme_mesh *mesh,
+                                       const getme_block *bl, int32_t e,
+                                       double ysign, double *x)
+{
+    int nv = getme__nv[bl->type];
+    const int32_t *c = bl->conn + (int64_t)e * nv;
+    for (int i = 0; i < nv; i++) {
+        const double *p = mesh->coords + 3 * (int64_t)c[i];
+        x[3 * i] = p[0];
+        x[3 * i + 1] = ysign * p[1];
+        x[3 * i + 2] = p[2];
+    }
+}
+
 /* Record a printf-style message on the mesh and return status. */
 getme_status getme__fail(getme_mesh *mesh, getme_status status,
                          const char *fmt, ...)
