@@ -48,6 +48,7 @@ class Params(C.Structure):  # getme_params of getme.h
                 ("max_no_min_improve", C.c_int), ("min_tol", C.c_double),
                 ("threshold_fraction", C.c_double), ("keep_best", C.c_int),
                 ("num_threads", C.c_int), ("renumber", C.c_int),
+                ("untangle", C.c_int),
                 ("progress", PROGRESS_FN), ("progress_data", C.c_void_p)]
 
 
@@ -57,7 +58,9 @@ class Result(C.Structure):
                 ("q_min_star_initial", C.c_double), ("q_mean_initial", C.c_double),
                 ("q_min_star", C.c_double), ("q_mean", C.c_double),
                 ("q_min", C.c_double), ("threshold", C.c_double),
-                ("seconds", C.c_double), ("stop_reason", C.c_int)]
+                ("seconds", C.c_double), ("stop_reason", C.c_int),
+                ("num_invalid_initial", C.c_int64), ("untangle_sweeps", C.c_int),
+                ("untangle_seconds", C.c_double)]
 
 
 class Lib:

@@ -163,6 +163,22 @@ static getme_status check_valid(getme_mesh *mesh, const getme_ws *ws,
                        bad > nfirst ? ", ..." : "");
 }
 
+/* Untangle an invalid input on the workspace (nothing is stored if some
+   element stays invalid: the caller's mesh does not move). */
+static getme_status untangle(getme_mesh *mesh, getme_ws *ws, getme_run *run)
+{
+    getme_untangle_result ur;
+    getme_status st = getme__untangle(ws, run->q, &ur);
+    run->result->num_invalid_initial = ur.num_invalid_before;
+    run->result->untangle_sweeps = ur.sweeps;
+    run->result->untangle_seconds = ur.seconds;
+    if (st != GETME_OK)
+        return getme__fail(mesh, st, "out of memory untangling %d elements",
+                           (int)ws->ne);
+    return ur.num_invalid_after ? getme__untangle_message(mesh, &ur)
+                                : GETME_OK;
+}
+
 getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
                           getme_result *result)
 {
@@ -212,6 +228,8 @@ getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
         goto done;
     }
     getme__ws_qualities(&ws, run.q);
+    if (params->untangle && (st = untangle(mesh, &ws, &run)) != GETME_OK)
+        goto done;
     if ((st = check_valid(mesh, &ws, run.q)) != GETME_OK)
         goto done;
     getme__ws_summary(&ws, run.q, &result->q_mean_initial,

@@ -83,6 +83,16 @@ int getme__report(getme_run *run, int iteration, getme_stage stage, int cycle,
 /* GETMe adaptive; run->adj must be built (getme_smooth does it before the
    run's arrays, so that its temporaries do not add to the peak). */
 getme_status getme__adaptive(getme_run *run);
+
+/* Untangle ws in place (untangle.c); q holds the qualities at ws->x and is
+   kept up to date.  GETME_OK (res says how many elements stay invalid) or
+   GETME_ERR_NOMEM. */
+getme_status getme__untangle(getme_ws *ws, double *q,
+                             getme_untangle_result *res);
+/* Record on mesh the message naming the elements res says are still
+   invalid; returns GETME_ERR_INVALID_MESH. */
+getme_status getme__untangle_message(getme_mesh *mesh,
+                                     const getme_untangle_result *res);
 getme_status getme__laplace(getme_run *run);
 
 #endif /* GETME_SMOOTH_INTERNAL_H */
