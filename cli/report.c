@@ -89,6 +89,10 @@ int cli_write_report(const char *path, const char *input, const char *output,
     fprintf(f, ",\n  \"iterations\": {\"total\": %d, \"mean_stage\": %d, "
                "\"min_stage\": %d, \"min_cycles\": %d},\n",
             r->iterations, r->iterations_mean, r->iterations_min, r->cycles_min);
+    fprintf(f, "  \"untangle\": {\"invalid\": %lld, \"sweeps\": %d, "
+               "\"seconds\": %.6f},\n",
+            (long long)r->num_invalid_initial, r->untangle_sweeps,
+            r->untangle_seconds);
     fprintf(f, "  \"seconds\": %.6f,\n  \"stop_reason\": \"%s\",\n",
             r->seconds, stop_name(r->stop_reason));
     fputs("  \"history\": [", f);
