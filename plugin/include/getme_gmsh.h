@@ -80,6 +80,13 @@ GETME_GMSH_API void getme_gmsh_options_free(getme_gmsh_options *options);
  *   "fix_skin"       1 (default): also fix every node on the mesh skin
  *   "fix_interfaces" 1 (default): also fix nodes on faces between entities
  *                    of different physical groups
+ *   "untangle"       1 (default): untangle a mesh with invalid (inverted or
+ *                    degenerate) elements first (getme_mesh_untangle), with
+ *                    a warning giving the counts; 0: refuse it
+ *   "allow_invalid"  0 (default): if untangling leaves invalid elements the
+ *                    model is unchanged; 1: the partly untangled coordinates
+ *                    are written to the model (not smoothed); the call
+ *                    returns GETME_ERR_INVALID_MESH either way
  * GETME_ERR_ARGUMENT for an unknown name or a value out of range (the
  * reason is in getme_gmsh_options_error()).
  */
@@ -115,6 +122,8 @@ typedef struct getme_gmsh_report {
     getme_quality_stats before; /* mean-ratio statistics before and after    */
     getme_quality_stats after;
     getme_result result;        /* iterations per stage, stop reason ...     */
+    getme_untangle_result untangle; /* counts of the untangling step (all 0
+                                   when the mesh was valid)                  */
     double wall;                /* seconds for the whole call (wall, CPU)    */
     double cpu;
     char message[512];          /* "" on success, else the error             */
@@ -132,8 +141,10 @@ typedef struct getme_gmsh_report {
  * Returns GETME_OK, or: GETME_ERR_STATE (Gmsh not initialized, no mesh),
  * GETME_ERR_ARGUMENT (bad entity, unknown group), GETME_ERR_TOPOLOGY
  * (unsupported or second-order elements, non-planar surface),
- * GETME_ERR_INVALID_MESH (inverted elements), GETME_ERR_NOMEM.  On error
- * the model is unchanged.
+ * GETME_ERR_INVALID_MESH (inverted elements that untangling could not
+ * repair, named with their Gmsh tags in the message, or any inverted element
+ * with "untangle" = 0), GETME_ERR_NOMEM.  On error the model is unchanged
+ * (except the partly untangled coordinates with "allow_invalid" = 1).
  */
 GETME_GMSH_API getme_status getme_gmsh_optimize(
     int niter, const int *dim_tags, size_t dim_tags_n,
@@ -151,7 +162,9 @@ GETME_GMSH_API getme_status getme_gmsh_quality(
 /* A report value by name, for bindings: "dim", "num_entities", "num_nodes",
    "num_elements", "num_fixed", "num_moved", "wall", "cpu", "iterations",
    "iterations_mean", "iterations_min", "cycles_min", "stop_reason",
-   "threshold", "seconds", "<before|after>_<q_min_star|q_min|q_mean|q_max|
+   "threshold", "seconds", "untangle_invalid_before",
+   "untangle_invalid_after", "untangle_sweeps", "untangle_moved",
+   "untangle_seconds", "<before|after>_<q_min_star|q_min|q_mean|q_max|
    num_invalid|num_below_04|num_below_01|num_elements|num_free>",
    "<before|after>_hist<0..9>".  NaN for an unknown name. */
 GETME_GMSH_API double getme_gmsh_report_value(const getme_gmsh_report *report,

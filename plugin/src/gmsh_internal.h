@@ -33,6 +33,7 @@ struct getme_gmsh_options {
     int log;            /* 0, 1, 2 */
     int fix_skin;
     int fix_interfaces;
+    int allow_invalid;  /* write partly untangled coordinates back */
     int num_fix, cap_fix;
     char **fix;         /* physical group names or "dim:tag" */
     char error[256];

@@ -42,7 +42,8 @@ static getme_status bad(getme_gmsh_options *opt, const char *fmt,
     return GETME_ERR_ARGUMENT;
 }
 
-/* Our own names take 0/1 (fix_*) or 0..2 (log); the rest is libgetme's. */
+/* Our own names take 0/1 (fix_*, allow_invalid) or 0..2 (log); the rest
+   is libgetme's. */
 getme_status getme_gmsh_options_set(getme_gmsh_options *opt, const char *name,
                                     double value)
 {
@@ -52,6 +53,7 @@ getme_status getme_gmsh_options_set(getme_gmsh_options *opt, const char *name,
     int *flag = strcmp(name, "log") == 0              ? &opt->log
                 : strcmp(name, "fix_skin") == 0       ? &opt->fix_skin
                 : strcmp(name, "fix_interfaces") == 0 ? &opt->fix_interfaces
+                : strcmp(name, "allow_invalid") == 0  ? &opt->allow_invalid
                                                       : NULL;
     if (flag) {
         double hi = flag == &opt->log ? 2 : 1;

@@ -54,7 +54,9 @@ double getme_gmsh_report_value(const getme_gmsh_report *r, const char *name)
         "dim", "num_entities", "num_nodes", "num_elements", "num_fixed",
         "num_moved", "wall", "cpu", "iterations", "iterations_mean",
         "iterations_min", "cycles_min", "stop_reason", "threshold",
-        "seconds"};
+        "seconds", "untangle_invalid_before", "untangle_invalid_after",
+        "untangle_sweeps", "untangle_moved", "untangle_seconds"};
+    const getme_untangle_result *u = &r->untangle;
     const double values[] = {r->dim,
                              r->num_entities,
                              r->num_nodes,
@@ -69,7 +71,12 @@ double getme_gmsh_report_value(const getme_gmsh_report *r, const char *name)
                              res->cycles_min,
                              (double)res->stop_reason,
                              res->threshold,
-                             res->seconds};
+                             res->seconds,
+                             (double)u->num_invalid_before,
+                             (double)u->num_invalid_after,
+                             u->sweeps,
+                             u->num_moved,
+                             u->seconds};
     for (size_t i = 0; i < sizeof names / sizeof *names; i++)
         if (strcmp(name, names[i]) == 0)
             return values[i];

@@ -12,13 +12,19 @@ method     "getme" (GETMe adaptive) or "laplace" (smart Laplace)
 fix        physical group names (or "dim:tag") whose nodes stay fixed
 log        0 silent, 1 summary + histograms, 2 also one line per iteration
 params     any libgetme parameter: sigma, max_iter, tol, threshold_fraction,
-           max_no_min_improve, keep_best, num_threads, renumber; and
-           fix_skin, fix_interfaces (0/1)
+           max_no_min_improve, keep_best, num_threads, renumber, untangle
+           (1 by default: a mesh with inverted elements is untangled first,
+           with a Gmsh warning giving the counts; 0 refuses it); and
+           fix_skin, fix_interfaces, allow_invalid (0/1)
 
 Returns a dict: iterations (total, mean stage, min stage, cycles),
-q_min_star / q_min / q_mean before and after, nodes moved, seconds.
-Raises getme.GetmeError (with the Gmsh-logged message) on bad use; the
-model is then unchanged.
+q_min_star / q_min / q_mean before and after, nodes moved, seconds, and
+"untangle": invalid_before / invalid_after / sweeps / nodes_moved /
+seconds of the untangling step.
+Raises getme.GetmeError (with the Gmsh-logged message) on bad use, and with
+status 3 when inverted elements could not be untangled (the message names
+them by their Gmsh tags); the model is then unchanged, except with
+allow_invalid=1, which writes the partly untangled coordinates.
 """
 import ctypes
 import os
@@ -75,6 +81,12 @@ def _report_dict(rep):
         out["num_invalid_" + when] = int(val(when + "_num_invalid"))
         out["histogram_" + when] = [int(val("%s_hist%d" % (when, b)))
                                     for b in range(_lib.HIST_BINS)]
+    out["untangle"] = {k: val("untangle_" + k) for k in
+                       ("invalid_before", "invalid_after", "sweeps", "moved",
+                        "seconds")}
+    for k in ("invalid_before", "invalid_after", "sweeps", "moved"):
+        out["untangle"][k] = int(out["untangle"][k])
+    out["untangle"]["nodes_moved"] = out["untangle"].pop("moved")
     return out
 
 
