@@ -44,8 +44,14 @@
 #define SWEEPS_PER_RING 25
 /* Rings of free nodes that may be added around the invalid elements. */
 #define MAX_RINGS 3
-/* Newton steps per node visit. */
+/* Newton steps per node visit; a visit ends early after a step shorter
+   than STEP_TOL local sizes. */
 #define NEWTON_STEPS 3
+#define STEP_TOL 1e-4
+/* A node that moves less than STEP_QUIET local sizes in a visit does not
+   make its neighbours be visited again in the next sweep: nodes whose
+   neighbourhood did not change are skipped (their optimum did not move). */
+#define STEP_QUIET 1e-3
 /* eps = EPS_REL * (local size)^d: delta stays positive while a corner of
    the node's star has sigma below it. */
 #define EPS_REL 1e-3
@@ -176,34 +182,31 @@ static int element_untangled(const getme_ws *ws, const double *coords,
 
 /* ---- one node's objective ----------------------------------------------- */
 
-typedef struct node_ctx {
-    const getme_ws *ws;
-    const double *x; /* current coordinates (node i's own entry unused) */
-    int32_t i;
-    int d;
-    double delta2;
-} node_ctx;
+/* A corner containing the node being optimised, affine in its position p:
+   S(p) = s0 + p r^T (r: the row of W^-1 that multiplies the node, or minus
+   their sum for the corner's own node). */
+typedef struct corner_lin {
+    double s0[3][3]; /* columns of S with the node at the origin */
+    double r[3];
+} corner_lin;
 
-/* Sum of eta over the corners containing node i with i placed at p; the
-   gradient with respect to p into g (if not NULL).  +inf where h = 0
-   (delta = 0 and a corner with sigma <= 0). */
-static double node_objective(const node_ctx *c, const double *p, double *g)
+/* Most corners a node can be in: every element of its star has at most 8. */
+#define CORNERS_PER_ELEMENT 8
+
+/* The corners of node i's star that contain it, into out; returns their
+   number. */
+static int node_corners(const getme_ws *ws, const double *coords, int32_t i,
+                        corner_lin *out)
 {
-    const getme_ws *ws = c->ws;
-    const int d = c->d;
-    double sum = 0.0;
-    if (g)
-        g[0] = g[1] = g[2] = 0.0;
-    for (int64_t k = ws->star_ptr[c->i]; k < ws->star_ptr[c->i + 1]; k++) {
+    const int d = ws->dim;
+    int n = 0;
+    for (int64_t k = ws->star_ptr[i]; k < ws->star_ptr[i + 1]; k++) {
         int32_t e = ws->star[k];
         int t = getme__ws_type(ws, e);
-        const int32_t *nodes = getme__ws_nodes(ws, t, e);
-        int nv = getme__nv[t];
         double x[3 * GETME_MAX_NV];
-        getme__ws_gather(ws, c->x, t, e, x);
-        int li = getme__local_index(nodes, nv, c->i);
-        for (int m = 0; m < 3; m++)
-            x[3 * li + m] = p[m];
+        getme__ws_gather(ws, coords, t, e, x);
+        int li = getme__local_index(getme__ws_nodes(ws, t, e), getme__nv[t], i);
+        x[3 * li] = x[3 * li + 1] = x[3 * li + 2] = 0.0;
         const corner_table *ct = &CORNERS[t];
         for (int q = 0; q < ct->num; q++) {
             int j = -1;
@@ -212,35 +215,67 @@ static double node_objective(const node_ctx *c, const double *p, double *g)
                     j = m;
             if (j < 0)
                 continue;
-            double s[3][3] = {{0}}, cof[3][3], f;
-            corner_s(x, ct, q, d, s);
-            double sigma = corner_det(s, d, &f, g ? cof : NULL);
-            double r = sqrt(sigma * sigma + 4.0 * c->delta2);
-            /* (sigma + r) / 2 without cancellation for sigma < 0 */
-            double h = sigma >= 0.0 ? 0.5 * (sigma + r)
-                                    : 2.0 * c->delta2 / (r - sigma);
-            if (!(h > 0.0))
-                return INFINITY;
-            double hp = d == 3 ? cbrt(h) * cbrt(h) : h; /* h^(2/d) */
-            double eta = f / ((double)d * hp);
-            sum += eta;
-            if (!g)
-                continue;
-            /* d eta / d S = 2 S / (d h^(2/d)) - (2/d) (eta / r) cof S, and
-               d S / d p = (row j of W^-1, or minus their sum for j = 0) */
-            double a = 2.0 / ((double)d * hp), b = 2.0 / (double)d * eta / r;
-            double row[3] = {0.0, 0.0, 0.0};
-            for (int n = 0; n < d; n++) {
+            corner_lin *c = &out[n++];
+            memset(c, 0, sizeof *c);
+            corner_s(x, ct, q, d, c->s0);
+            for (int col = 0; col < d; col++) {
                 if (j > 0)
-                    row[n] = ct->winv[j - 1][n];
+                    c->r[col] = ct->winv[j - 1][col];
                 else
                     for (int m = 0; m < d; m++)
-                        row[n] -= ct->winv[m][n];
+                        c->r[col] -= ct->winv[m][col];
             }
-            for (int n = 0; n < d; n++)
-                for (int m = 0; m < d; m++)
-                    g[m] += (a * s[n][m] - b * cof[n][m]) * row[n];
         }
+    }
+    return n;
+}
+
+typedef struct node_ctx {
+    const corner_lin *corners;
+    int num, d;
+    double delta2;
+} node_ctx;
+
+static inline void corner_at(const corner_lin *c, const double *p, int d,
+                             double s[3][3])
+{
+    for (int n = 0; n < d; n++)
+        for (int m = 0; m < d; m++)
+            s[n][m] = c->s0[n][m] + p[m] * c->r[n];
+}
+
+/* Sum of eta over the node's corners with the node placed at p; the
+   gradient with respect to p into g (if not NULL).  +inf where h = 0
+   (delta = 0 and a corner with sigma <= 0). */
+static double node_objective(const node_ctx *c, const double *p, double *g)
+{
+    const int d = c->d;
+    double sum = 0.0;
+    if (g)
+        g[0] = g[1] = g[2] = 0.0;
+    for (int q = 0; q < c->num; q++) {
+        double s[3][3] = {{0}}, cof[3][3], f;
+        corner_at(&c->corners[q], p, d, s);
+        double sigma = corner_det(s, d, &f, g ? cof : NULL);
+        double r = sqrt(sigma * sigma + 4.0 * c->delta2);
+        /* (sigma + r) / 2 without cancellation for sigma < 0 */
+        double h = sigma >= 0.0 ? 0.5 * (sigma + r)
+                                : 2.0 * c->delta2 / (r - sigma);
+        if (!(h > 0.0))
+            return INFINITY;
+        double hc = d == 3 ? cbrt(h) : 1.0;
+        double hp = d == 3 ? hc * hc : h; /* h^(2/d) */
+        double eta = f / ((double)d * hp);
+        sum += eta;
+        if (!g)
+            continue;
+        /* d eta / d S = 2 S / (d h^(2/d)) - (2/d) (eta / r) cof S, and
+           d S / d p = r_j: grad = (d eta / d S) r_j */
+        double a = 2.0 / ((double)d * hp), b = 2.0 / (double)d * eta / r;
+        const double *row = c->corners[q].r;
+        for (int n = 0; n < d; n++)
+            for (int m = 0; m < d; m++)
+                g[m] += (a * s[n][m] - b * cof[n][m]) * row[n];
     }
     return sum;
 }
@@ -281,51 +316,37 @@ static int solve_shifted(double H[3][3], double mu, const double *g,
     return 1;
 }
 
-/* Smallest sigma and mean |S|^2 / d over the corners containing node i. */
-static void node_scales(const getme_ws *ws, const double *coords, int32_t i,
-                        double *sigma_min, double *size2)
+/* Smallest sigma and mean |S|^2 / d over the node's corners at p. */
+static void node_scales(const node_ctx *c, const double *p, double *sigma_min,
+                        double *size2)
 {
-    int d = ws->dim, count = 0;
     double smin = INFINITY, fsum = 0.0;
-    for (int64_t k = ws->star_ptr[i]; k < ws->star_ptr[i + 1]; k++) {
-        int32_t e = ws->star[k];
-        int t = getme__ws_type(ws, e);
-        double x[3 * GETME_MAX_NV];
-        getme__ws_gather(ws, coords, t, e, x);
-        int li = getme__local_index(getme__ws_nodes(ws, t, e), getme__nv[t], i);
-        const corner_table *ct = &CORNERS[t];
-        for (int q = 0; q < ct->num; q++) {
-            int in = 0;
-            for (int m = 0; m <= d; m++)
-                in |= ct->node[q][m] == li;
-            if (!in)
-                continue;
-            double s[3][3] = {{0}}, f;
-            corner_s(x, ct, q, d, s);
-            double det = corner_det(s, d, &f, NULL);
-            smin = det < smin ? det : smin;
-            fsum += f;
-            count++;
-        }
+    for (int q = 0; q < c->num; q++) {
+        double s[3][3] = {{0}}, f;
+        corner_at(&c->corners[q], p, c->d, s);
+        double det = corner_det(s, c->d, &f, NULL);
+        smin = det < smin ? det : smin;
+        fsum += f;
     }
     *sigma_min = smin;
-    *size2 = count ? fsum / ((double)d * count) : 0.0;
+    *size2 = c->num ? fsum / ((double)c->d * c->num) : 0.0;
 }
 
-/* Optimise node i (writes coords[3 i ..] only).  Returns 1 if it moved. */
-static int optimise_node(const getme_ws *ws, double *coords, int32_t i)
+/* Optimise node i (writes coords[3 i ..] only).  Returns 0 if it did not
+   move, 1 if it moved by less than STEP_QUIET local sizes, else 2. */
+static int optimise_node(const getme_ws *ws, double *coords, int32_t i,
+                         corner_lin *scratch)
 {
-    node_ctx c = {ws, coords, i, ws->dim, 0.0};
     const int d = ws->dim;
-    double smin, size2;
-    node_scales(ws, coords, i, &smin, &size2);
+    node_ctx c = {scratch, node_corners(ws, coords, i, scratch), d, 0.0};
+    double p[3], g[3], smin, size2;
+    memcpy(p, coords + 3 * (int64_t)i, sizeof p);
+    node_scales(&c, p, &smin, &size2);
     if (!(size2 > 0.0) || !isfinite(size2))
         return 0;
     double len = sqrt(size2);
     double eps = EPS_REL * (d == 3 ? size2 * len : size2);
     c.delta2 = smin < eps ? eps * (eps - smin) : 0.0;
-    double p[3], g[3];
-    memcpy(p, coords + 3 * (int64_t)i, sizeof p);
     double f = node_objective(&c, p, g);
     if (!isfinite(f))
         return 0;
@@ -394,12 +415,16 @@ static int optimise_node(const getme_ws *ws, double *coords, int32_t i)
         memcpy(p, pt, sizeof p);
         f = node_objective(&c, p, g);
         moved = 1;
-        if (alpha * alpha * dn < 1e-20 * size2)
+        if (alpha * alpha * dn < STEP_TOL * STEP_TOL * size2)
             break;
     }
-    if (moved)
-        memcpy(coords + 3 * (int64_t)i, p, sizeof p);
-    return moved;
+    if (!moved)
+        return 0;
+    double *x = coords + 3 * (int64_t)i, dist2 = 0.0;
+    for (int m = 0; m < d; m++)
+        dist2 += (p[m] - x[m]) * (p[m] - x[m]);
+    memcpy(x, p, sizeof p);
+    return dist2 < STEP_QUIET * STEP_QUIET * size2 ? 1 : 2;
 }
 
 /* ---- the driver --------------------------------------------------------- */
@@ -407,7 +432,9 @@ static int optimise_node(const getme_ws *ws, double *coords, int32_t i)
 typedef struct ut_state {
     getme_ws *ws;
     double *q;          /* ne qualities at ws->x, kept up to date          */
-    uint8_t *nflag;     /* nn: bit 1 moving, bit 2 has moved               */
+    uint8_t *nflag;     /* nn: bit 1 moving, bit 2 has moved, bit 4 moved
+                           more than STEP_QUIET in the previous sweep (or
+                           is new), bit 8 in this sweep                    */
     uint8_t *eflag;     /* ne: bit 1 in the region (touches a moving node) */
     int32_t *nodes;     /* moving nodes, by colour, ascending inside one   */
     int32_t *colour_ptr;/* num_colours + 1                                 */
@@ -417,6 +444,8 @@ typedef struct ut_state {
     int32_t num_elems;
     int32_t *stamp;     /* colour marks, max colours entries               */
     int32_t max_colours;
+    corner_lin *scratch;/* per thread: the corners of the node in hand    */
+    int64_t scratch_per_thread;
 } ut_state;
 
 /* Colour the moving nodes greedily in ascending order (serial, so the
@@ -499,7 +528,7 @@ static int32_t grow_ring(ut_state *u)
                 const int32_t *cf = getme__ws_nodes(ws, tf, f);
                 for (int w = 0; w < getme__nv[tf]; w++)
                     if (!ws->fixed[cf[w]] && !(u->nflag[cf[w]] & 1)) {
-                        u->nflag[cf[w]] |= 1;
+                        u->nflag[cf[w]] |= 1 | 8;
                         added++;
                     }
             }
@@ -507,20 +536,51 @@ static int32_t grow_ring(ut_state *u)
     return added;
 }
 
+/* 1 if a node sharing an element with node i (or i itself) moved by more
+   than STEP_QUIET in the previous sweep or, for the colours already done,
+   in this one.  Same-colour nodes share no element, so the flags read were
+   written by finished colour phases only: no race, any thread count. */
+static int neighbourhood_changed(const ut_state *u, int32_t i)
+{
+    const getme_ws *ws = u->ws;
+    for (int64_t k = ws->star_ptr[i]; k < ws->star_ptr[i + 1]; k++) {
+        int32_t e = ws->star[k];
+        int t = getme__ws_type(ws, e);
+        const int32_t *c = getme__ws_nodes(ws, t, e);
+        for (int v = 0; v < getme__nv[t]; v++)
+            if (u->nflag[c[v]] & 12)
+                return 1;
+    }
+    return 0;
+}
+
 /* One Gauss-Seidel sweep in colour order; then the region's qualities.
    Returns the number of region elements not yet untangled (with a free
-   node) into *pending and the invalid ones into *invalid. */
-static void sweep(ut_state *u, int32_t *pending, int32_t *invalid)
+   node) into *pending and the invalid ones into *invalid.  Returns the
+   number of nodes visited (0: nothing changed since the last sweep). */
+static int32_t sweep(ut_state *u, int32_t *pending, int32_t *invalid)
 {
+    int32_t visited = 0;
     getme_ws *ws = u->ws;
     const int nt = ws->nt;
+    for (int32_t k = 0; k < u->num_nodes; k++) {
+        uint8_t *f = &u->nflag[u->nodes[k]];
+        *f = (uint8_t)((*f & ~12) | ((*f & 8) ? 4 : 0));
+    }
     for (int32_t c = 0; c < u->num_colours; c++) {
         int32_t a = u->colour_ptr[c], b = u->colour_ptr[c + 1];
-#pragma omp parallel for schedule(static) num_threads(nt) if (b - a > PAR_MIN)
+#pragma omp parallel for schedule(static) num_threads(nt) \
+    reduction(+ : visited) if (b - a > PAR_MIN)
         for (int32_t k = a; k < b; k++) {
             int32_t i = u->nodes[k];
-            if (optimise_node(ws, ws->x, i))
-                u->nflag[i] |= 2;
+            if (!neighbourhood_changed(u, i))
+                continue;
+            visited++;
+            int r = optimise_node(ws, ws->x, i,
+                                  u->scratch + (int64_t)omp_get_thread_num() *
+                                                   u->scratch_per_thread);
+            if (r)
+                u->nflag[i] |= (uint8_t)(r == 2 ? 2 | 8 : 2);
         }
     }
     int32_t pend = 0, bad = 0;
@@ -537,6 +597,7 @@ static void sweep(ut_state *u, int32_t *pending, int32_t *invalid)
     }
     *pending = pend;
     *invalid = bad;
+    return visited;
 }
 
 getme_status getme__untangle(getme_ws *ws, double *q,
@@ -562,8 +623,12 @@ getme_status getme__untangle(getme_ws *ws, double *q,
     u.colour = malloc(nn * sizeof *u.colour);
     u.elems = malloc(ne * sizeof *u.elems);
     u.stamp = calloc((size_t)u.max_colours, sizeof *u.stamp);
+    u.scratch_per_thread = (int64_t)CORNERS_PER_ELEMENT * ws->max_star;
+    u.scratch = malloc((size_t)(ws->nt * u.scratch_per_thread) *
+                       sizeof *u.scratch);
     getme_status st = GETME_ERR_NOMEM;
-    if (!u.nflag || !u.eflag || !u.nodes || !u.colour || !u.elems || !u.stamp)
+    if (!u.nflag || !u.eflag || !u.nodes || !u.colour || !u.elems || !u.stamp ||
+        !u.scratch)
         goto out;
     /* ring 0: the free nodes of the invalid elements */
     for (int32_t e = 0; e < ws->ne; e++) {
@@ -573,7 +638,7 @@ getme_status getme__untangle(getme_ws *ws, double *q,
         const int32_t *c = getme__ws_nodes(ws, t, e);
         for (int v = 0; v < getme__nv[t]; v++)
             if (!ws->fixed[c[v]])
-                u.nflag[c[v]] |= 1;
+                u.nflag[c[v]] |= 1 | 8;
     }
     for (int ring = 0; ring <= MAX_RINGS; ring++) {
         if ((st = colour_nodes(&u)) != GETME_OK)
@@ -583,8 +648,10 @@ getme_status getme__untangle(getme_ws *ws, double *q,
         collect_region(&u);
         res->rings = ring;
         int32_t pending = 1, invalid = 1;
-        for (int s = 0; s < SWEEPS_PER_RING && pending > 0; s++) {
-            sweep(&u, &pending, &invalid);
+        int32_t visited = 1;
+        for (int s = 0; s < SWEEPS_PER_RING && pending > 0 && visited > 0;
+             s++) {
+            visited = sweep(&u, &pending, &invalid);
             res->sweeps++;
         }
         if (invalid == 0 || ring == MAX_RINGS || grow_ring(&u) == 0)
@@ -623,6 +690,7 @@ out:
     free(u.colour);
     free(u.elems);
     free(u.stamp);
+    free(u.scratch);
     free(u.colour_ptr);
     res->seconds = omp_get_wtime() - t0;
     return st;
