@@ -24,6 +24,8 @@ from quality import element_quality  # noqa: E402
 
 GETME, WORK = sys.argv[1], sys.argv[2]
 os.makedirs(WORK, exist_ok=True)
+for name in os.listdir(WORK):  # outputs of an earlier run
+    os.remove(os.path.join(WORK, name))
 N, E0, N0 = 6, 101, 1001
 failures, passed = [], 0
 
