@@ -179,6 +179,27 @@ static getme_status untangle(getme_mesh *mesh, getme_ws *ws, getme_run *run)
                                 : GETME_OK;
 }
 
+getme_status getme__start(getme_mesh *mesh, const getme_params **params,
+                          getme_params *defaults, getme_ws *ws)
+{
+    if (!*params) {
+        getme_params_init(defaults);
+        *params = defaults;
+    }
+    mesh->error[0] = '\0';
+    if (mesh->num_elements == 0)
+        return getme__fail(mesh, GETME_ERR_STATE, "the mesh has no elements");
+    const char *problem = getme__params_problem(*params);
+    if (problem)
+        return getme__fail(mesh, GETME_ERR_ARGUMENT, "parameters: %s", problem);
+    int nt = (*params)->num_threads > 0 ? (*params)->num_threads
+                                        : omp_get_max_threads();
+    getme_status st = getme__ws_build(ws, mesh, (*params)->renumber, nt);
+    if (st != GETME_OK)
+        return getme__fail(mesh, st, "out of memory building the workspace");
+    return GETME_OK;
+}
+
 getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
                           getme_result *result)
 {
@@ -186,27 +207,14 @@ getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
     getme_result local;
     if (!mesh)
         return GETME_ERR_ARGUMENT;
-    if (!params) {
-        getme_params_init(&defaults);
-        params = &defaults;
-    }
     if (!result)
         result = &local;
     memset(result, 0, sizeof *result);
-    mesh->error[0] = '\0';
     double t0 = omp_get_wtime();
-    if (mesh->num_elements == 0)
-        return getme__fail(mesh, GETME_ERR_STATE, "the mesh has no elements");
-    const char *problem = getme__params_problem(params);
-    if (problem)
-        return getme__fail(mesh, GETME_ERR_ARGUMENT, "parameters: %s", problem);
-    int nt = params->num_threads > 0 ? params->num_threads
-                                     : omp_get_max_threads();
-
     getme_ws ws;
-    getme_status st = getme__ws_build(&ws, mesh, params->renumber, nt);
+    getme_status st = getme__start(mesh, &params, &defaults, &ws);
     if (st != GETME_OK)
-        return getme__fail(mesh, st, "out of memory building the workspace");
+        return st;
     getme_run run;
     memset(&run, 0, sizeof run);
     getme_adj adj;

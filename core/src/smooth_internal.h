@@ -50,6 +50,13 @@ typedef struct getme_run {
     int64_t cap_qold;
 } getme_run;
 
+/* The start of getme_smooth() and getme_mesh_untangle(): params NULL ->
+   defaults (filled in), error cleared, a mesh with elements and usable
+   params, the workspace built.  GETME_OK, or a status with the message on
+   the mesh. */
+getme_status getme__start(getme_mesh *mesh, const getme_params **params,
+                          getme_params *defaults, getme_ws *ws);
+
 getme_status getme__run_alloc(getme_run *run);
 void getme__run_free(getme_run *run);
 

@@ -402,9 +402,10 @@ static int optimise_node(const getme_ws *ws, double *coords, int32_t i,
         }
         if (!(slope < 0.0))
             break;
-        double alpha = 1.0, pt[3], ft = f;
+        double alpha = 2.0, pt[3], ft = f;
         int accepted = 0;
-        for (int ls = 0; ls < 30 && !accepted; ls++, alpha *= 0.5) {
+        for (int ls = 0; ls < 30 && !accepted; ls++) {
+            alpha *= 0.5;
             for (int m = 0; m < 3; m++)
                 pt[m] = m < d ? p[m] + alpha * dir[m] : p[m];
             ft = node_objective(&c, pt, NULL);
@@ -720,26 +721,14 @@ getme_status getme_mesh_untangle(getme_mesh *mesh, const getme_params *params,
     getme_untangle_result local;
     if (!mesh)
         return GETME_ERR_ARGUMENT;
-    if (!params) {
-        getme_params_init(&defaults);
-        params = &defaults;
-    }
     if (!result)
         result = &local;
     memset(result, 0, sizeof *result);
-    mesh->error[0] = '\0';
     double t0 = omp_get_wtime();
-    if (mesh->num_elements == 0)
-        return getme__fail(mesh, GETME_ERR_STATE, "the mesh has no elements");
-    if (params->num_threads < 0)
-        return getme__fail(mesh, GETME_ERR_ARGUMENT,
-                           "parameters: num_threads must be >= 0");
-    int nt = params->num_threads > 0 ? params->num_threads
-                                     : omp_get_max_threads();
     getme_ws ws;
-    getme_status st = getme__ws_build(&ws, mesh, params->renumber, nt);
+    getme_status st = getme__start(mesh, &params, &defaults, &ws);
     if (st != GETME_OK)
-        return getme__fail(mesh, st, "out of memory building the workspace");
+        return st;
     double *q = malloc((size_t)ws.ne * sizeof *q);
     if (!q) {
         getme__ws_free(&ws);
