@@ -244,19 +244,32 @@ static inline void corner_at(const corner_lin *c, const double *p, int d,
             s[n][m] = c->s0[n][m] + p[m] * c->r[n];
 }
 
-/* Sum of eta over the node's corners with the node placed at p; the
-   gradient with respect to p into g (if not NULL).  +inf where h = 0
-   (delta = 0 and a corner with sigma <= 0). */
-static double node_objective(const node_ctx *c, const double *p, double *g)
+/*
+ * Sum of eta over the node's corners with the node placed at p; its
+ * gradient into g and Hessian into H (each may be NULL).  +inf where h = 0
+ * (delta = 0 and a corner with sigma <= 0).
+ *
+ * With S = S0 + p r^T: F = |S|^2 is quadratic in p (grad 2 u, u = sum_n
+ * r_n s_n; Hessian 2 |r|^2 I) and sigma = det S is affine in p (matrix
+ * determinant lemma; grad v = sum_n r_n cof_n).  With phi = h^(-2/d) / d,
+ * eta = F phi(sigma), phi' = -(2/d) phi / r, phi'' = -(2/d) (phi' - phi
+ * sigma / r^2) / r (r = sqrt(sigma^2 + 4 delta^2), h' = h / r):
+ *   grad eta = 2 phi u + F phi' v,
+ *   Hess eta = 2 |r|^2 phi I + 2 phi' (u v^T + v u^T) + F phi'' v v^T.
+ */
+static double node_objective(const node_ctx *c, const double *p, double *g,
+                             double H[3][3])
 {
     const int d = c->d;
     double sum = 0.0;
     if (g)
         g[0] = g[1] = g[2] = 0.0;
+    if (H)
+        memset(H, 0, 9 * sizeof **H);
     for (int q = 0; q < c->num; q++) {
         double s[3][3] = {{0}}, cof[3][3], f;
         corner_at(&c->corners[q], p, d, s);
-        double sigma = corner_det(s, d, &f, g ? cof : NULL);
+        double sigma = corner_det(s, d, &f, g || H ? cof : NULL);
         double r = sqrt(sigma * sigma + 4.0 * c->delta2);
         /* (sigma + r) / 2 without cancellation for sigma < 0 */
         double h = sigma >= 0.0 ? 0.5 * (sigma + r)
@@ -264,18 +277,31 @@ static double node_objective(const node_ctx *c, const double *p, double *g)
         if (!(h > 0.0))
             return INFINITY;
         double hc = d == 3 ? cbrt(h) : 1.0;
-        double hp = d == 3 ? hc * hc : h; /* h^(2/d) */
-        double eta = f / ((double)d * hp);
-        sum += eta;
-        if (!g)
+        double phi = 1.0 / ((double)d * (d == 3 ? hc * hc : h));
+        sum += f * phi;
+        if (!g && !H)
             continue;
-        /* d eta / d S = 2 S / (d h^(2/d)) - (2/d) (eta / r) cof S, and
-           d S / d p = r_j: grad = (d eta / d S) r_j */
-        double a = 2.0 / ((double)d * hp), b = 2.0 / (double)d * eta / r;
         const double *row = c->corners[q].r;
-        for (int n = 0; n < d; n++)
+        double u[3] = {0.0, 0.0, 0.0}, v[3] = {0.0, 0.0, 0.0}, r2 = 0.0;
+        for (int n = 0; n < d; n++) {
+            r2 += row[n] * row[n];
+            for (int m = 0; m < d; m++) {
+                u[m] += row[n] * s[n][m];
+                v[m] += row[n] * cof[n][m];
+            }
+        }
+        double phi1 = -2.0 / (double)d * phi / r;
+        if (g)
             for (int m = 0; m < d; m++)
-                g[m] += (a * s[n][m] - b * cof[n][m]) * row[n];
+                g[m] += 2.0 * phi * u[m] + f * phi1 * v[m];
+        if (!H)
+            continue;
+        double phi2 = -2.0 / (double)d * (phi1 - phi * sigma / (r * r)) / r;
+        for (int m = 0; m < d; m++)
+            for (int n = 0; n < d; n++)
+                H[m][n] += (m == n ? 2.0 * r2 * phi : 0.0) +
+                           2.0 * phi1 * (u[m] * v[n] + v[m] * u[n]) +
+                           f * phi2 * v[m] * v[n];
     }
     return sum;
 }
@@ -347,30 +373,21 @@ static int optimise_node(const getme_ws *ws, double *coords, int32_t i,
     double len = sqrt(size2);
     double eps = EPS_REL * (d == 3 ? size2 * len : size2);
     c.delta2 = smin < eps ? eps * (eps - smin) : 0.0;
-    double f = node_objective(&c, p, g);
+    double H[3][3];
+    double f = node_objective(&c, p, g, H);
     if (!isfinite(f))
         return 0;
     int moved = 0;
-    const double hfd = 1e-7 * len;
     for (int step = 0; step < NEWTON_STEPS; step++) {
         double gn = 0.0;
         for (int m = 0; m < d; m++)
             gn += g[m] * g[m];
         if (!(gn > 0.0) || !isfinite(gn))
             break;
-        /* Hessian by forward differences of the gradient, symmetrised */
-        double H[3][3] = {{0}}, gd[3];
         int ok = 1;
-        for (int m = 0; m < d && ok; m++) {
-            double q[3] = {p[0], p[1], p[2]};
-            q[m] += hfd;
-            ok = isfinite(node_objective(&c, q, gd));
-            for (int n = 0; n < d; n++)
-                H[n][m] = (gd[n] - g[n]) / hfd;
-        }
         for (int m = 0; m < d; m++)
-            for (int n = 0; n < m; n++)
-                H[m][n] = H[n][m] = 0.5 * (H[m][n] + H[n][m]);
+            for (int n = 0; n < d; n++)
+                ok &= isfinite(H[m][n]);
         double dir[3] = {0.0, 0.0, 0.0};
         int have = 0;
         if (ok) {
@@ -408,13 +425,13 @@ static int optimise_node(const getme_ws *ws, double *coords, int32_t i,
             alpha *= 0.5;
             for (int m = 0; m < 3; m++)
                 pt[m] = m < d ? p[m] + alpha * dir[m] : p[m];
-            ft = node_objective(&c, pt, NULL);
+            ft = node_objective(&c, pt, NULL, NULL);
             accepted = ft <= f + 1e-4 * alpha * slope;
         }
         if (!accepted)
             break;
         memcpy(p, pt, sizeof p);
-        f = node_objective(&c, p, g);
+        f = node_objective(&c, p, g, H);
         moved = 1;
         if (alpha * alpha * dn < STEP_TOL * STEP_TOL * size2)
             break;
