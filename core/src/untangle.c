@@ -19,9 +19,10 @@
  * (delta^2 = eps (eps - sigma_min) while sigma_min < eps, else 0, with eps
  * scaled to the local size), so it shrinks as the mesh untangles.
  *
- * Minimisation: a few Newton steps per node (analytic gradient, Hessian by
- * forward differences of the gradient, Levenberg shift when it is not
- * positive definite, Armijo backtracking), node after node.  The moving
+ * Minimisation: a few Newton steps per node (analytic gradient and
+ * Hessian, Levenberg shift when it is not positive definite, Armijo
+ * backtracking), node after node; nodes whose neighbourhood did not move
+ * since their last visit are skipped.  The moving
  * nodes are coloured so that no two nodes of one colour share an element;
  * the nodes of a colour are optimised in parallel (each writes only its own
  * coordinates and reads only nodes of other colours), colour after colour.
@@ -452,8 +453,12 @@ typedef struct ut_state {
     double *q;          /* ne qualities at ws->x, kept up to date          */
     uint8_t *nflag;     /* nn: bit 1 moving, bit 2 has moved, bit 4 moved
                            more than STEP_QUIET in the previous sweep (or
-                           is new), bit 8 in this sweep                    */
-    uint8_t *eflag;     /* ne: bit 1 in the region (touches a moving node) */
+                           is new), bit 8 in this sweep, bit 16 node of a
+                           pending element, bit 32 within one element of
+                           one (hot), bit 64 skipped as not hot although
+                           its neighbourhood changed (stale)               */
+    uint8_t *eflag;     /* ne: bit 1 in the region (touches a moving node),
+                           bit 2 pending (not yet untangled)               */
     int32_t *nodes;     /* moving nodes, by colour, ascending inside one   */
     int32_t *colour_ptr;/* num_colours + 1                                 */
     int32_t num_nodes, num_colours;
@@ -518,7 +523,7 @@ static void collect_region(ut_state *u)
     for (int32_t k = 0; k < u->num_nodes; k++) {
         int32_t i = u->nodes[k];
         for (int64_t s = ws->star_ptr[i]; s < ws->star_ptr[i + 1]; s++)
-            u->eflag[ws->star[s]] |= 1;
+            u->eflag[ws->star[s]] |= 1 | 2;
     }
     u->num_elems = 0;
     for (int32_t e = 0; e < ws->ne; e++)
@@ -572,6 +577,34 @@ static int neighbourhood_changed(const ut_state *u, int32_t i)
     return 0;
 }
 
+/* Mark the hot nodes (bit 32): those sharing an element with a node of a
+   pending element.  Only hot nodes are visited, so that the last few
+   tangles do not cost sweeps over the whole region.  Serial: the marks are
+   the same for any thread count. */
+static void mark_hot(ut_state *u)
+{
+    const getme_ws *ws = u->ws;
+    for (int pass = 0; pass < 3; pass++)
+        for (int32_t k = 0; k < u->num_elems; k++) {
+            int32_t e = u->elems[k];
+            int t = getme__ws_type(ws, e);
+            const int32_t *c = getme__ws_nodes(ws, t, e);
+            int nv = getme__nv[t], near = 0;
+            if (pass == 2)
+                for (int v = 0; v < nv; v++)
+                    near |= u->nflag[c[v]] & 16;
+            for (int v = 0; v < nv; v++) {
+                uint8_t *f = &u->nflag[c[v]];
+                if (pass == 0)
+                    *f &= (uint8_t)~(16 | 32);
+                else if (pass == 1 && (u->eflag[e] & 2))
+                    *f |= 16;
+                else if (pass == 2 && near)
+                    *f |= 32;
+            }
+        }
+}
+
 /* One Gauss-Seidel sweep in colour order; then the region's qualities.
    Returns the number of region elements not yet untangled (with a free
    node) into *pending and the invalid ones into *invalid.  Returns the
@@ -585,14 +618,21 @@ static int32_t sweep(ut_state *u, int32_t *pending, int32_t *invalid)
         uint8_t *f = &u->nflag[u->nodes[k]];
         *f = (uint8_t)((*f & ~12) | ((*f & 8) ? 4 : 0));
     }
+    mark_hot(u);
     for (int32_t c = 0; c < u->num_colours; c++) {
         int32_t a = u->colour_ptr[c], b = u->colour_ptr[c + 1];
 #pragma omp parallel for schedule(static) num_threads(nt) \
     reduction(+ : visited) if (b - a > PAR_MIN)
         for (int32_t k = a; k < b; k++) {
             int32_t i = u->nodes[k];
-            if (!neighbourhood_changed(u, i))
+            uint8_t *f = &u->nflag[i];
+            if (!(*f & 64) && !neighbourhood_changed(u, i))
                 continue;
+            if (!(*f & 32)) { /* not hot: remember to come back */
+                *f |= 64;
+                continue;
+            }
+            *f &= (uint8_t)~64;
             visited++;
             int r = optimise_node(ws, ws->x, i,
                                   u->scratch + (int64_t)omp_get_thread_num() *
@@ -609,9 +649,11 @@ static int32_t sweep(ut_state *u, int32_t *pending, int32_t *invalid)
         int32_t e = u->elems[k];
         u->q[e] = getme__ws_quality(ws, ws->x, e);
         int valid = u->q[e] > 0.0;
-        bad += !valid;
-        pend += ws->free_elem[e] &&
+        int p = ws->free_elem[e] &&
                 (!valid || !element_untangled(ws, ws->x, e));
+        bad += !valid;
+        pend += p;
+        u->eflag[e] = (uint8_t)((u->eflag[e] & ~2) | (p ? 2 : 0));
     }
     *pending = pend;
     *invalid = bad;
