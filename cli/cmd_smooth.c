@@ -240,10 +240,10 @@ static int untangle(const smooth_args *a, getme_doc *doc,
               after = (long long)ur->num_invalid_after;
     cli_warning(&a->log, "%lld invalid (inverted or degenerate) element%s in "
                          "the input, %lld remain%s after untangling (%d "
-                         "sweeps, %d nodes moved, %.3f s)",
+                         "sweep%s, %d nodes moved, %.3f s)",
                 before, before == 1 ? "" : "s", after,
-                after == 1 ? "s" : "", ur->sweeps, (int)ur->num_moved,
-                ur->seconds);
+                after == 1 ? "s" : "", ur->sweeps, ur->sweeps == 1 ? "" : "s",
+                (int)ur->num_moved, ur->seconds);
     if (after == 0)
         return 0;
     int32_t ne = getme_mesh_num_elements(mesh);

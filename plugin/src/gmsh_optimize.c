@@ -131,12 +131,12 @@ static getme_status untangle(gg_run *run)
         return fail(run, st, getme_mesh_error(mesh));
     if (run->opt->log >= 1)
         gg_log("warning", "%lld invalid (inverted or degenerate) element%s, "
-               "%lld remain%s after untangling (%d sweeps, %ld nodes moved, "
-               "%g s)", (long long)u->num_invalid_before,
+               "%lld remain%s after untangling (%d sweep%s, %ld nodes "
+               "moved, %g s)", (long long)u->num_invalid_before,
                u->num_invalid_before == 1 ? "" : "s",
                (long long)u->num_invalid_after,
                u->num_invalid_after == 1 ? "s" : "", u->sweeps,
-               (long)u->num_moved, u->seconds);
+               u->sweeps == 1 ? "" : "s", (long)u->num_moved, u->seconds);
     if (st == GETME_OK)
         return GETME_OK;
     char text[GG_MSG], head[128];
