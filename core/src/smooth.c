@@ -175,6 +175,8 @@ static getme_status untangle(getme_mesh *mesh, getme_ws *ws, getme_run *run)
     if (st != GETME_OK)
         return getme__fail(mesh, st, "out of memory untangling %d elements",
                            (int)ws->ne);
+    /* the relaxation's trial coordinates must equal ws->x outside it */
+    memcpy(run->xnew, ws->x, (size_t)ws->nn * 3 * sizeof *run->xnew);
     return ur.num_invalid_after ? getme__untangle_message(mesh, &ur)
                                 : GETME_OK;
 }
