@@ -31,15 +31,25 @@ static const char SMOOTH_HELP[] =
     "  --free-interfaces      let nodes on region interfaces move\n"
     "  --param NAME=VALUE     any smoothing parameter: sigma (1.5), tol (1e-4),\n"
     "                         threshold_fraction (0.005), max_no_min_improve (5),\n"
-    "                         keep_best (1), renumber (1)\n"
+    "                         min_tol (1e-5), keep_best (1), renumber (1),\n"
+    "                         finish (1: finishing step after the q*min stage;\n"
+    "                         0: the paper's GETMe adaptive alone),\n"
+    "                         finish_fraction (0.001), finish_max_passes (100),\n"
+    "                         corner_guard (1: no hex/prism/pyramid/quad corner\n"
+    "                         ends below max(input's worst, corner_floor)),\n"
+    "                         corner_floor (0)\n"
     "  --no-untangle          refuse an input with invalid (inverted or\n"
     "                         degenerate) elements (exit 6) instead of\n"
     "                         untangling it first\n"
     "  --allow-invalid        if untangling leaves invalid elements, still\n"
     "                         write the partly untangled (unsmoothed) mesh\n"
     "                         (the exit code stays 8)\n"
-    "  --report FILE.json     write before/after statistics, iterations and\n"
-    "                         the per-iteration history as JSON\n"
+    "  --worst N              list the N worst elements after smoothing and\n"
+    "                         why each stays bad (default 10; printed with -v,\n"
+    "                         always in --report)\n"
+    "  --report FILE.json     write before/after statistics, iterations,\n"
+    "                         the worst elements and the per-iteration\n"
+    "                         history as JSON\n"
     "  -q, --quiet            print errors only\n"
     "  -v, --verbose          print the quality histograms\n"
     "\n"
@@ -57,6 +67,7 @@ typedef struct smooth_args {
     const char *input, *output, *report;
     const char **fix, **free_sets;
     int num_fix, num_free, free_interfaces, allow_invalid;
+    long worst;
     getme_params params;
     cli_log log;
 } smooth_args;
@@ -83,7 +94,13 @@ static int on_progress(const getme_progress *p, void *data)
     const char *stage = p->stage == GETME_STAGE_MEAN  ? "qmean stage"
                         : p->stage == GETME_STAGE_MIN ? "q*min stage"
                                                       : "smart Laplace";
-    if (p->stage == GETME_STAGE_MIN)
+    if (p->stage == GETME_STAGE_FINISH)
+        cli_info(ps->log, "Finishing pass %d: q*min %.4f, qmean %.4f, %d "
+                          "elements below %.4f worked on, %d raised (%.2f s)",
+                 p->iteration, p->q_min_star, p->q_mean,
+                 (int)p->num_transformed, p->threshold, (int)p->num_relaxed,
+                 p->elapsed);
+    else if (p->stage == GETME_STAGE_MIN)
         cli_info(ps->log, "It %4d (%s, cycle %d, q_t %.4f): q*min %.4f, "
                           "qmean %.4f, %d transformed, %d relaxed (%.2f s)",
                  p->iteration, stage, p->cycle, p->threshold, p->q_min_star,
@@ -131,6 +148,7 @@ static const char *value(int argc, char **argv, int *i)
 static int parse(int argc, char **argv, smooth_args *a)
 {
     getme_params_init(&a->params);
+    a->worst = 10;
     a->fix = calloc((size_t)argc, sizeof *a->fix);
     a->free_sets = calloc((size_t)argc, sizeof *a->free_sets);
     if (!a->fix || !a->free_sets)
@@ -179,6 +197,10 @@ static int parse(int argc, char **argv, smooth_args *a)
             a->allow_invalid = 1;
         } else if (!strcmp(o, "--param")) {
             if (!(v = value(argc, argv, &i)) || set_param(&a->params, v) != 0)
+                return EXIT_USAGE;
+        } else if (!strcmp(o, "--worst")) {
+            if (!(v = value(argc, argv, &i)) ||
+                cli_parse_int(o, v, 0, 1000000, &a->worst) != 0)
                 return EXIT_USAGE;
         } else if (!strcmp(o, "--report")) {
             if (!(a->report = value(argc, argv, &i)))
@@ -299,7 +321,13 @@ static int run(smooth_args *a)
     if (doc->info[0])
         cli_info(log, "%s", doc->info);
 
+    getme_quality_stats before = doc->stats, after;
+    cli_print_stats(log, "Quality before", &before);
+    cli_measures mbefore, mafter;
+    cli_measures_log(log, mesh, "Measures before", &mbefore);
+
     cli_history history = {0};
+    cli_worst_list worst = {0}, worst_free = {0};
     progress_state ps = {log, &history};
     a->params.progress = on_progress;
     a->params.progress_data = &ps;
@@ -311,9 +339,6 @@ static int run(smooth_args *a)
         int n = env ? atoi(env) : 0;
         a->params.num_threads = n > 0 ? n : omp_get_num_procs();
     }
-
-    getme_quality_stats before = doc->stats, after;
-    cli_print_stats(log, "Quality before", &before);
     getme_untangle_result ur;
     memset(&ur, 0, sizeof ur);
     code = 0;
@@ -322,7 +347,6 @@ static int run(smooth_args *a)
             write_output(a, doc, "partly untangled, not smoothed, ");
         goto out;
     }
-
     int threads = a->params.num_threads;
     cli_info(log, "Optimizing mesh (%s, %d thread%s)...",
              a->params.method == GETME_METHOD_ADAPTIVE ? "GETMe adaptive"
@@ -345,17 +369,40 @@ static int run(smooth_args *a)
              res.cycles_min);
     getme_mesh_quality_stats(mesh, -1, &after);
     cli_print_stats(log, "Quality after ", &after);
+    cli_measures_log(log, mesh, "Measures after ", &mafter);
+    if (res.corner_sj_initial < 1.0 || res.corner_sj < 1.0)
+        cli_info(log, "Worst corner scaled Jacobian (hex, prism, pyramid, "
+                      "quad): %.4f before, %.4f after",
+                 res.corner_sj_initial, res.corner_sj);
+    if (cli_worst(doc, (int32_t)a->worst, 0, &worst) != 0 ||
+        cli_worst(doc, (int32_t)a->worst, GETME_WORST_FREE_ONLY,
+                  &worst_free) != 0) {
+        code = GETME_IO_ERR_INTERNAL;
+        goto out;
+    }
+    if (after.q_min < after.q_min_star)
+        cli_warning(log, "qmin %.4f is below q*min %.4f: the worst elements "
+                         "have no free node, no node move can fix them "
+                         "(see --worst, -v)",
+                    after.q_min, after.q_min_star);
+    if (log->verbose) {
+        cli_print_worst(log, doc, &worst, "");
+        if (after.q_min < after.q_min_star)
+            cli_print_worst(log, doc, &worst_free, " with a free node");
+    }
 
     if ((code = write_output(a, doc, "")) != 0)
         goto out;
     if (a->report &&
         cli_write_report(a->report, a->input, a->output, &a->params, mesh,
-                         &before, &after, &res, &history,
-                         doc->format->name) != 0) {
+                         &before, &after, &res, &history, doc, &worst,
+                         &worst_free, &mbefore, &mafter) != 0) {
         cli_error("%s: cannot write the report", a->report);
         code = GETME_IO_ERR_WRITE;
     }
 out:
+    free(worst.items);
+    free(worst_free.items);
     free(history.items);
     getme_doc_close(doc);
     return code;

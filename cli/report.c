@@ -51,7 +51,10 @@ int cli_write_report(const char *path, const char *input, const char *output,
                      const getme_params *p, getme_mesh *mesh,
                      const getme_quality_stats *before,
                      const getme_quality_stats *after, const getme_result *r,
-                     const cli_history *h, const char *format_name)
+                     const cli_history *h, const getme_doc *doc,
+                     const cli_worst_list *worst,
+                     const cli_worst_list *worst_free,
+                     const cli_measures *mb, const cli_measures *ma)
 {
     FILE *f = fopen(path, "w");
     if (!f)
@@ -63,14 +66,18 @@ int cli_write_report(const char *path, const char *input, const char *output,
     fputs(",\n  \"output\": ", f);
     json_string(f, output);
     fputs(",\n  \"format\": ", f);
-    json_string(f, format_name);
+    json_string(f, doc->format->name);
     fprintf(f, ",\n  \"method\": \"%s\",\n",
             p->method == GETME_METHOD_ADAPTIVE ? "getme" : "laplace");
     fprintf(f, "  \"params\": {\"max_iter\": %d, \"tol\": %.17g, \"sigma\": %.17g, "
                "\"threshold_fraction\": %.17g, \"max_no_min_improve\": %d, \"min_tol\": %.17g, "
-               "\"keep_best\": %d, \"num_threads\": %d, \"renumber\": %d},\n",
+               "\"keep_best\": %d, \"finish\": %d, \"finish_fraction\": %.17g, "
+               "\"finish_max_passes\": %d, \"corner_guard\": %d, "
+               "\"corner_floor\": %.17g, \"num_threads\": %d, \"renumber\": %d},\n",
             p->max_iter, p->tol, p->sigma, p->threshold_fraction,
-            p->max_no_min_improve, p->min_tol, p->keep_best, p->num_threads, p->renumber);
+            p->max_no_min_improve, p->min_tol, p->keep_best, p->finish,
+            p->finish_fraction, p->finish_max_passes, p->corner_guard,
+            p->corner_floor, p->num_threads, p->renumber);
     fprintf(f, "  \"nodes\": %d,\n  \"fixed_nodes\": %d,\n  \"elements\": {",
             (int)getme_mesh_num_nodes(mesh), (int)getme_mesh_num_fixed(mesh));
     int first = 1;
@@ -86,13 +93,27 @@ int cli_write_report(const char *path, const char *input, const char *output,
     json_stats(f, before);
     fputs(",\n  \"after\": ", f);
     json_stats(f, after);
+    fputs(",\n  \"measures\": {\"before\": ", f);
+    cli_json_measures(f, mb);
+    fputs(",\n    \"after\": ", f);
+    cli_json_measures(f, ma);
+    fputc('}', f);
     fprintf(f, ",\n  \"iterations\": {\"total\": %d, \"mean_stage\": %d, "
-               "\"min_stage\": %d, \"min_cycles\": %d},\n",
-            r->iterations, r->iterations_mean, r->iterations_min, r->cycles_min);
+               "\"min_stage\": %d, \"min_cycles\": %d, \"finish_passes\": %d, "
+               "\"finish_improved\": %d},\n",
+            r->iterations, r->iterations_mean, r->iterations_min, r->cycles_min,
+            r->passes_finish, (int)r->moved_finish);
     fprintf(f, "  \"untangle\": {\"invalid\": %lld, \"sweeps\": %d, "
                "\"seconds\": %.6f},\n",
             (long long)r->num_invalid_initial, r->untangle_sweeps,
             r->untangle_seconds);
+    fprintf(f, "  \"corner_sj\": {\"before\": %.17g, \"after\": %.17g},\n",
+            r->corner_sj_initial, r->corner_sj);
+    fputs("  \"worst_elements\": ", f);
+    cli_json_worst(f, doc, worst);
+    fputs(",\n  \"worst_free_elements\": ", f);
+    cli_json_worst(f, doc, worst_free);
+    fputs(",\n", f);
     fprintf(f, "  \"seconds\": %.6f,\n  \"stop_reason\": \"%s\",\n",
             r->seconds, stop_name(r->stop_reason));
     fputs("  \"history\": [", f);

@@ -23,6 +23,8 @@ rc=$?
 [ $rc -eq 0 ] && ok "exit 0" || bad "exit $rc"
 grep -q "^Info    : Optimizing mesh (GETMe adaptive)..." run.log && ok "start line" || bad "no start line"
 grep -q "^Info    : 0.90 < quality < 1.00 : " run.log && ok "histogram" || bad "no histogram"
+grep -q "^Info    : Measures after (tet): dihedral .* deg, scaled Jacobian min .*, gamma min .*, SICN min " run.log \
+  && ok "measures line" || bad "no measures line"
 grep -q "^Info    : Done optimizing mesh (Wall " run.log && ok "done line" || bad "no done line"
 grep -q "^Info    : Done meshing 3D" run.log && ok "Gmsh's own meshing lines" || bad "no Gmsh lines"
 head -2 part.msh | grep -q "^4.1 0 8" && ok "MSH 4.1" || bad "not MSH 4.1"

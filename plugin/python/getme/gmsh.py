@@ -19,6 +19,9 @@ params     any libgetme parameter: sigma, max_iter, tol, threshold_fraction,
 
 Returns a dict: iterations (total, mean stage, min stage, cycles),
 q_min_star / q_min / q_mean before and after, nodes moved, seconds, and
+measures_before / measures_after: {type: {measure: {"min", "max", "mean",
+"num_elements", "num_negative", "histogram", ...}}} for the dihedral
+angles, scaled Jacobian, Gmsh's gamma and SICN (docs/quality.md), and
 "untangle": invalid_before / invalid_after / sweeps / nodes_moved /
 seconds of the untangling step.
 Raises getme.GetmeError (with the Gmsh-logged message) on bad use, and with
@@ -81,6 +84,10 @@ def _report_dict(rep):
         out["num_invalid_" + when] = int(val(when + "_num_invalid"))
         out["histogram_" + when] = [int(val("%s_hist%d" % (when, b)))
                                     for b in range(_lib.HIST_BINS)]
+        after = when == "after"
+        out["measures_" + when] = _lib.measure_dict(
+            lambda t, m: _lib.plugin.getme_gmsh_report_measure(
+                rep, after, t, m).contents)
     out["untangle"] = {k: val("untangle_" + k) for k in
                        ("invalid_before", "invalid_after", "sweeps", "moved",
                         "seconds")}
@@ -123,7 +130,8 @@ def model_quality(dimTags=(), fix=()):
             "q_min_star": d["q_min_star_before"],
             "q_mean": d["q_mean_before"], "q_max": d["q_max_before"],
             "num_invalid": d["num_invalid_before"],
-            "histogram": d["histogram_before"]}
+            "histogram": d["histogram_before"],
+            "measures": d["measures_before"]}
 
 
 def distort(seed=1, amount=0.4, rounds=5, dimTags=(), fix=()):
