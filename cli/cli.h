@@ -3,7 +3,8 @@
  *
  * Exit codes (stable, for scripts): 0 success, 1 internal error, 2 usage,
  * 3 cannot read the input, 4 malformed input, 5 unsupported content,
- * 6 invalid (inverted) elements in the input, 7 cannot write the output.
+ * 6 invalid (inverted) elements in the input (with --no-untangle), 7 cannot
+ * write the output, 8 invalid elements that untangling could not repair.
  * They equal getme_io_status values.
  */
 #ifndef GETME_CLI_H

@@ -37,6 +37,10 @@ static const char GMSH_HELP[] =
     "                        fixed; repeatable\n"
     "  --free-interfaces     do not fix faces between physical groups (nodes on\n"
     "                        Gmsh interface surfaces stay fixed regardless)\n"
+    "  --no-untangle         refuse a mesh with inverted elements (exit 6)\n"
+    "                        instead of untangling it first\n"
+    "  --allow-invalid       if untangling leaves inverted elements, still\n"
+    "                        write the partly untangled mesh (exit code 8)\n"
     "  --threads N           OpenMP threads (0: default)\n"
     "  --sigma S, --max-iter N, --threshold-fraction F   GETMe parameters\n"
     "  --quiet               only errors\n";
@@ -45,7 +49,7 @@ typedef struct gmsh_args {
     const char *input, *output;
     int dim;
     double clmax, clmin, msh_version;
-    int binary, quiet;
+    int binary, quiet, allow_invalid;
     getme_gmsh_options *opt;
 } gmsh_args;
 
@@ -126,6 +130,13 @@ static int parse_one(gmsh_args *a, int argc, char **argv, int *i)
         takes = 0;
     } else if (!strcmp(o, "--free-interfaces")) {
         getme_gmsh_options_set(a->opt, "fix_interfaces", 0);
+        takes = 0;
+    } else if (!strcmp(o, "--no-untangle")) {
+        getme_gmsh_options_set(a->opt, "untangle", 0);
+        takes = 0;
+    } else if (!strcmp(o, "--allow-invalid")) {
+        getme_gmsh_options_set(a->opt, "allow_invalid", 1);
+        a->allow_invalid = 1;
         takes = 0;
     } else if (!takes_value(o)) {
         cli_error("unknown option '%s' (see getme gmsh --help)", o);
@@ -254,12 +265,14 @@ static int open_and_mesh(const gmsh_args *a)
     return GETME_IO_OK;
 }
 
-static int exit_code(getme_status st)
+static int exit_code(getme_status st, const getme_gmsh_report *rep)
 {
     switch (st) {
     case GETME_OK: return 0;
     case GETME_ERR_ARGUMENT: return GETME_IO_ERR_USAGE;
-    case GETME_ERR_INVALID_MESH: return GETME_IO_ERR_INVALID;
+    case GETME_ERR_INVALID_MESH: /* 8 if untangling ran and fell short */
+        return rep->untangle.num_invalid_before ? GETME_IO_ERR_TANGLED
+                                                : GETME_IO_ERR_INVALID;
     case GETME_ERR_STATE:
     case GETME_ERR_TOPOLOGY: return GETME_IO_ERR_UNSUPPORTED;
     default: return GETME_IO_ERR_INTERNAL;
@@ -318,10 +331,12 @@ static int run(gmsh_args *a)
         getme_status st = getme_gmsh_optimize(0, NULL, 0, a->opt, &rep);
         if (st != GETME_OK && a->quiet)
             cli_error("%s", rep.message);
-        rc = exit_code(st);
+        rc = exit_code(st, &rep);
     }
-    if (rc == 0)
-        rc = write_output(a, out);
+    if (rc == 0 || (rc == GETME_IO_ERR_TANGLED && a->allow_invalid)) {
+        int wrc = write_output(a, out);
+        rc = rc ? rc : wrc;
+    }
     if (rc == 0 && !a->quiet) {
         char line[4200];
         snprintf(line, sizeof line, "Wrote '%s'", out);

@@ -38,6 +38,12 @@ static const char SMOOTH_HELP[] =
     "                         corner_guard (1: no hex/prism/pyramid/quad corner\n"
     "                         ends below max(input's worst, corner_floor)),\n"
     "                         corner_floor (0)\n"
+    "  --no-untangle          refuse an input with invalid (inverted or\n"
+    "                         degenerate) elements (exit 6) instead of\n"
+    "                         untangling it first\n"
+    "  --allow-invalid        if untangling leaves invalid elements, still\n"
+    "                         write the partly untangled (unsmoothed) mesh\n"
+    "                         (the exit code stays 8)\n"
     "  --worst N              list the N worst elements after smoothing and\n"
     "                         why each stays bad (default 10; printed with -v,\n"
     "                         always in --report)\n"
@@ -47,14 +53,20 @@ static const char SMOOTH_HELP[] =
     "  -q, --quiet            print errors only\n"
     "  -v, --verbose          print the quality histograms\n"
     "\n"
+    "An input with invalid elements is untangled first (free nodes near them\n"
+    "move until every element is valid, docs/untangle.md), with a warning\n"
+    "saying how many were invalid and how many remain, then smoothed.\n"
+    "\n"
     "exit codes: 0 ok, 1 internal error, 2 usage, 3 cannot read input,\n"
-    "4 malformed input, 5 unsupported content, 6 invalid elements in input,\n"
-    "7 cannot write output\n";
+    "4 malformed input, 5 unsupported content, 6 invalid elements in input\n"
+    "(--no-untangle), 7 cannot write output, 8 invalid elements that could not\n"
+    "be untangled (named by their ids in the file; no output unless\n"
+    "--allow-invalid)\n";
 
 typedef struct smooth_args {
     const char *input, *output, *report;
     const char **fix, **free_sets;
-    int num_fix, num_free, free_interfaces;
+    int num_fix, num_free, free_interfaces, allow_invalid;
     long worst;
     getme_params params;
     cli_log log;
@@ -179,6 +191,10 @@ static int parse(int argc, char **argv, smooth_args *a)
                 return EXIT_USAGE;
         } else if (!strcmp(o, "--free-interfaces")) {
             a->free_interfaces = 1;
+        } else if (!strcmp(o, "--no-untangle")) {
+            a->params.untangle = 0;
+        } else if (!strcmp(o, "--allow-invalid")) {
+            a->allow_invalid = 1;
         } else if (!strcmp(o, "--param")) {
             if (!(v = value(argc, argv, &i)) || set_param(&a->params, v) != 0)
                 return EXIT_USAGE;
@@ -211,6 +227,69 @@ static int parse(int argc, char **argv, smooth_args *a)
     return 0;
 }
 
+static int write_output(const smooth_args *a, getme_doc *doc,
+                        const char *what)
+{
+    cli_info(&a->log, "Writing %s'%s'...", what, a->output);
+    getme_io_status ios = getme_doc_write(doc, a->output);
+    if (ios != GETME_IO_OK) {
+        cli_error("%s", getme_doc_error(doc));
+        return ios;
+    }
+    cli_info(&a->log, "Done writing '%s'", a->output);
+    return 0;
+}
+
+/* Elements listed by file id in the error about elements that stay
+   invalid. */
+#define MAX_NAMED 20
+
+/* Untangle an input with invalid elements: one warning line with the
+   counts; the elements that stay invalid named by their file ids.
+   Returns 0, GETME_IO_ERR_TANGLED or GETME_IO_ERR_INTERNAL. */
+static int untangle(const smooth_args *a, getme_doc *doc,
+                    getme_untangle_result *ur)
+{
+    getme_mesh *mesh = getme_doc_mesh(doc);
+    cli_info(&a->log, "Untangling (%d thread%s)...", a->params.num_threads,
+             a->params.num_threads == 1 ? "" : "s");
+    getme_status st = getme_mesh_untangle(mesh, &a->params, ur);
+    if (st != GETME_OK && st != GETME_ERR_INVALID_MESH) {
+        cli_error("%s: %s", a->input, getme_mesh_error(mesh));
+        return GETME_IO_ERR_INTERNAL;
+    }
+    long long before = (long long)ur->num_invalid_before,
+              after = (long long)ur->num_invalid_after;
+    cli_warning(&a->log, "%lld invalid (inverted or degenerate) element%s in "
+                         "the input, %lld remain%s after untangling (%d "
+                         "sweep%s, %d nodes moved, %.3f s)",
+                before, before == 1 ? "" : "s", after,
+                after == 1 ? "s" : "", ur->sweeps, ur->sweeps == 1 ? "" : "s",
+                (int)ur->num_moved, ur->seconds);
+    if (after == 0)
+        return 0;
+    int32_t ne = getme_mesh_num_elements(mesh);
+    double *q = malloc((size_t)ne * sizeof *q);
+    char list[MAX_NAMED * 22 + 8] = "";
+    size_t len = 0;
+    int named = 0;
+    if (q && getme_mesh_element_qualities(mesh, q) == GETME_OK)
+        for (int32_t e = 0; e < ne && named < MAX_NAMED; e++)
+            if (!(q[e] > 0.0))
+                len += (size_t)snprintf(list + len, sizeof list - len, "%s%lld",
+                                        named++ ? ", " : "",
+                                        (long long)getme_doc_element_id(doc, e));
+    free(q);
+    cli_error("%s: %lld element%s could not be untangled (%lld with every node "
+              "fixed): %s%s; %s",
+              a->input, after, after == 1 ? "" : "s",
+              (long long)ur->num_stuck, list, after > named ? ", ..." : "",
+              a->allow_invalid ? "writing the partly untangled mesh as asked"
+                               : "no output written (--allow-invalid writes "
+                                 "the partly untangled mesh)");
+    return GETME_IO_ERR_TANGLED;
+}
+
 static int run(smooth_args *a)
 {
     const cli_log *log = &a->log;
@@ -231,7 +310,7 @@ static int run(smooth_args *a)
     double t0 = omp_get_wtime();
     cli_info(log, "Reading '%s'...", a->input);
     int code;
-    getme_doc *doc = cli_open(a->input, &opts, 0, &code);
+    getme_doc *doc = cli_open(a->input, &opts, a->params.untangle, &code);
     if (!doc)
         return code;
     getme_mesh *mesh = getme_doc_mesh(doc);
@@ -260,6 +339,14 @@ static int run(smooth_args *a)
         int n = env ? atoi(env) : 0;
         a->params.num_threads = n > 0 ? n : omp_get_num_procs();
     }
+    getme_untangle_result ur;
+    memset(&ur, 0, sizeof ur);
+    code = 0;
+    if (before.num_invalid > 0 && (code = untangle(a, doc, &ur)) != 0) {
+        if (code == GETME_IO_ERR_TANGLED && a->allow_invalid)
+            write_output(a, doc, "partly untangled, not smoothed, ");
+        goto out;
+    }
     int threads = a->params.num_threads;
     cli_info(log, "Optimizing mesh (%s, %d thread%s)...",
              a->params.method == GETME_METHOD_ADAPTIVE ? "GETMe adaptive"
@@ -267,6 +354,9 @@ static int run(smooth_args *a)
              threads, threads == 1 ? "" : "s");
     getme_result res;
     getme_status st = getme_smooth(mesh, &a->params, &res);
+    res.num_invalid_initial = ur.num_invalid_before;
+    res.untangle_sweeps = ur.sweeps;
+    res.untangle_seconds = ur.seconds;
     if (st != GETME_OK) {
         cli_error("%s: %s", a->input, getme_mesh_error(mesh));
         code = st == GETME_ERR_INVALID_MESH ? GETME_IO_ERR_INVALID
@@ -301,14 +391,8 @@ static int run(smooth_args *a)
             cli_print_worst(log, doc, &worst_free, " with a free node");
     }
 
-    cli_info(log, "Writing '%s'...", a->output);
-    getme_io_status ios = getme_doc_write(doc, a->output);
-    if (ios != GETME_IO_OK) {
-        cli_error("%s", getme_doc_error(doc));
-        code = ios;
+    if ((code = write_output(a, doc, "")) != 0)
         goto out;
-    }
-    cli_info(log, "Done writing '%s'", a->output);
     if (a->report &&
         cli_write_report(a->report, a->input, a->output, &a->params, mesh,
                          &before, &after, &res, &history, doc, &worst,
