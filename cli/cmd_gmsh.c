@@ -7,7 +7,7 @@
  *              [-o out.msh] [-format msh22|msh41] [-bin] [--method getme|
  *              laplace] [--fix GROUP]... [--threads N] [--sigma S]
  *              [--max-iter N] [--threshold-fraction F] [--free-interfaces]
- *              [--quiet]
+ *              [--topology] [--no-untangle] [--allow-invalid] [--quiet]
  *
  * Exit codes as the rest of the getme command (cli.h).
  */
@@ -37,6 +37,9 @@ static const char GMSH_HELP[] =
     "                        fixed; repeatable\n"
     "  --free-interfaces     do not fix faces between physical groups (nodes on\n"
     "                        Gmsh interface surfaces stay fixed regardless)\n"
+    "  --topology            when some of the worst tets have no free node (no\n"
+    "                        node move can fix them), run Gmsh's optimize(\"\")\n"
+    "                        (edge/face swaps) first, then GETMe adaptive\n"
     "  --no-untangle         refuse a mesh with inverted elements (exit 6)\n"
     "                        instead of untangling it first\n"
     "  --allow-invalid       if untangling leaves inverted elements, still\n"
@@ -133,6 +136,9 @@ static int parse_one(gmsh_args *a, int argc, char **argv, int *i)
         takes = 0;
     } else if (!strcmp(o, "--no-untangle")) {
         getme_gmsh_options_set(a->opt, "untangle", 0);
+        takes = 0;
+    } else if (!strcmp(o, "--topology")) {
+        getme_gmsh_options_set(a->opt, "topology", 1);
         takes = 0;
     } else if (!strcmp(o, "--allow-invalid")) {
         getme_gmsh_options_set(a->opt, "allow_invalid", 1);
