@@ -248,6 +248,12 @@ def test_gui_logic():
           abs(after[0] - getme.quality()["q_min_star"]) < 1e-12,
           "GUI smoothing result %s (distorted %.4f)" % (after, q_bad))
     check(gmsh.onelab.getString("ONELAB/Action") == [""], "action consumed")
+    passes = gmsh.onelab.getNumber(gui.P + "Result/5Finishing passes")
+    check(passes and passes[0] >= 1, "the panel's finishing step ran: %s" % passes)
+    tag = gmsh.onelab.getNumber(gui.P + "Result/7Worst element tag")
+    etypes, etags, _ = gmsh.model.mesh.getElements(2)
+    check(tag and int(tag[0]) in set(int(t) for ts in etags for t in ts),
+          "the panel names the worst element by its Gmsh tag: %s" % tag)
 
 
 def test_worst_and_topology():
