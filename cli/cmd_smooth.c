@@ -29,21 +29,8 @@ static const char SMOOTH_HELP[] =
     "                         (repeatable)\n"
     "  --free NAME            do not fix this CGNS BC/family (repeatable)\n"
     "  --free-interfaces      let nodes on region interfaces move\n"
-    "  --param NAME=VALUE     any smoothing parameter: sigma (1.5), tol (1e-4),\n"
-    "                         threshold_fraction (0.005), max_no_min_improve (5),\n"
-    "                         min_tol (1e-5), keep_best (1), renumber (1),\n"
-    "                         finish (1: finishing step after the q*min stage;\n"
-    "                         0: the paper's GETMe adaptive alone),\n"
-    "                         finish_fraction (0.001), finish_max_passes (100),\n"
-    "                         corner_guard (1: no hex/prism/pyramid/quad corner\n"
-    "                         ends below max(input's worst, corner_floor)),\n"
-    "                         corner_floor (0)\n"
-    "  --no-untangle          refuse an input with invalid (inverted or\n"
-    "                         degenerate) elements (exit 6) instead of\n"
-    "                         untangling it first\n"
-    "  --allow-invalid        if untangling leaves invalid elements, still\n"
-    "                         write the partly untangled (unsmoothed) mesh\n"
-    "                         (the exit code stays 8)\n"
+    "  --param NAME=VALUE     any smoothing parameter (repeatable; the table\n"
+    "                         below)\n"
     "  --worst N              list the N worst elements after smoothing and\n"
     "                         why each stays bad (default 10; printed with -v,\n"
     "                         always in --report)\n"
@@ -128,8 +115,18 @@ static int set_param(getme_params *p, const char *arg)
     name[eq - arg] = '\0';
     if (cli_parse_double("--param", eq + 1, &v) != 0)
         return -1;
+    const getme_param_info *info = getme_param_find(name);
+    if (!info) {
+        cli_error("--param %s: unknown parameter '%s' (getme smooth --help "
+                  "lists them)", arg, name);
+        return -1;
+    }
     if (getme_params_set(p, name, v) != GETME_OK) {
-        cli_error("--param %s: unknown parameter or value out of range", arg);
+        char range[64];
+        cli_param_range(info, range, sizeof range);
+        cli_error("--param %s: %s takes %s %s", arg, name,
+                  info->type == GETME_PARAM_REAL ? "a number" : "an integer",
+                  range);
         return -1;
     }
     return 0;
@@ -158,6 +155,7 @@ static int parse(int argc, char **argv, smooth_args *a)
         long n;
         if (!strcmp(o, "-h") || !strcmp(o, "--help")) {
             fputs(SMOOTH_HELP, stdout);
+            cli_print_params(stdout);
             return -1;
         } else if (!strcmp(o, "-o") || !strcmp(o, "--output")) {
             if (!(a->output = value(argc, argv, &i)))

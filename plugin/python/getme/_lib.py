@@ -71,6 +71,16 @@ class MeasureStats(ctypes.Structure):
                 ("histogram", c_int64 * HIST_BINS)]
 
 
+class ParamInfo(ctypes.Structure):
+    """getme_param_info from getme.h: one entry of the parameter table."""
+    _fields_ = [("name", c_char_p), ("type", c_int), ("default_value", c_double),
+                ("min", c_double), ("max", c_double), ("open_min", c_int),
+                ("offset", c_size_t), ("help", c_char_p)]
+
+
+PARAM_TYPES = ("real", "int", "bool", "enum")
+
+
 def _sig(lib, name, restype, *argtypes):
     f = getattr(lib, name)
     f.restype = restype
@@ -78,6 +88,8 @@ def _sig(lib, name, restype, *argtypes):
 
 
 _sig(core, "getme_version", c_char_p)
+_sig(core, "getme_param_count", c_int)
+_sig(core, "getme_param_at", POINTER(ParamInfo), c_int)
 _sig(core, "getme_status_string", c_char_p, c_int)
 _sig(core, "getme_mesh_create", c_int, POINTER(c_void_p), c_int, c_int32,
      POINTER(c_double))
@@ -151,3 +163,17 @@ def version():
 
 def status_text(status):
     return core.getme_status_string(status).decode()
+
+
+def parameters():
+    """libgetme's parameter table (getme_param_at): one dict per numeric
+    parameter with name, type ("real", "int", "bool", "enum"), default, min,
+    max, open_min and help.  The one definition the CLI, the Gmsh options
+    and the GUI also use."""
+    out = []
+    for i in range(core.getme_param_count()):
+        p = core.getme_param_at(i).contents
+        out.append({"name": p.name.decode(), "type": PARAM_TYPES[p.type],
+                    "default": p.default_value, "min": p.min, "max": p.max,
+                    "open_min": bool(p.open_min), "help": p.help.decode()})
+    return out
