@@ -145,7 +145,7 @@ getme_status getme__finish(getme_run *run)
     p.x = ws->x;
     p.guard = run->guard;
     p.floor = run->corner_floor;
-    p.loss = getenv("GETME_LOSS") ? atof(getenv("GETME_LOSS")) : GETME_PATCH_LOSS;
+    p.loss = GETME_PATCH_LOSS;
     double q_mean, q_min;
     getme__ws_summary(ws, run->q, &q_mean, &q_min, NULL);
     getme_status st = GETME_OK;
