@@ -12,6 +12,7 @@
 #include "getme.h"
 #include "getme_formats.h"
 
+#include <signal.h>
 #include <stdio.h>
 
 enum { EXIT_USAGE = 2 };
@@ -46,6 +47,35 @@ getme_doc *cli_open(const char *path, const getme_doc_options *opts,
 
 /* Mesh summary: "195070 tets, 12 prisms; 37012 nodes (8123 fixed)". */
 void cli_describe_mesh(getme_mesh *mesh, char *buf, size_t size);
+
+/* ---- files written (paths.c) ---- */
+
+/* 1 if a and b are the same file (device and inode; a file that does not
+   exist yet: same directory and name). */
+int cli_same_file(const char *a, const char *b);
+
+typedef struct cli_paths {
+    const char *input;          /* as given                                  */
+    const char *output, *report; /* as given, NULL if none                   */
+    char out[4096], rep[4096];  /* what to write (symbolic links followed)   */
+} cli_paths;
+
+/* Before anything is read: the output has the input format's extension,
+   output and report are regular files or new (never a device, FIFO...),
+   their directories are writable, and neither is the input nor the other.
+   Prints the error and returns the exit code (2 or 7), or 0. */
+int cli_check_paths(cli_paths *p);
+/* After reading: neither output nor report is a file the input includes.
+   0 or EXIT_USAGE (printed). */
+int cli_check_read_files(const cli_paths *p, const getme_doc *doc);
+
+/* Hold termination signals while files are written (on = 1), deliver them
+   after (on = 0): a Ctrl-C leaves the whole output or none. */
+typedef struct cli_guard {
+    int active;
+    sigset_t old;
+} cli_guard;
+void cli_write_guard(cli_guard *g, int on);
 
 int cli_smooth(int argc, char **argv);
 int cli_quality(int argc, char **argv);

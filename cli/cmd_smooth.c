@@ -3,6 +3,7 @@
  */
 #include "cli.h"
 
+#include <errno.h>
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
@@ -201,17 +202,19 @@ static int run(smooth_args *a)
     opts.fix_interfaces = !a->free_interfaces;
     opts.verbose = log->verbose;
 
-    if (getme_io_same_file(a->input, a->output)) {
-        cli_error("%s: refusing to overwrite the input; choose another output "
-                  "file", a->output);
-        return EXIT_USAGE;
-    }
+    cli_paths paths = {a->input, a->output, a->report, "", ""};
+    int code = cli_check_paths(&paths);
+    if (code)
+        return code;
     double t0 = omp_get_wtime();
     cli_info(log, "Reading '%s'...", a->input);
-    int code;
     getme_doc *doc = cli_open(a->input, &opts, 0, &code);
     if (!doc)
         return code;
+    if ((code = cli_check_read_files(&paths, doc)) != 0) {
+        getme_doc_close(doc);
+        return code;
+    }
     getme_mesh *mesh = getme_doc_mesh(doc);
     char desc[256];
     cli_describe_mesh(mesh, desc, sizeof desc);
@@ -256,20 +259,24 @@ static int run(smooth_args *a)
     cli_print_stats(log, "Quality after ", &after);
 
     cli_info(log, "Writing '%s'...", a->output);
-    getme_io_status ios = getme_doc_write(doc, a->output);
+    cli_guard guard = {0};
+    cli_write_guard(&guard, 1);
+    getme_io_status ios = getme_doc_write(doc, paths.out);
     if (ios != GETME_IO_OK) {
         cli_error("%s", getme_doc_error(doc));
         code = ios;
-        goto out;
+    } else {
+        cli_info(log, "Done writing '%s'", a->output);
+        if (a->report &&
+            cli_write_report(paths.rep, a->input, a->output, &a->params, mesh,
+                             &before, &after, &res, &history,
+                             doc->format->name) != 0) {
+            cli_error("%s: cannot write the report: %s", a->report,
+                      strerror(errno));
+            code = GETME_IO_ERR_WRITE;
+        }
     }
-    cli_info(log, "Done writing '%s'", a->output);
-    if (a->report &&
-        cli_write_report(a->report, a->input, a->output, &a->params, mesh,
-                         &before, &after, &res, &history,
-                         doc->format->name) != 0) {
-        cli_error("%s: cannot write the report", a->report);
-        code = GETME_IO_ERR_WRITE;
-    }
+    cli_write_guard(&guard, 0);
 out:
     free(history.items);
     getme_doc_close(doc);

@@ -53,9 +53,15 @@ int cli_write_report(const char *path, const char *input, const char *output,
                      const getme_quality_stats *after, const getme_result *r,
                      const cli_history *h, const char *format_name)
 {
-    FILE *f = fopen(path, "w");
-    if (!f)
+    /* Through a temporary file next to it and a rename, like the mesh. */
+    char tmp[4200];
+    if (getme_io_tmp_path(path, tmp, sizeof tmp) != 0)
         return -1;
+    FILE *f = fopen(tmp, "w");
+    if (!f) {
+        remove(tmp);
+        return -1;
+    }
     fputs("{\n  \"getme_version\": ", f);
     json_string(f, getme_version());
     fputs(",\n  \"input\": ", f);
@@ -102,5 +108,10 @@ int cli_write_report(const char *path, const char *input, const char *output,
                 (int)e->num_relaxed, e->elapsed);
     }
     fputs("\n  ]\n}\n", f);
-    return fclose(f) == 0 ? 0 : -1;
+    int bad = ferror(f);
+    if (fclose(f) != 0 || bad) {
+        remove(tmp);
+        return -1;
+    }
+    return getme_io_commit(tmp, path);
 }

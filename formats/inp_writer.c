@@ -78,6 +78,16 @@ static getme_io_status name_outputs(writer *w, const char *out_path)
                 break;
         }
     }
+    /* Never replace anything but a regular file (the deck's own name was
+       checked by getme_doc_write). */
+    for (size_t i = 1; i < st->nfiles; i++) {
+        struct stat sb;
+        if (lstat(w->out[i], &sb) == 0 && !S_ISREG(sb.st_mode))
+            return getme_doc_fail(w->doc, GETME_IO_ERR_USAGE,
+                                  "output '%s' (the copy of included '%s') "
+                                  "exists and is not a regular file",
+                                  w->out[i], st->files[i].path);
+    }
     /* Never overwrite any file of the input deck. */
     for (size_t i = 0; i < st->nfiles; i++)
         for (size_t j = 0; j < st->nfiles; j++)

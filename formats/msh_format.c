@@ -573,4 +573,4 @@ const getme_format getme_format_msh = {
     "Gmsh MSH 2.2/4.1, ASCII or binary (4.1 read natively, others via the "
     "Gmsh SDK)",
     msh_probe,
-    msh_open, msh_write, msh_close};
+    msh_open, msh_write, msh_close, ".msh", NULL};

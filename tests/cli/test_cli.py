@@ -198,9 +198,9 @@ def errors_case():
     check("--fix" in p.stdout, "smooth --help lists options")
     garbage = os.path.join(WORK, "garbage.msh")
     open(garbage, "w").write("$MeshFormat\nthis is not a mesh\n")
-    p = subprocess.run([GETME, "smooth", garbage, "-o", garbage + ".out"], capture_output=True, text=True)
+    p = subprocess.run([GETME, "smooth", garbage, "-o", garbage + "-out.msh"], capture_output=True, text=True)
     check(p.returncode in (4, 5), f"garbage input -> {p.returncode}, want 4 (malformed)")
-    check(not os.path.exists(garbage + ".out"), "no output for bad input")
+    check(not os.path.exists(garbage + "-out.msh"), "no output for bad input")
     # An inverted element: swap the last two nodes of one tet (MSH 2.2 text:
     # "tag type ntags tags... nodes").
     good = os.path.join(WORK, "inv-src.msh")
@@ -222,10 +222,10 @@ def errors_case():
     open(inv, "w").write("\n".join(lines))
     tags = [[int(victim[0])] * 6]
     digest = sha(inv)
-    p = run("smooth", inv, "-o", inv + ".out", expect=6)
+    p = run("smooth", inv, "-o", inv + "-out.msh", expect=6)
     check("invalid" in p.stderr and str(tags[0][5]) in p.stderr,
           "inverted element reported by its Gmsh tag")
-    check(sha(inv) == digest and not os.path.exists(inv + ".out"), "input untouched, no output")
+    check(sha(inv) == digest and not os.path.exists(inv + "-out.msh"), "input untouched, no output")
     run("quality", inv, expect=6)
     p = run("smooth", good, "-o", good, expect=2)
     check("overwrite" in p.stderr, "refuses to overwrite the input")

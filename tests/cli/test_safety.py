@@ -1,0 +1,257 @@
+#!/usr/bin/python3
+"""Regression tests of issue #10: the getme command never loses data and
+refuses damaged input with file and line.
+
+usage: /usr/bin/python3 test_safety.py GETME_BINARY WORKDIR CASE
+CASE: paths | damage | usability
+
+paths:  --report / -o naming the input, an included file or the output
+        (compared by device and inode), special files, symbolic links,
+        missing directories, output extensions, temporary files.
+damage: truncated files, unknown entities, NaN coordinates, degenerate
+        elements, unknown --free names.
+usability: the remaining items of the issue (quality without free nodes,
+        CalculiX decks, ...).
+Every refused run is checked for its exit code (the README's table), the
+input's sha256 and the absence of any output or temporary file.
+"""
+import hashlib
+import os
+import re
+import signal
+import stat
+import subprocess
+import sys
+
+import gmsh
+
+GETME, WORK, CASE = sys.argv[1], os.path.abspath(sys.argv[2]), sys.argv[3]
+os.makedirs(WORK, exist_ok=True)
+failures = []
+passed = 0
+
+
+def check(cond, what):
+    global passed
+    if cond:
+        passed += 1
+    else:
+        failures.append(what)
+        print("FAILED:", what, flush=True)
+
+
+def run(*args, expect=0, cwd=None):
+    p = subprocess.run([GETME, *args], capture_output=True, text=True, cwd=cwd,
+                       timeout=300)
+    if p.returncode != expect:
+        print(p.stdout[-3000:], p.stderr[-3000:])
+    check(p.returncode == expect,
+          f"getme {' '.join(args)} -> {p.returncode}, want {expect}")
+    return p
+
+
+def sha(path):
+    return hashlib.sha256(open(path, "rb").read()).hexdigest()
+
+
+def path(name):
+    return os.path.join(WORK, name)
+
+
+def tmp_files():
+    return sorted(f for f in os.listdir(WORK) if ".getme-tmp." in f)
+
+
+def make_box(name, version=4.1, size=0.3, binary=False):
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.model.occ.addBox(0, 0, 0, 1, 1, 1)
+    gmsh.model.occ.synchronize()
+    gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+    gmsh.model.mesh.generate(3)
+    gmsh.option.setNumber("Mesh.MshFileVersion", version)
+    gmsh.option.setNumber("Mesh.Binary", 1 if binary else 0)
+    gmsh.write(path(name))
+    gmsh.finalize()
+    return path(name)
+
+
+TET_DECK = """*HEADING
+box
+*NODE
+1, 0, 0, 0
+2, 1, 0, 0
+3, 0, 1, 0
+4, 0, 0, 1
+5, 1, 1, 1
+6, 0.3, 0.3, 0.3
+*ELEMENT, TYPE=C3D4, ELSET=ALL
+1, 1, 2, 3, 6
+2, 1, 2, 6, 4
+3, 1, 6, 3, 4
+4, 2, 3, 6, 5
+5, 2, 6, 4, 5
+6, 6, 3, 4, 5
+7, 2, 3, 4, 5
+"""
+
+
+# ---- paths ---------------------------------------------------------------
+
+def refused(args, expect, inputs, outputs=(), message=None):
+    """Run, expect the code, inputs' sha256 unchanged, outputs absent."""
+    digests = {f: sha(f) for f in inputs}
+    before = tmp_files()
+    p = run(*args, expect=expect)
+    for f, d in digests.items():
+        check(sha(f) == d, f"{os.path.basename(f)} unchanged by {' '.join(args)}")
+    for f in outputs:
+        check(not os.path.lexists(f), f"no {os.path.basename(f)} after {' '.join(args)}")
+    check(tmp_files() == before, f"no temporary file left by {' '.join(args)}")
+    if message:
+        check(re.search(message, p.stderr) is not None,
+              f"message /{message}/ in {p.stderr.strip()!r}")
+    return p
+
+
+def paths_case():
+    src = make_box("box.msh")
+    dist = path("dist.msh")
+    run("distort", src, "-o", dist, "--seed", "3", "-q")
+    out = path("out.msh")
+    # --report naming the input, by another name, a hard link, a symlink
+    refused(["smooth", dist, "-o", out, "--report", dist, "-q"], 2, [dist], [out],
+            "report .*dist.msh: refusing to overwrite the input")
+    os.link(dist, path("hard.msh"))
+    os.symlink("dist.msh", path("soft.json"))
+    refused(["smooth", dist, "-o", out, "--report", path("hard.msh"), "-q"], 2, [dist], [out])
+    refused(["smooth", dist, "-o", out, "--report", path("soft.json"), "-q"], 2, [dist], [out])
+    p = subprocess.run([GETME, "smooth", "dist.msh", "-o", "out.msh", "--report",
+                        "./dist.msh", "-q"], cwd=WORK, capture_output=True)
+    check(p.returncode == 2 and not os.path.exists(out), "report ./dist.msh refused")
+    # -o naming the input through a hard link
+    refused(["smooth", dist, "-o", path("hard.msh"), "-q"], 2, [dist], [],
+            "refusing to overwrite the input")
+    # --report naming the output (existing or not, other spelling)
+    refused(["smooth", dist, "-o", out, "--report", path("./out.msh"), "-q"], 2, [dist], [out],
+            "it is the output file")
+    open(out, "w").write("keep me\n")
+    refused(["smooth", dist, "-o", out, "--report", out, "-q"], 2, [dist, out])
+    os.remove(out)
+    # --report / -o naming an *INCLUDEd file of an INP deck
+    open(path("nodes.inc"), "w").write(TET_DECK.split("*ELEMENT")[0].split("*NODE\n")[1])
+    deck = path("deck.inp")
+    open(deck, "w").write("*HEADING\nx\n*NODE\n*INCLUDE, INPUT=nodes.inc\n*ELEMENT" +
+                          TET_DECK.split("*ELEMENT")[1])
+    refused(["smooth", deck, "-o", path("deck-out.inp"), "--report", path("nodes.inc"), "-q"],
+            2, [deck, path("nodes.inc")], [path("deck-out.inp")], "which the input includes")
+    os.link(path("nodes.inc"), path("nodes-link.inp"))
+    refused(["smooth", deck, "-o", path("nodes-link.inp"), "-q"], 2,
+            [deck, path("nodes.inc")], [], "overwrite")
+    run("smooth", deck, "-o", path("deck-out.inp"), "--report", path("deck.json"), "-q")
+    check(os.path.exists(path("deck.json")), "report written next to a deck with includes")
+
+    # special files: never replaced
+    fifo = path("fifo.msh")
+    os.mkfifo(fifo)
+    refused(["smooth", dist, "-o", fifo, "-q"], 2, [dist], [], "is a FIFO")
+    check(stat.S_ISFIFO(os.lstat(fifo).st_mode), "the FIFO is still a FIFO")
+    refused(["smooth", dist, "-o", out, "--report", fifo, "-q"], 2, [dist], [out], "is a FIFO")
+    os.symlink("/dev/null", path("null.msh"))
+    refused(["smooth", dist, "-o", path("null.msh"), "-q"], 2, [dist], [],
+            "is a character device")
+    check(stat.S_ISCHR(os.stat("/dev/null").st_mode), "/dev/null is still a character device")
+    check(os.path.islink(path("null.msh")), "the link to /dev/null is still a link")
+    refused(["smooth", dist, "-o", "/dev/null", "-q"], 2, [dist], [])
+    refused(["smooth", dist, "-o", "/dev/stdout", "-q"], 2, [dist], [])
+    refused(["distort", dist, "-o", fifo, "--seed", "1", "-q"], 2, [dist], [], "is a FIFO")
+    os.mkdir(path("adir.msh"))
+    refused(["smooth", dist, "-o", path("adir.msh"), "-q"], 2, [dist], [], "is a directory")
+    check(os.path.isdir(path("adir.msh")), "the directory is still a directory")
+
+    # a symbolic link to a regular file: the file is written, the link stays
+    open(path("target.msh"), "w").write("old\n")
+    os.symlink("target.msh", path("link.msh"))
+    run("smooth", dist, "-o", path("link.msh"), "-q")
+    check(os.path.islink(path("link.msh")), "-o symlink: the link stays a link")
+    check(open(path("target.msh"), "rb").read(6) == b"$MeshF", "-o symlink: its target was written")
+    os.symlink("missing.msh", path("dangling.msh"))
+    refused(["smooth", dist, "-o", path("dangling.msh"), "-q"], 2, [dist], [path("missing.msh")],
+            "symbolic link to a missing file")
+
+    # output directory missing / not writable: before reading (a malformed
+    # input would give 4 if it were read first)
+    bad = path("bad.msh")
+    open(bad, "w").write("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\nnonsense\n")
+    refused(["smooth", bad, "-o", path("nodir/out.msh"), "-q"], 7, [bad], [],
+            "nodir/out.msh: cannot create a temporary file next to it")
+    refused(["smooth", dist, "-o", out, "--report", path("nodir/r.json"), "-q"], 7, [dist], [out])
+    if os.geteuid() != 0:  # root may write anywhere
+        os.mkdir(path("ro"), 0o555)
+        refused(["smooth", bad, "-o", path("ro/out.msh"), "-q"], 7, [bad], [])
+
+    # output format = input format
+    refused(["smooth", dist, "-o", path("out.inp"), "-q"], 2, [dist], [path("out.inp")],
+            "must be one too")
+    refused(["smooth", deck, "-o", path("deck.msh"), "-q"], 2, [deck], [path("deck.msh")])
+    refused(["smooth", dist, "-o", path("out.vtk"), "-q"], 2, [dist], [path("out.vtk")])
+    refused(["distort", dist, "-o", path("out.inp"), "--seed", "1", "-q"], 2, [dist], [])
+    run("smooth", dist, "-o", path("OUT.MSH"), "-q")
+
+    # temporary files: recognisable names; one left by a killed process is
+    # removed by the next write of the same output, one of a live process
+    # is not
+    dead = 1
+    while os.path.exists(f"/proc/{dead}") or dead == 1:
+        dead = (dead * 7919 + 13) % 4000000 + 2
+    stale = path(f".out.msh.getme-tmp.{dead}.12345")
+    live = path(".out.msh.getme-tmp.1.777")
+    other = path(f".other.msh.getme-tmp.{dead}.1")
+    for f in (stale, live, other):
+        open(f, "w").write("partial")
+    run("smooth", dist, "-o", out, "-q")
+    check(not os.path.exists(stale), "a dead process's temporary file is removed")
+    check(os.path.exists(live) and os.path.exists(other),
+          "temporary files of live processes / other outputs are kept")
+    for f in (live, other):
+        os.remove(f)
+    # SIGKILL while writing leaves at most one such file, and the next run
+    # removes it
+    big = make_box("big.msh", size=0.03)
+    for delay in (0.05, 0.3, 1.0, 2.0):
+        p = subprocess.Popen([GETME, "smooth", big, "-o", path("big-out.msh"), "-q",
+                              "--max-iter", "3"])
+        try:
+            p.wait(timeout=delay)
+        except subprocess.TimeoutExpired:
+            p.send_signal(signal.SIGKILL)
+            p.wait()
+    left = [f for f in os.listdir(WORK) if ".getme-tmp." in f]
+    check(all(f.startswith(".big-out.msh.getme-tmp.") for f in left),
+          f"only recognisable temporary files after SIGKILL ({left})")
+    run("smooth", big, "-o", path("big-out.msh"), "-q", "--max-iter", "3")
+    check(tmp_files() == [], f"the next run removed them ({tmp_files()})")
+    # SIGTERM / SIGINT: whole output or nothing, never a temporary file
+    for sig in (signal.SIGTERM, signal.SIGINT):
+        for delay in (0.2, 0.6, 1.2):
+            if os.path.exists(path("big-out2.msh")):
+                os.remove(path("big-out2.msh"))
+            p = subprocess.Popen([GETME, "smooth", big, "-o", path("big-out2.msh"), "-q",
+                                  "--max-iter", "3"])
+            try:
+                p.wait(timeout=delay)
+            except subprocess.TimeoutExpired:
+                p.send_signal(sig)
+                p.wait()
+            check(tmp_files() == [], f"signal {sig} after {delay} s: no temporary file")
+            if os.path.exists(path("big-out2.msh")):
+                check(open(path("big-out2.msh"), "rb").read().rstrip().endswith(b"$EndElements"),
+                      "an output that exists is complete")
+
+
+# ---- main ---------------------------------------------------------------
+
+CASES = {"paths": paths_case}
+CASES[CASE]()
+print(f"{passed} passed, {len(failures)} failed")
+sys.exit(1 if failures else 0)
