@@ -504,14 +504,19 @@ static void describe_groups(const msh41_reader *r, char *buf, size_t size)
 
 static getme_io_status check_fix_names(msh41_reader *r)
 {
-    for (int w = 0; r->opts && w < r->opts->num_fix; w++) {
+    int nfix = r->opts ? r->opts->num_fix : 0;
+    int nfree = r->opts ? r->opts->num_free : 0;
+    for (int w = 0; w < nfix + nfree; w++) {
         if (r->fix_found && r->fix_found[w])
             continue;
         char known[300];
         describe_groups(r, known, sizeof known);
         return getme_doc_fail(r->doc, GETME_IO_ERR_USAGE,
-                              "'%s': Unknown physical group '%s' to fix (%s)",
-                              r->doc->path, r->opts->fix[w], known);
+                              "'%s': Unknown physical group '%s' to %s (%s)",
+                              r->doc->path,
+                              w < nfix ? r->opts->fix[w]
+                                       : r->opts->free_sets[w - nfix],
+                              w < nfix ? "fix" : "free", known);
     }
     return GETME_IO_OK;
 }

@@ -16,6 +16,7 @@
 #include "msh41_internal.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -485,16 +486,20 @@ const char *msh41_group_name(const msh41_reader *r, int dim, int tag)
 static getme_io_status prepare_groups(msh41_reader *r)
 {
     int nfix = r->opts ? r->opts->num_fix : 0;
-    if (r->groups_ready || nfix == 0) {
+    int nfree = r->opts ? r->opts->num_free : 0;
+    if (r->groups_ready || nfix + nfree == 0) {
         r->groups_ready = 1;
         return GETME_IO_OK;
     }
     r->groups_ready = 1;
-    r->fix_found = calloc((size_t)nfix, sizeof *r->fix_found);
+    /* --fix words first, then --free words (only looked up: no physical
+       group is fixed by default, but an unknown name is an error) */
+    r->fix_found = calloc((size_t)(nfix + nfree), sizeof *r->fix_found);
     if (!r->fix_found)
         return oom(r);
-    for (int w = 0; w < nfix; w++) {
-        const char *word = r->opts->fix[w];
+    for (int w = 0; w < nfix + nfree; w++) {
+        const char *word = w < nfix ? r->opts->fix[w]
+                                    : r->opts->free_sets[w - nfix];
         int dim, tag, used = 0;
         int by_tag = sscanf(word, "%d:%d%n", &dim, &tag, &used) == 2 &&
                      word[used] == 0;
@@ -507,7 +512,7 @@ static getme_io_status prepare_groups(msh41_reader *r)
                 int match = by_tag ? (e->dim == dim && p == tag)
                                    : (name && strcmp(name, word) == 0);
                 if (match) {
-                    e->fix = 1;
+                    e->fix |= w < nfix;
                     r->fix_found[w]++;
                 }
             }
@@ -554,8 +559,22 @@ static getme_io_status read_node_tags(msh41_reader *r, uint64_t *tags,
 
 /* Coordinates of one block.  ASCII: one node per line, which the writer
    relies on (anything else is declined). */
+static getme_io_status not_finite(msh41_reader *r, uint64_t tag,
+                                  const double *x)
+{
+    return msh41_fail(r, GETME_IO_ERR_PARSE,
+                      "node %llu has a coordinate that is not a finite "
+                      "number (%g %g %g)",
+                      (unsigned long long)tag, x[0], x[1], x[2]);
+}
+
+static int finite3(const double *x)
+{
+    return isfinite(x[0]) && isfinite(x[1]) && isfinite(x[2]);
+}
+
 static getme_io_status read_node_coords(msh41_reader *r, double *xyz,
-                                        size_t n)
+                                        const uint64_t *tags, size_t n)
 {
     if (r->binary) {
         if (msh41_in_read(&r->in, xyz, 3 * n * 8))
@@ -564,12 +583,17 @@ static getme_io_status read_node_coords(msh41_reader *r, double *xyz,
             uint64_t bits = le64((const unsigned char *)&xyz[i]);
             memcpy(&xyz[i], &bits, sizeof bits);
         }
+        for (size_t i = 0; i < n; i++)
+            if (!finite3(xyz + 3 * i))
+                return not_finite(r, tags[i], xyz + 3 * i);
         return GETME_IO_OK;
     }
     getme_io_status st = GETME_IO_OK;
     for (size_t i = 0; i < n && st == GETME_IO_OK; i++) {
         for (int k = 0; k < 3 && st == GETME_IO_OK; k++)
             st = read_double(r, &xyz[3 * i + k]);
+        if (st == GETME_IO_OK && !finite3(xyz + 3 * i))
+            st = not_finite(r, tags[i], xyz + 3 * i);
         if (st == GETME_IO_OK && !msh41_in_eol(&r->in))
             st = msh41_decline(r, "node coordinates not one node per line");
     }
@@ -605,7 +629,8 @@ static getme_io_status read_node_block(msh41_reader *r, size_t *filled)
     b->count = (size_t)count;
     st = read_node_tags(r, r->tags + b->first, b->count);
     if (st == GETME_IO_OK)
-        st = read_node_coords(r, r->xyz + 3 * b->first, b->count);
+        st = read_node_coords(r, r->xyz + 3 * b->first, r->tags + b->first,
+                              b->count);
     /* A point's group fixes the point's node (Gmsh: mesh_vertices[0]). */
     const msh41_entity *e = msh41_find_entity(r, b->dim, b->tag);
     if (st == GETME_IO_OK && b->dim == 0 && e && e->fix && b->count)
@@ -706,6 +731,14 @@ static getme_io_status take_element(msh41_reader *r, msh41_eblock *b,
                                     int fix)
 {
     for (int k = 0; k < nv; k++) {
+        for (int j = 0; b && b->conn && j < k; j++)
+            if (rec[1 + j] == rec[1 + k])
+                return msh41_fail(r, GETME_IO_ERR_INVALID,
+                                  "element %llu is degenerate: node %llu "
+                                  "appears twice; getme smooths valid meshes "
+                                  "only",
+                                  (unsigned long long)rec[0],
+                                  (unsigned long long)rec[1 + k]);
         int32_t idx = msh41_map_find(&r->map, rec[1 + k]);
         if (idx < 0)
             return msh41_fail(r, GETME_IO_ERR_PARSE,
@@ -764,6 +797,16 @@ static getme_io_status read_ascii_elements(msh41_reader *r, msh41_eblock *b,
     return st;
 }
 
+/* As Gmsh's reader: an element block needs its entity, from $Entities or
+   created by a $Nodes block of the same dimension and tag. */
+static int node_block_entity(const msh41_reader *r, int dim, int tag)
+{
+    for (size_t i = 0; i < r->nnb; i++)
+        if (r->nb[i].dim == dim && r->nb[i].tag == tag)
+            return 1;
+    return 0;
+}
+
 static getme_io_status read_element_block(msh41_reader *r)
 {
     int dim = 0, tag = 0, type = 0;
@@ -786,6 +829,11 @@ static getme_io_status read_element_block(msh41_reader *r)
         return msh41_fail(r, GETME_IO_ERR_PARSE,
                           "bad element block dimension %d", dim);
     const msh41_entity *e = msh41_find_entity(r, dim, tag);
+    if (!e && !node_block_entity(r, dim, tag))
+        return msh41_fail(r, GETME_IO_ERR_PARSE,
+                          "element block of entity %d (dimension %d): no "
+                          "such entity in $Entities or $Nodes",
+                          tag, dim);
     msh41_eblock *b = NULL;
     if (dim >= 2 && dim >= r->top_dim && count > 0)
         st = new_eblock(r, dim, tag, type, count, nv, &b);

@@ -249,9 +249,171 @@ def paths_case():
                       "an output that exists is complete")
 
 
+# ---- damaged input ---------------------------------------------------------
+
+def set_coord(src, dst, value, binary):
+    """Copy an MSH file with the first coordinate of the first node with a
+    nonzero tag replaced by value (a float)."""
+    import struct
+    data = bytearray(open(src, "rb").read())
+    version = data.split(b"\n")[1].split()[0]
+    if not binary:
+        lines = data.decode().split("\n")
+        i = lines.index("$Nodes")
+        if version == b"2.2":
+            j = i + 2
+            f = lines[j].split()
+            f[1] = repr(value)
+            lines[j] = " ".join(f)
+        else:
+            j = i + 2
+            while True:  # a block header "dim tag param n" with n > 0
+                dim, tag, param, n = map(int, lines[j].split())
+                if n:
+                    break
+                j += 1
+            k = j + 1 + n  # first coordinate line of that block
+            f = lines[k].split()
+            f[0] = repr(value)
+            lines[k] = " ".join(f)
+            j = k
+        open(dst, "w").write("\n".join(lines))
+        return j + 1  # 1-based line number
+    at = data.index(b"$Nodes\n") + len(b"$Nodes\n")
+    if version == b"2.2":
+        at = data.index(b"\n", at) + 1 + 4  # count line, then int tag
+    else:
+        at += 4 * 8  # numEntityBlocks numNodes min max
+        while True:
+            dim, tag, param = struct.unpack("<iii", data[at:at + 12])
+            n = struct.unpack("<Q", data[at + 12:at + 20])[0]
+            at += 20
+            if n:
+                at += 8 * n  # tags
+                break
+    data[at:at + 8] = struct.pack("<d", value)
+    open(dst, "wb").write(bytes(data))
+    return None
+
+
+def damage_case():
+    m41 = make_box("d41.msh")
+    m22 = make_box("d22.msh", version=2.2)
+    b22 = make_box("b22.msh", version=2.2, binary=True)
+    b41 = make_box("b41.msh", binary=True)
+    out = path("out.msh")
+
+    # truncated files: refused with file and line, whatever the reader
+    for src, cut in ((m22, 16), (m22, 1000), (b22, 16), (m41, 16)):
+        data = open(src, "rb").read()
+        bad = src[:-4] + f"-cut{cut}.msh"
+        open(bad, "wb").write(data[:-cut])
+        for reader in ("", "gmsh"):
+            env = dict(os.environ, GETME_MSH_READER=reader) if reader else None
+            p = subprocess.run([GETME, "smooth", bad, "-o", out, "-q"], capture_output=True,
+                               text=True, env=env)
+            where = "byte" if src == b22 else "line"
+            check(p.returncode == 4, f"{os.path.basename(bad)} ({reader or 'default'}) -> "
+                                     f"{p.returncode}, want 4 ({p.stderr.strip()})")
+            check(os.path.basename(bad) in p.stderr and where in p.stderr,
+                  f"truncation message names file and {where}: {p.stderr.strip()}")
+            check(not os.path.exists(out), "no output for a truncated file")
+    # MSH 2.2 damage inside the file: an element line short of a node, a
+    # section with more lines than it declares
+    lines = open(m22).read().split("\n")
+    e = lines.index("$Elements") + 2
+    short = lines[:]
+    short[e + 3] = " ".join(short[e + 3].split()[:-1])
+    open(path("short22.msh"), "w").write("\n".join(short))
+    p = refused(["smooth", path("short22.msh"), "-o", out, "-q"], 4, [path("short22.msh")],
+                [out], r"short22.msh', line %d: bad element line" % (e + 4))
+    extra = lines[:]
+    extra.insert(e + 2, extra[e + 1])
+    open(path("extra22.msh"), "w").write("\n".join(extra))
+    refused(["smooth", path("extra22.msh"), "-o", out, "-q"], 4, [path("extra22.msh")], [out],
+            "holds more entries than it declares")
+
+    # an element block of an entity that does not exist (Gmsh refuses it)
+    lines = open(m41).read().split("\n")
+    e = lines.index("$Elements") + 2
+    while lines[e].split()[0] != "3":
+        e += int(lines[e].split()[3]) + 1
+    f = lines[e].split()
+    f[1] = "77"
+    lines[e] = " ".join(f)
+    open(path("noent.msh"), "w").write("\n".join(lines))
+    refused(["smooth", path("noent.msh"), "-o", out, "-q"], 4, [path("noent.msh")], [out],
+            r"noent.msh', line %d: element block of entity 77 \(dimension 3\): no such entity"
+            % (e + 1))
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    try:
+        gmsh.open(path("noent.msh"))
+        gmsh_ok = True
+    except Exception:
+        gmsh_ok = False
+    gmsh.finalize()
+    check(not gmsh_ok, "Gmsh itself refuses the unknown entity")
+
+    # NaN / Inf coordinates: exit 4, file and line (binary: the node / byte)
+    for src, binary in ((m41, False), (m22, False), (b41, True), (b22, True)):
+        for value in (float("nan"), float("inf"), float("-inf")):
+            bad = src[:-4] + "-nonfinite.msh"
+            line = set_coord(src, bad, value, binary)
+            want = r"line %d: node \d+ has a coordinate that is not a finite" % line \
+                if line else "node \\d+ has a coordinate that is not a finite"
+            refused(["smooth", bad, "-o", out, "-q"], 4, [bad], [out], want)
+    deck = path("nan.inp")
+    open(deck, "w").write(TET_DECK.replace("6, 0.3, 0.3, 0.3", "6, 0.3, nan, 0.3"))
+    refused(["smooth", deck, "-o", path("nan-out.inp"), "-q"], 4, [deck], [], r"nan.inp:9: node 6: bad coordinate")
+
+    # a degenerate tet (a node twice): exit 6 and the file's element tag
+    lines = open(m41).read().split("\n")
+    e = lines.index("$Elements") + 2
+    while lines[e].split()[0] != "3":
+        e += int(lines[e].split()[3]) + 1
+    f = lines[e + 1].split()
+    tag41 = f[0]
+    f[4] = f[3]
+    lines[e + 1] = " ".join(f)
+    open(path("deg41.msh"), "w").write("\n".join(lines))
+    refused(["smooth", path("deg41.msh"), "-o", out, "-q"], 6, [path("deg41.msh")], [out],
+            r"deg41.msh', line %d: element %s is degenerate" % (e + 2, tag41))
+    lines = open(m22).read().split("\n")
+    e = lines.index("$Elements") + 2
+    while lines[e].split()[1] != "4":
+        e += 1
+    f = lines[e].split()
+    tag22 = f[0]
+    f[-1] = f[-2]
+    lines[e] = " ".join(f)
+    open(path("deg22.msh"), "w").write("\n".join(lines))
+    refused(["smooth", path("deg22.msh"), "-o", out, "-q"], 6, [path("deg22.msh")], [out],
+            r"element %s is degenerate" % tag22)
+    deck = path("deg.inp")
+    open(deck, "w").write(TET_DECK.replace("3, 1, 6, 3, 4", "3, 1, 6, 3, 3"))
+    refused(["smooth", deck, "-o", path("deg-out.inp"), "-q"], 6, [deck], [],
+            r"deg.inp:13: element 3 is degenerate: node 3 appears twice")
+    run("quality", deck, expect=6)
+
+    # --free with an unknown name: refused for every format
+    for src in (m41, m22):
+        refused(["smooth", src, "-o", out, "--free", "nosuch", "-q"], 2, [src], [out],
+                "Unknown physical group 'nosuch' to free")
+    deck = path("ok.inp")
+    open(deck, "w").write(TET_DECK)
+    refused(["smooth", deck, "-o", path("ok-out.inp"), "--free", "nosuch", "-q"], 2, [deck], [],
+            "no node or element set named 'nosuch' to free")
+    run("smooth", deck, "-o", path("ok-out.inp"), "--free", "ALL", "-q")
+    cg = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "examples",
+                      "cgns", "hybrid.cgns")
+    refused(["smooth", cg, "-o", path("x.cgns"), "--free", "nosuch", "-q"], 2, [cg],
+            [path("x.cgns")])
+
+
 # ---- main ---------------------------------------------------------------
 
-CASES = {"paths": paths_case}
+CASES = {"paths": paths_case, "damage": damage_case}
 CASES[CASE]()
 print(f"{passed} passed, {len(failures)} failed")
 sys.exit(1 if failures else 0)
