@@ -98,6 +98,40 @@ _sig(core, "getme_mesh_distort", c_int, c_void_p, ctypes.c_uint64, c_double,
      c_double, c_int)
 
 
+MAX_RELAX = 16
+
+
+class Params(ctypes.Structure):
+    """getme_params from getme.h (checked against getme_params_sizeof)."""
+    _fields_ = [("method", c_int), ("max_iter", c_int), ("tol", c_double),
+                ("sigma", c_double), ("num_relax_mean", c_int),
+                ("relax_mean", c_double * MAX_RELAX),
+                ("num_relax_min", c_int),
+                ("relax_min", c_double * MAX_RELAX),
+                ("max_no_min_improve", c_int), ("min_tol", c_double),
+                ("threshold_fraction", c_double), ("keep_best", c_int),
+                ("num_threads", c_int), ("renumber", c_int),
+                ("progress", c_void_p), ("progress_data", c_void_p)]
+
+
+_sig(core, "getme_params_init", None, POINTER(Params))
+_sig(core, "getme_params_sizeof", c_size_t)
+
+
+def defaults():
+    """The library's default parameters (getme_params_init): the one table
+    every entry point (CLI, Python, GUI) starts from."""
+    if ctypes.sizeof(Params) != core.getme_params_sizeof():
+        raise GetmeError("getme_params layout differs from this module's")
+    p = Params()
+    core.getme_params_init(ctypes.byref(p))
+    return {"method": "getme" if p.method == 0 else "laplace",
+            "max_iter": p.max_iter, "tol": p.tol, "sigma": p.sigma,
+            "max_no_min_improve": p.max_no_min_improve, "min_tol": p.min_tol,
+            "threshold_fraction": p.threshold_fraction,
+            "keep_best": p.keep_best, "renumber": p.renumber}
+
+
 def version():
     return core.getme_version().decode()
 

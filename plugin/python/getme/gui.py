@@ -23,24 +23,28 @@ import sys
 import gmsh
 
 from . import gmsh as gg
+from . import _lib
 from ._lib import GetmeError
 
 P = "GETMe adaptive/"
 
 
 def parameters():
+    d = _lib.defaults()  # the library's defaults, as the CLI's
     groups = ["%s" % gmsh.model.getPhysicalName(d, t) or "%d:%d" % (d, t)
               for d, t in gmsh.model.getPhysicalGroups()]
     return [
-        {"type": "string", "name": P + "0Method", "values": ["getme"],
+        {"type": "string", "name": P + "0Method", "values": [d["method"]],
          "choices": ["getme", "laplace"],
          "help": "GETMe adaptive or smart Laplace (baseline)"},
-        {"type": "number", "name": P + "1Sigma", "values": [1.5],
+        {"type": "number", "name": P + "1Sigma", "values": [d["sigma"]],
          "min": 0.05, "max": 3, "step": 0.05},
-        {"type": "number", "name": P + "2Max iterations", "values": [1000],
+        {"type": "number", "name": P + "2Max iterations",
+         "values": [d["max_iter"]],
          "min": 1, "max": 100000, "step": 1},
         {"type": "number", "name": P + "3Threshold fraction",
-         "values": [0.01], "min": 0.0001, "max": 1, "step": 0.001},
+         "values": [d["threshold_fraction"]], "min": 0.0001, "max": 1,
+         "step": 0.001},
         {"type": "string", "name": P + "4Fixed groups", "values": [""],
          "help": "comma-separated physical group names or dim:tag; "
                  "available: " + (", ".join(groups) or "none")},
@@ -58,7 +62,36 @@ def number(name):
     return v[0] if v else None
 
 
+RESULT_ROWS = ["q*min before", "q*min after", "q_mean before",
+               "q_mean after", "Iterations", "Nodes moved"]
+
+
+def clear_result():
+    """Remove the rows of the last run (and its error), so that the panel
+    never shows results of an earlier mesh after a failed run."""
+    for i, label in enumerate(RESULT_ROWS):
+        gmsh.onelab.clear(P + "Result/%d%s" % (i, label))
+    gmsh.onelab.clear(P + "Result/Error")
+
+
+def log_error(message):
+    """Gmsh's Python API raises after logging at level "error" (it reports
+    the last error of the call): log it and carry on, the GUI stays up."""
+    try:
+        gmsh.logger.write(message, "error")
+    except Exception:  # noqa: BLE001 -- the message is logged already
+        pass
+
+
+def show_error(message):
+    clear_result()
+    gmsh.onelab.set(json.dumps([
+        {"type": "string", "name": P + "Result/Error", "values": [message],
+         "readOnly": True}]))
+
+
 def show_result(res):
+    clear_result()
     rows = [("q*min before", res["q_min_star_before"]),
             ("q*min after", res["q_min_star_after"]),
             ("q_mean before", res["q_mean_before"]),
@@ -96,7 +129,8 @@ def smooth():
                           threshold_fraction=number("3Threshold fraction"))
         show_result(res)
     except GetmeError as e:
-        gmsh.logger.write("GETMe: %s" % e, "error")
+        show_error(str(e))
+        log_error("GETMe: %s" % e)
     redraw()
 
 
@@ -111,7 +145,7 @@ def distort_if_asked():
         gmsh.logger.write("Distorted the mesh for the demo (%d nodes moved)"
                           % n, "info")
     except GetmeError as e:
-        gmsh.logger.write("GETMe: %s" % e, "error")
+        log_error("GETMe: %s" % e)
     redraw()
 
 
