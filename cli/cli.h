@@ -12,7 +12,6 @@
 #include "getme.h"
 #include "getme_formats.h"
 
-#include <signal.h>
 #include <stdio.h>
 
 enum { EXIT_USAGE = 2 };
@@ -30,6 +29,11 @@ void cli_warning(const cli_log *log, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));
 void cli_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 
+/* q*min of stats as printed: "0.1919", or "- (no element has a free
+   node)" when it is undefined (every node fixed), never a made-up 1. */
+const char *cli_q_min_star(const getme_quality_stats *s, char *buf,
+                           size_t size);
+
 /* Gmsh-like histogram and summary of stats, one line each. */
 void cli_print_stats(const cli_log *log, const char *title,
                      const getme_quality_stats *s);
@@ -41,9 +45,10 @@ int cli_parse_double(const char *opt, const char *s, double *out);
 /* Open a document; on failure print its one-line error, close it and
    return NULL with the exit code in *code.  With allow_invalid, an input
    whose only problem is invalid elements is returned (*code =
-   GETME_IO_ERR_INVALID) so that it can still be reported on. */
+   GETME_IO_ERR_INVALID) so that it can still be reported on.  The
+   document's warning, if any, is printed through log. */
 getme_doc *cli_open(const char *path, const getme_doc_options *opts,
-                    int allow_invalid, int *code);
+                    int allow_invalid, int *code, const cli_log *log);
 
 /* Mesh summary: "195070 tets, 12 prisms; 37012 nodes (8123 fixed)". */
 void cli_describe_mesh(getme_mesh *mesh, char *buf, size_t size);
@@ -73,7 +78,6 @@ int cli_check_read_files(const cli_paths *p, const getme_doc *doc);
    after (on = 0): a Ctrl-C leaves the whole output or none. */
 typedef struct cli_guard {
     int active;
-    sigset_t old;
 } cli_guard;
 void cli_write_guard(cli_guard *g, int on);
 

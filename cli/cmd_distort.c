@@ -77,7 +77,7 @@ int cli_distort(int argc, char **argv)
     int st = cli_check_paths(&paths);
     if (st)
         return st;
-    getme_doc *doc = cli_open(input, NULL, 0, &st);
+    getme_doc *doc = cli_open(input, NULL, 0, &st, &log);
     if (!doc)
         return st;
     if ((st = cli_check_read_files(&paths, doc)) != 0) {

@@ -208,7 +208,7 @@ static int run(smooth_args *a)
         return code;
     double t0 = omp_get_wtime();
     cli_info(log, "Reading '%s'...", a->input);
-    getme_doc *doc = cli_open(a->input, &opts, 0, &code);
+    getme_doc *doc = cli_open(a->input, &opts, 0, &code, log);
     if (!doc)
         return code;
     if ((code = cli_check_read_files(&paths, doc)) != 0) {

@@ -12,6 +12,7 @@
 #include "cli.h"
 
 #include <errno.h>
+#include <pthread.h>
 #include <signal.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -125,22 +126,64 @@ int cli_check_read_files(const cli_paths *p, const getme_doc *doc)
 
 /* Termination signals wait while files are written, so that a Ctrl-C or
    kill leaves either the complete output or nothing (never a temporary
-   file); they are delivered, with their usual effect, once writing ends.
-   Only SIGKILL and a power loss can leave a temporary file
-   (".<output>.getme-tmp.<pid>.<n>"); the next write of that output
-   removes it. */
+   file); they take their usual effect once writing ends.  Only SIGKILL and
+   a power loss can leave a temporary file (".<output>.getme-tmp.<pid>.<n>");
+   the next write of that output removes it.
+
+   Blocking the signals with sigprocmask is not enough: the mask is per
+   thread, and a signal sent to the process goes to any thread that does
+   not block it (the OpenMP workers).  So a handler decides, in whatever
+   thread it runs.  Its two flags are the command's only process-wide
+   state: a signal handler has no other way to reach its caller. */
+static volatile sig_atomic_t writing, pending;
+
+static const int SIGNALS[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
+
+static void die_now(int sig)
+{
+    signal(sig, SIG_DFL);
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, sig);
+    pthread_sigmask(SIG_UNBLOCK, &set, NULL);
+    raise(sig);
+}
+
+static void on_signal(int sig)
+{
+    if (writing)
+        pending = sig;
+    else
+        die_now(sig);
+}
+
 void cli_write_guard(cli_guard *g, int on)
 {
     if (on) {
-        sigset_t set;
-        sigemptyset(&set);
-        sigaddset(&set, SIGINT);
-        sigaddset(&set, SIGTERM);
-        sigaddset(&set, SIGHUP);
-        sigaddset(&set, SIGQUIT);
-        g->active = sigprocmask(SIG_BLOCK, &set, &g->old) == 0;
+        struct sigaction sa;
+        memset(&sa, 0, sizeof sa);
+        sa.sa_handler = on_signal;
+        sigfillset(&sa.sa_mask);
+        g->active = 1;
+        for (size_t i = 0; i < sizeof SIGNALS / sizeof *SIGNALS; i++) {
+            struct sigaction old;
+            /* a signal the user's shell ignores (nohup) stays ignored */
+            if (sigaction(SIGNALS[i], NULL, &old) == 0 &&
+                old.sa_handler != SIG_IGN)
+                sigaction(SIGNALS[i], &sa, NULL);
+        }
+        writing = 1;
     } else if (g->active) {
-        sigprocmask(SIG_SETMASK, &g->old, NULL);
+        writing = 0;
         g->active = 0;
+        int sig = pending;
+        if (sig)
+            die_now(sig);
+        for (size_t i = 0; i < sizeof SIGNALS / sizeof *SIGNALS; i++) {
+            struct sigaction old;
+            if (sigaction(SIGNALS[i], NULL, &old) == 0 &&
+                old.sa_handler == on_signal)
+                signal(SIGNALS[i], SIG_DFL);
+        }
     }
 }

@@ -25,11 +25,15 @@ static void json_string(FILE *f, const char *s)
 
 static void json_stats(FILE *f, const getme_quality_stats *s)
 {
-    fprintf(f, "{\"elements\": %lld, \"invalid\": %lld, \"q_min_star\": %.17g, "
+    /* q*min is undefined (null) when no element has a free node */
+    char qs[32] = "null";
+    if (s->num_free > 0)
+        snprintf(qs, sizeof qs, "%.17g", s->q_min_star);
+    fprintf(f, "{\"elements\": %lld, \"invalid\": %lld, \"q_min_star\": %s, "
                "\"q_min\": %.17g, \"q_mean\": %.17g, \"q_max\": %.17g, "
                "\"below_0_4\": %lld, \"below_0_1\": %lld, \"histogram\": [",
             (long long)s->num_elements, (long long)s->num_invalid,
-            s->q_min_star, s->q_min, s->q_mean, s->q_max,
+            qs, s->q_min, s->q_mean, s->q_max,
             (long long)s->num_below_04, (long long)s->num_below_01);
     for (int b = 0; b < GETME_HIST_BINS; b++)
         fprintf(f, "%s%lld", b ? ", " : "", (long long)s->histogram[b]);

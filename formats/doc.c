@@ -64,6 +64,11 @@ const char *getme_doc_error(const getme_doc *doc)
 
 const char *getme_doc_info(const getme_doc *doc) { return doc ? doc->info : ""; }
 
+const char *getme_doc_warning(const getme_doc *doc)
+{
+    return doc ? doc->warning : "";
+}
+
 getme_mesh *getme_doc_mesh(getme_doc *doc) { return doc ? doc->mesh : NULL; }
 
 /* Name the first invalid elements by their ids in the file. */

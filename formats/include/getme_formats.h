@@ -99,6 +99,8 @@ struct getme_doc {
                             check; callers need not compute them again)      */
     char info[1024];     /* one line the CLI may log: zones, sets, fixed...  */
     char error[1024];    /* the last error, one line                         */
+    char warning[1024];  /* input accepted with a caveat (the CLI prints it
+                            as a warning), one line; empty if none           */
 };
 
 /* The registered adapters, NULL-terminated. */
@@ -128,6 +130,7 @@ void getme_doc_close(getme_doc *doc);
 getme_mesh *getme_doc_mesh(getme_doc *doc);
 const char *getme_doc_error(const getme_doc *doc);
 const char *getme_doc_info(const getme_doc *doc);
+const char *getme_doc_warning(const getme_doc *doc);
 
 /* Set doc->error (printf style) and return status. */
 getme_io_status getme_doc_fail(getme_doc *doc, getme_io_status status,

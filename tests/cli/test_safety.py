@@ -18,6 +18,7 @@ input's sha256 and the absence of any output or temporary file.
 import hashlib
 import os
 import re
+import shutil
 import signal
 import stat
 import subprocess
@@ -26,7 +27,8 @@ import sys
 import gmsh
 
 GETME, WORK, CASE = sys.argv[1], os.path.abspath(sys.argv[2]), sys.argv[3]
-os.makedirs(WORK, exist_ok=True)
+shutil.rmtree(WORK, ignore_errors=True)
+os.makedirs(WORK)
 failures = []
 passed = 0
 
@@ -411,9 +413,139 @@ def damage_case():
             [path("x.cgns")])
 
 
+# ---- usability -------------------------------------------------------------
+
+def hex_grid_deck(n, h, extra_ids=False):
+    """A perfect n^3 hex grid of spacing h, as CalculiX's own test decks
+    (C3D8I; with extra_ids, 10 node ids and a trailing comma per element
+    line, as ccx's dloadlinI.inp)."""
+    def nid(i, j, k):
+        return 1 + i + (n + 1) * (j + (n + 1) * k)
+    lines = ["*HEADING", "grid", "*NODE, NSET=NALL"]
+    for k in range(n + 1):
+        for j in range(n + 1):
+            for i in range(n + 1):
+                lines.append(f"{nid(i, j, k)}, {i * h!r}, {j * h!r}, {k * h!r}")
+    lines.append("*ELEMENT, TYPE=C3D8I, ELSET=EALL")
+    e = 0
+    for k in range(n):
+        for j in range(n):
+            for i in range(n):
+                e += 1
+                c = [nid(i, j, k), nid(i + 1, j, k), nid(i + 1, j + 1, k), nid(i, j + 1, k),
+                     nid(i, j, k + 1), nid(i + 1, j, k + 1), nid(i + 1, j + 1, k + 1),
+                     nid(i, j + 1, k + 1)]
+                if extra_ids:
+                    c += [c[0] + 1000, c[1] + 1000]
+                lines.append(f"{e}, " + ", ".join(map(str, c)) + ("," if extra_ids else ""))
+    lines += ["*MATERIAL, NAME=STEEL", "*ELASTIC", "210000., .3",
+              "*SOLID SECTION, ELSET=EALL, MATERIAL=STEEL", ""]
+    return "\n".join(lines) + "\n"
+
+
+def usability_case():
+    # quality of a mesh without any free node: no made-up q*min of 1
+    one = path("one.inp")
+    open(one, "w").write("*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 0, 1, 0\n4, 0.2, 0.2, 0.1\n"
+                         "*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n")
+    p = run("quality", one)
+    check("no element has a free node" in p.stdout and "q*min 1.0000" not in p.stdout,
+          f"quality without free nodes says so: {p.stdout.splitlines()[1]}")
+    check("qmin 0.2977" in p.stdout, "qmin still printed")
+    p = run("smooth", one, "-o", path("one-out.inp"), "--report", path("one.json"))
+    check("q*min 1.0000" not in p.stdout and "no element has a free node" in p.stdout,
+          "smooth's log says so too")
+    import json
+    rep = json.load(open(path("one.json")))
+    check(rep["before"]["q_min_star"] is None and rep["after"]["q_min_star"] is None,
+          "report: q_min_star null without free nodes")
+
+    # perfect hexes: nodes that move by a rounding step keep their text
+    deck = path("grid.inp")
+    open(deck, "w").write(hex_grid_deck(4, 0.25))
+    run("smooth", deck, "-o", path("grid-out.inp"), "-q")
+    check(open(deck, "rb").read() == open(path("grid-out.inp"), "rb").read(),
+          "a perfect hex grid deck comes back byte for byte")
+    # ... although the smoother did move some of them by a rounding step
+    # (seen through the MSH writer, which writes every coordinate it has)
+    nodes, hexes = [], []
+    for ln in hex_grid_deck(4, 0.25).split("\n"):
+        f = [x.strip() for x in ln.split(",")]
+        if len(f) == 4 and "." in ln:
+            nodes.append((int(f[0]), [float(v) for v in f[1:]]))
+        elif len(f) == 9 and f[0].isdigit():
+            hexes.append([int(v) for v in f])
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.model.addDiscreteEntity(3, 1)
+    gmsh.model.mesh.addNodes(3, 1, [t for t, _ in nodes], [c for _, x in nodes for c in x])
+    gmsh.model.mesh.addElementsByType(1, 5, [h[0] for h in hexes], [v for h in hexes for v in h[1:]])
+    gmsh.write(path("grid.msh"))
+    gmsh.finalize()
+    run("smooth", path("grid.msh"), "-o", path("grid-out.msh"), "-q")
+
+    def coords(f):
+        gmsh.initialize()
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.open(f)
+        t, x, _ = gmsh.model.mesh.getNodes()
+        gmsh.finalize()
+        return dict(zip(t.tolist(), x.reshape(-1, 3).tolist()))
+    a, b = coords(path("grid.msh")), coords(path("grid-out.msh"))
+    diffs = [max(abs(p - q) for p, q in zip(a[t], b[t])) for t in a if a[t] != b[t]]
+    check(diffs and max(diffs) < 1e-12,
+          f"the smoother moves {len(diffs)} grid nodes by rounding steps only")
+    # a node that really moves is still written
+    moved = hex_grid_deck(4, 0.25).replace("34, 0.75, 0.25, 0.25", "34, 0.7, 0.3, 0.25")
+    check(moved != hex_grid_deck(4, 0.25), "test deck edit applies")
+    open(path("moved.inp"), "w").write(moved)
+    run("smooth", path("moved.inp"), "-o", path("moved-out.inp"), "-q")
+    out_lines = open(path("moved-out.inp")).read().split("\n")
+    changed = [(x, y) for x, y in zip(moved.split("\n"), out_lines) if x != y]
+    check(changed and all(x.split(",")[0] == y.split(",")[0] for x, y in changed),
+          f"moved nodes rewritten ({len(changed)} lines), nothing else")
+
+    # element lines with extra node ids (ccx ignores them): warning naming
+    # file and line, accepted, written back byte for byte
+    deck = path("extra.inp")
+    text = hex_grid_deck(3, 0.5, extra_ids=True)
+    open(deck, "w").write(text)
+    p = run("smooth", deck, "-o", path("extra-out.inp"))
+    line = text.split("\n").index("*ELEMENT, TYPE=C3D8I, ELSET=EALL") + 2
+    check(re.search(r"Warning : .*extra.inp:%d: element 1 has more node ids than its type "
+                    r"needs.*\(27 elements" % line, p.stdout) is not None,
+          f"warning names file and line: {p.stdout[:400]!r}")
+    out = open(path("extra-out.inp")).read()
+    els = [x for x in text.split("\n") if re.match(r"^\d+, \d+, \d+, \d+, \d+, \d+, \d+, \d+, \d+, \d+, \d+,$", x)]
+    check(len(els) == 27 and all(x in out.split("\n") for x in els),
+          "element lines with extra ids kept byte for byte")
+    p = run("smooth", deck, "-o", path("extra-out2.inp"), "-q")
+    check("Warning" not in p.stdout, "-q silences the warning")
+    # too few ids is still an error
+    bad = text.replace("1, 1, 2, 6, 5, 17, 18, 22, 21, 1001, 1002,", "1, 1, 2, 6")
+    check(bad != text, "test deck edit applies (too few ids)")
+    open(path("few.inp"), "w").write(bad)
+    refused(["smooth", path("few.inp"), "-o", path("few-out.inp"), "-q"], 4,
+            [path("few.inp")], [path("few-out.inp")], r"few.inp:%d: element 1" % line)
+    # CalculiX's own decks, when its test package is installed
+    ccx = "/usr/share/doc/calculix-ccx-test/examples/test"
+    for name in ("dloadlinI", "beampsensfreq"):
+        src = os.path.join(ccx, name + ".inp.gz")
+        if not os.path.exists(src):
+            print(f"(skipped {name}: calculix-ccx-test not installed)")
+            continue
+        import gzip
+        data = gzip.open(src).read()
+        open(path(name + ".inp"), "wb").write(data)
+        p = run("smooth", path(name + ".inp"), "-o", path(name + "-out.inp"))
+        check("more node ids than its type needs" in p.stdout, f"{name}: warning")
+        check(open(path(name + "-out.inp"), "rb").read() == data,
+              f"{name}: perfect hexes come back byte for byte")
+
+
 # ---- main ---------------------------------------------------------------
 
-CASES = {"paths": paths_case, "damage": damage_case}
+CASES = {"paths": paths_case, "damage": damage_case, "usability": usability_case}
 CASES[CASE]()
 print(f"{passed} passed, {len(failures)} failed")
 sys.exit(1 if failures else 0)
