@@ -93,8 +93,43 @@ typedef struct cli_history {
     int count, cap;
 } cli_history;
 
+/* ---- smoothing options shared by smooth and gmsh (smooth_opts.c) ---- */
+
+typedef struct cli_smooth_opts {
+    const char **fix, **free_sets;
+    int num_fix, num_free, free_interfaces;
+    const char *report;
+    getme_params params;
+    cli_log log;
+    cli_history history; /* filled by the progress callback */
+} cli_smooth_opts;
+
+/* Their --help lines. */
+extern const char CLI_SMOOTH_OPTIONS_HELP[];
+/* Defaults (getme_params_init); room for argc names.  0 or -1 (memory). */
+int cli_smooth_opts_init(cli_smooth_opts *o, int argc);
+void cli_smooth_opts_free(cli_smooth_opts *o);
+/* argv[*i] if it is a smoothing option (advancing *i past its value):
+   1 taken, 0 not a smoothing option, -1 bad value (printed). */
+int cli_smooth_option(cli_smooth_opts *o, int argc, char **argv, int *i);
+/* The document options the smoothing options imply. */
+void cli_smooth_doc_options(const cli_smooth_opts *o, getme_doc_options *d);
+/* Before smoothing: progress lines and history on, the thread count
+   decided, "Optimizing mesh (...)..." logged; the parameters are copied to
+   *params when that is not o->params. */
+void cli_smooth_begin(cli_smooth_opts *o, getme_params *params);
+/* "Done optimizing mesh (Wall ...): N + M iterations (K q*min cycles)". */
+void cli_smooth_done(const cli_smooth_opts *o, const getme_result *res);
+
+/* What the report says about the mesh. */
+typedef struct cli_mesh_counts {
+    int32_t nodes, fixed;
+    int32_t elements[GETME_NUM_TYPES];
+} cli_mesh_counts;
+void cli_count_mesh(getme_mesh *mesh, cli_mesh_counts *c);
+
 int cli_write_report(const char *path, const char *input, const char *output,
-                     const getme_params *params, getme_mesh *mesh,
+                     const getme_params *params, const cli_mesh_counts *mesh,
                      const getme_quality_stats *before,
                      const getme_quality_stats *after,
                      const getme_result *result, const cli_history *history,

@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const char SMOOTH_HELP[] =
+static const char SMOOTH_HELP_HEAD[] =
     "usage: getme smooth IN -o OUT [options]\n"
     "\n"
     "Smooth the mesh in IN by moving free nodes and write the same file with\n"
@@ -20,158 +20,42 @@ static const char SMOOTH_HELP[] =
     "CGNS BC patches, plus the sets named with --fix.\n"
     "\n"
     "options:\n"
-    "  -o, --output FILE      output file (required)\n"
-    "  --method getme|laplace GETMe adaptive (default) or smart Laplace\n"
-    "  --threads N            OpenMP threads (default: all cores); the result\n"
-    "                         is bit-identical for any N\n"
-    "  --max-iter N           iteration limit over both stages (default 1000)\n"
-    "  --fix NAME             also fix a named set: Gmsh physical group name\n"
-    "                         (or DIM:TAG), INP NSET/ELSET, CGNS BC/family\n"
-    "                         (repeatable)\n"
-    "  --free NAME            do not fix this CGNS BC/family (repeatable)\n"
-    "  --free-interfaces      let nodes on region interfaces move\n"
-    "  --param NAME=VALUE     any smoothing parameter: sigma (1.5), tol (1e-4),\n"
-    "                         threshold_fraction (0.005), max_no_min_improve (5),\n"
-    "                         keep_best (1), renumber (1)\n"
-    "  --report FILE.json     write before/after statistics, iterations and\n"
-    "                         the per-iteration history as JSON\n"
-    "  -q, --quiet            print errors only\n"
-    "  -v, --verbose          print the quality histograms\n"
+    "  -o, --output FILE      output file (required; the input's format and\n"
+    "                         extension; a regular file or a new one)\n";
+
+static const char SMOOTH_HELP_TAIL[] =
     "\n"
     "exit codes: 0 ok, 1 internal error, 2 usage, 3 cannot read input,\n"
     "4 malformed input, 5 unsupported content, 6 invalid elements in input,\n"
     "7 cannot write output\n";
 
 typedef struct smooth_args {
-    const char *input, *output, *report;
-    const char **fix, **free_sets;
-    int num_fix, num_free, free_interfaces;
-    getme_params params;
-    cli_log log;
+    const char *input, *output;
+    cli_smooth_opts o;
 } smooth_args;
-
-typedef struct progress_state {
-    const cli_log *log;
-    cli_history *history;
-} progress_state;
-
-static int on_progress(const getme_progress *p, void *data)
-{
-    progress_state *ps = data;
-    cli_history *h = ps->history;
-    if (h->count == h->cap) {
-        int cap = h->cap ? 2 * h->cap : 64;
-        getme_progress *items = realloc(h->items, (size_t)cap * sizeof *items);
-        if (items) {
-            h->items = items;
-            h->cap = cap;
-        }
-    }
-    if (h->count < h->cap)
-        h->items[h->count++] = *p;
-    const char *stage = p->stage == GETME_STAGE_MEAN  ? "qmean stage"
-                        : p->stage == GETME_STAGE_MIN ? "q*min stage"
-                                                      : "smart Laplace";
-    if (p->stage == GETME_STAGE_MIN)
-        cli_info(ps->log, "It %4d (%s, cycle %d, q_t %.4f): q*min %.4f, "
-                          "qmean %.4f, %d transformed, %d relaxed (%.2f s)",
-                 p->iteration, stage, p->cycle, p->threshold, p->q_min_star,
-                 p->q_mean, (int)p->num_transformed, (int)p->num_relaxed,
-                 p->elapsed);
-    else
-        cli_info(ps->log, "It %4d (%s): q*min %.4f, qmean %.4f, %d relaxed "
-                          "(%.2f s)",
-                 p->iteration, stage, p->q_min_star, p->q_mean,
-                 (int)p->num_relaxed, p->elapsed);
-    return 0;
-}
-
-/* name=value for --param. */
-static int set_param(getme_params *p, const char *arg)
-{
-    const char *eq = strchr(arg, '=');
-    char name[64];
-    double v;
-    if (!eq || eq == arg || (size_t)(eq - arg) >= sizeof name) {
-        cli_error("--param expects NAME=VALUE, got '%s'", arg);
-        return -1;
-    }
-    memcpy(name, arg, (size_t)(eq - arg));
-    name[eq - arg] = '\0';
-    if (cli_parse_double("--param", eq + 1, &v) != 0)
-        return -1;
-    if (getme_params_set(p, name, v) != GETME_OK) {
-        cli_error("--param %s: unknown parameter or value out of range", arg);
-        return -1;
-    }
-    return 0;
-}
-
-/* Takes the value of an option: "--opt VALUE". */
-static const char *value(int argc, char **argv, int *i)
-{
-    if (*i + 1 >= argc) {
-        cli_error("%s needs a value (see getme smooth --help)", argv[*i]);
-        return NULL;
-    }
-    return argv[++*i];
-}
 
 static int parse(int argc, char **argv, smooth_args *a)
 {
-    getme_params_init(&a->params);
-    a->fix = calloc((size_t)argc, sizeof *a->fix);
-    a->free_sets = calloc((size_t)argc, sizeof *a->free_sets);
-    if (!a->fix || !a->free_sets)
+    if (cli_smooth_opts_init(&a->o, argc) != 0)
         return 1;
     for (int i = 1; i < argc; i++) {
-        const char *o = argv[i], *v;
-        long n;
+        const char *o = argv[i];
+        int r = cli_smooth_option(&a->o, argc, argv, &i);
+        if (r < 0)
+            return EXIT_USAGE;
+        if (r > 0)
+            continue;
         if (!strcmp(o, "-h") || !strcmp(o, "--help")) {
-            fputs(SMOOTH_HELP, stdout);
+            fputs(SMOOTH_HELP_HEAD, stdout);
+            fputs(CLI_SMOOTH_OPTIONS_HELP, stdout);
+            fputs(SMOOTH_HELP_TAIL, stdout);
             return -1;
         } else if (!strcmp(o, "-o") || !strcmp(o, "--output")) {
-            if (!(a->output = value(argc, argv, &i)))
-                return EXIT_USAGE;
-        } else if (!strcmp(o, "--method")) {
-            if (!(v = value(argc, argv, &i)))
-                return EXIT_USAGE;
-            if (!strcmp(v, "getme") || !strcmp(v, "adaptive"))
-                a->params.method = GETME_METHOD_ADAPTIVE;
-            else if (!strcmp(v, "laplace"))
-                a->params.method = GETME_METHOD_SMART_LAPLACE;
-            else {
-                cli_error("--method expects getme or laplace, got '%s'", v);
+            if (i + 1 >= argc) {
+                cli_error("%s needs a value (see getme smooth --help)", o);
                 return EXIT_USAGE;
             }
-        } else if (!strcmp(o, "--threads")) {
-            if (!(v = value(argc, argv, &i)) ||
-                cli_parse_int(o, v, 1, 4096, &n) != 0)
-                return EXIT_USAGE;
-            a->params.num_threads = (int)n;
-        } else if (!strcmp(o, "--max-iter")) {
-            if (!(v = value(argc, argv, &i)) ||
-                cli_parse_int(o, v, 0, 1000000000, &n) != 0)
-                return EXIT_USAGE;
-            a->params.max_iter = (int)n;
-        } else if (!strcmp(o, "--fix")) {
-            if (!(a->fix[a->num_fix++] = value(argc, argv, &i)))
-                return EXIT_USAGE;
-        } else if (!strcmp(o, "--free")) {
-            if (!(a->free_sets[a->num_free++] = value(argc, argv, &i)))
-                return EXIT_USAGE;
-        } else if (!strcmp(o, "--free-interfaces")) {
-            a->free_interfaces = 1;
-        } else if (!strcmp(o, "--param")) {
-            if (!(v = value(argc, argv, &i)) || set_param(&a->params, v) != 0)
-                return EXIT_USAGE;
-        } else if (!strcmp(o, "--report")) {
-            if (!(a->report = value(argc, argv, &i)))
-                return EXIT_USAGE;
-        } else if (!strcmp(o, "-q") || !strcmp(o, "--quiet")) {
-            a->log.quiet = 1;
-        } else if (!strcmp(o, "-v") || !strcmp(o, "--verbose")) {
-            a->log.verbose = 1;
+            a->output = argv[++i];
         } else if (o[0] == '-' && o[1]) {
             cli_error("unknown option '%s' (see getme smooth --help)", o);
             return EXIT_USAGE;
@@ -192,17 +76,12 @@ static int parse(int argc, char **argv, smooth_args *a)
 
 static int run(smooth_args *a)
 {
-    const cli_log *log = &a->log;
+    cli_smooth_opts *so = &a->o;
+    const cli_log *log = &so->log;
     getme_doc_options opts;
-    getme_doc_options_init(&opts);
-    opts.fix = a->fix;
-    opts.num_fix = a->num_fix;
-    opts.free_sets = a->free_sets;
-    opts.num_free = a->num_free;
-    opts.fix_interfaces = !a->free_interfaces;
-    opts.verbose = log->verbose;
+    cli_smooth_doc_options(so, &opts);
 
-    cli_paths paths = {a->input, a->output, a->report, "", ""};
+    cli_paths paths = {a->input, a->output, so->report, "", ""};
     int code = cli_check_paths(&paths);
     if (code)
         return code;
@@ -225,36 +104,17 @@ static int run(smooth_args *a)
 
     getme_quality_stats before = doc->stats, after;
     cli_print_stats(log, "Quality before", &before);
-
-    cli_history history = {0};
-    progress_state ps = {log, &history};
-    a->params.progress = on_progress;
-    a->params.progress_data = &ps;
-    /* Gmsh's initialisation sets OpenMP's global thread count to 1, so
-       "default" must be decided here: OMP_NUM_THREADS if set, else every
-       core. */
-    if (!a->params.num_threads) {
-        const char *env = getenv("OMP_NUM_THREADS");
-        int n = env ? atoi(env) : 0;
-        a->params.num_threads = n > 0 ? n : omp_get_num_procs();
-    }
-    int threads = a->params.num_threads;
-    cli_info(log, "Optimizing mesh (%s, %d thread%s)...",
-             a->params.method == GETME_METHOD_ADAPTIVE ? "GETMe adaptive"
-                                                       : "smart Laplace",
-             threads, threads == 1 ? "" : "s");
+    cli_smooth_begin(so, NULL);
     getme_result res;
-    getme_status st = getme_smooth(mesh, &a->params, &res);
+    getme_status st = getme_smooth(mesh, &so->params, &res);
     if (st != GETME_OK) {
         cli_error("%s: %s", a->input, getme_mesh_error(mesh));
         code = st == GETME_ERR_INVALID_MESH ? GETME_IO_ERR_INVALID
                                             : GETME_IO_ERR_INTERNAL;
-        goto out;
+        getme_doc_close(doc);
+        return code;
     }
-    cli_info(log, "Done optimizing mesh (Wall %.3fs): %d + %d iterations "
-                  "(%d q*min cycles)",
-             res.seconds, res.iterations_mean, res.iterations_min,
-             res.cycles_min);
+    cli_smooth_done(so, &res);
     getme_mesh_quality_stats(mesh, -1, &after);
     cli_print_stats(log, "Quality after ", &after);
 
@@ -267,18 +127,18 @@ static int run(smooth_args *a)
         code = ios;
     } else {
         cli_info(log, "Done writing '%s'", a->output);
-        if (a->report &&
-            cli_write_report(paths.rep, a->input, a->output, &a->params, mesh,
-                             &before, &after, &res, &history,
+        cli_mesh_counts counts;
+        cli_count_mesh(mesh, &counts);
+        if (so->report &&
+            cli_write_report(paths.rep, a->input, a->output, &so->params,
+                             &counts, &before, &after, &res, &so->history,
                              doc->format->name) != 0) {
-            cli_error("%s: cannot write the report: %s", a->report,
+            cli_error("%s: cannot write the report: %s", so->report,
                       strerror(errno));
             code = GETME_IO_ERR_WRITE;
         }
     }
     cli_write_guard(&guard, 0);
-out:
-    free(history.items);
     getme_doc_close(doc);
     return code;
 }
@@ -292,7 +152,6 @@ int cli_smooth(int argc, char **argv)
         code = run(&a);
     else if (code < 0)
         code = 0; /* --help */
-    free(a.fix);
-    free(a.free_sets);
+    cli_smooth_opts_free(&a.o);
     return code;
 }

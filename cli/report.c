@@ -51,8 +51,17 @@ static const char *stop_name(getme_stop_reason r)
     return "unknown";
 }
 
+void cli_count_mesh(getme_mesh *mesh, cli_mesh_counts *c)
+{
+    c->nodes = getme_mesh_num_nodes(mesh);
+    c->fixed = getme_mesh_num_fixed(mesh);
+    for (int t = 0; t < GETME_NUM_TYPES; t++)
+        c->elements[t] =
+            getme_mesh_num_elements_of_type(mesh, (getme_elem_type)t);
+}
+
 int cli_write_report(const char *path, const char *input, const char *output,
-                     const getme_params *p, getme_mesh *mesh,
+                     const getme_params *p, const cli_mesh_counts *mesh,
                      const getme_quality_stats *before,
                      const getme_quality_stats *after, const getme_result *r,
                      const cli_history *h, const char *format_name)
@@ -82,10 +91,10 @@ int cli_write_report(const char *path, const char *input, const char *output,
             p->max_iter, p->tol, p->sigma, p->threshold_fraction,
             p->max_no_min_improve, p->min_tol, p->keep_best, p->num_threads, p->renumber);
     fprintf(f, "  \"nodes\": %d,\n  \"fixed_nodes\": %d,\n  \"elements\": {",
-            (int)getme_mesh_num_nodes(mesh), (int)getme_mesh_num_fixed(mesh));
+            (int)mesh->nodes, (int)mesh->fixed);
     int first = 1;
     for (int t = 0; t < GETME_NUM_TYPES; t++) {
-        int32_t n = getme_mesh_num_elements_of_type(mesh, (getme_elem_type)t);
+        int32_t n = mesh->elements[t];
         if (!n)
             continue;
         fprintf(f, "%s\"%s\": %d", first ? "" : ", ",

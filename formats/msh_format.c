@@ -400,35 +400,12 @@ static getme_io_status check_model_coords(getme_doc *doc)
 static getme_io_status check_free_names(getme_doc *doc,
                                         const getme_doc_options *opts)
 {
-    int *groups = NULL, ierr = 0;
-    size_t ng = 0;
-    if (!opts || opts->num_free == 0)
+    char msg[512];
+    if (!opts || opts->num_free == 0 ||
+        getme_gmsh_check_groups(opts->free_sets, opts->num_free, "free", msg,
+                                sizeof msg) == GETME_OK)
         return GETME_IO_OK;
-    gmshModelGetPhysicalGroups(&groups, &ng, -1, &ierr);
-    getme_io_status st = GETME_IO_OK;
-    for (int w = 0; w < opts->num_free && st == GETME_IO_OK; w++) {
-        const char *word = opts->free_sets[w];
-        int dim, tag, used = 0, found = 0;
-        int by_tag = sscanf(word, "%d:%d%n", &dim, &tag, &used) == 2 &&
-                     word[used] == 0;
-        for (size_t i = 0; i + 1 < ng && !found; i += 2) {
-            char *name = NULL;
-            if (by_tag)
-                found = groups[i] == dim && groups[i + 1] == tag;
-            else {
-                gmshModelGetPhysicalName(groups[i], groups[i + 1], &name,
-                                         &ierr);
-                found = name && strcmp(name, word) == 0;
-                gmshFree(name);
-            }
-        }
-        if (!found)
-            st = getme_doc_fail(doc, GETME_IO_ERR_USAGE,
-                                "'%s': Unknown physical group '%s' to free",
-                                doc->path, word);
-    }
-    gmshFree(groups);
-    return st;
+    return getme_doc_fail(doc, GETME_IO_ERR_USAGE, "'%s': %s", doc->path, msg);
 }
 
 static int model_exists(const char *name)
