@@ -36,11 +36,7 @@ static int identify(const char *path, file_id *id)
     }
     const char *slash = strrchr(path, '/');
     char dir[4096];
-    if (!slash)
-        snprintf(dir, sizeof dir, ".");
-    else
-        snprintf(dir, sizeof dir, "%.*s", slash == path ? 1 : (int)(slash - path),
-                 path);
+    getme_io_dirname(path, dir, sizeof dir);
     id->name = slash ? slash + 1 : path;
     if (stat(dir, &sb) != 0)
         return -1;

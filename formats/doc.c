@@ -215,6 +215,16 @@ void getme_doc_close(getme_doc *doc)
     free(doc);
 }
 
+void getme_io_dirname(const char *path, char *buf, size_t size)
+{
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        snprintf(buf, size, ".");
+    else
+        snprintf(buf, size, "%.*s", slash == path ? 1 : (int)(slash - path),
+                 path);
+}
+
 /* "<dir>/.<base>.getme-tmp.<pid>.<n>" (the Gmsh path appends ".msh"). */
 static const char TMP_TAG[] = ".getme-tmp.";
 
@@ -243,12 +253,10 @@ static long stale_tmp(const char *name, const char *base, size_t blen)
 }
 
 /* Remove the temporary files a killed getme left next to out_path. */
-static void remove_stale_tmps(const char *out_path, int dirlen,
-                              const char *base)
+static void remove_stale_tmps(const char *out_path, const char *base)
 {
     char dir[4096], path[4096 + 256];
-    snprintf(dir, sizeof dir, "%.*s", dirlen ? dirlen : 1,
-             dirlen ? out_path : ".");
+    getme_io_dirname(out_path, dir, sizeof dir);
     DIR *d = opendir(dir);
     if (!d)
         return;
@@ -275,7 +283,7 @@ int getme_io_tmp_path(const char *out_path, char *buf, size_t size)
     const char *slash = strrchr(out_path, '/');
     int dirlen = slash ? (int)(slash - out_path) + 1 : 0;
     const char *base = slash ? slash + 1 : out_path;
-    remove_stale_tmps(out_path, dirlen, base);
+    remove_stale_tmps(out_path, base);
     struct timespec ts;
     clock_gettime(CLOCK_REALTIME, &ts);
     for (unsigned attempt = 0; attempt < 100; attempt++) {
@@ -359,13 +367,8 @@ getme_io_status getme_io_output_path(const char *out_path, char *buf,
                  out_path, kind_of(sb.st_mode));
         return GETME_IO_ERR_USAGE;
     }
-    const char *slash = strrchr(buf, '/');
     char dir[4096];
-    if (!slash)
-        snprintf(dir, sizeof dir, ".");
-    else
-        snprintf(dir, sizeof dir, "%.*s", slash == buf ? 1 : (int)(slash - buf),
-                 buf);
+    getme_io_dirname(buf, dir, sizeof dir);
     if (stat(dir, &sb) != 0 || !S_ISDIR(sb.st_mode) ||
         access(dir, W_OK | X_OK) != 0) {
         int e = errno;

@@ -243,43 +243,39 @@ static getme_io_status scan_count(scan *s, const char *section, long *count)
     return GETME_IO_OK;
 }
 
-static getme_io_status scan_nodes(scan *s)
+/* Entry i of the n that $section declares: its line in s->line. */
+static getme_io_status scan_entry(scan *s, const char *section, long n)
 {
-    long n;
-    getme_io_status st = scan_count(s, "Nodes", &n);
-    for (long i = 0; st == GETME_IO_OK && i < n; i++) {
-        double v[4];
-        int bad;
-        if (scan_line(s) != 0)
-            return scan_eof(s, "Nodes");
-        if (s->line[0] == '$')
-            return scan_fail(s, "$Nodes declares %ld nodes, it has fewer", n);
-        if (fields(s->line, v, 4, &bad) != 4 || bad)
-            return scan_fail(s, "bad node line '%s' (want: tag x y z)",
-                             s->line);
-        if (!isfinite(v[1]) || !isfinite(v[2]) || !isfinite(v[3]))
-            return scan_fail(s, "node %ld has a coordinate that is not a "
-                                "finite number", (long)v[0]);
-    }
-    return st;
+    if (scan_line(s) != 0)
+        return scan_eof(s, section);
+    if (s->line[0] == '$')
+        return scan_fail(s, "$%s declares %ld entries, it has fewer",
+                         section, n);
+    return GETME_IO_OK;
 }
 
-static getme_io_status scan_elements(scan *s)
+/* The lines of $Nodes ("tag x y z") or $Elements ("tag type ntags tags...
+   nodes..."). */
+static getme_io_status scan_entries(scan *s, int nodes)
 {
-    long n;
-    getme_io_status st = scan_count(s, "Elements", &n);
+    const char *section = nodes ? "Nodes" : "Elements";
+    long n = 0;
+    getme_io_status st = scan_count(s, section, &n);
     for (long i = 0; st == GETME_IO_OK && i < n; i++) {
         double v[64];
         int bad;
-        if (scan_line(s) != 0)
-            return scan_eof(s, "Elements");
-        if (s->line[0] == '$')
-            return scan_fail(s, "$Elements declares %ld elements, it has "
-                                "fewer", n);
+        if ((st = scan_entry(s, section, n)) != GETME_IO_OK)
+            return st;
         int nf = fields(s->line, v, 64, &bad);
-        int nv = nf >= 3 ? msh41_type_nodes((int)v[1], NULL) : 0;
-        if (bad || nf < 3 || v[2] < 0 ||
-            (nv > 0 && nf != 3 + (int)v[2] + nv))
+        if (nodes && (nf != 4 || bad))
+            return scan_fail(s, "bad node line '%s' (want: tag x y z)",
+                             s->line);
+        if (nodes && (!isfinite(v[1]) || !isfinite(v[2]) || !isfinite(v[3])))
+            return scan_fail(s, "node %ld has a coordinate that is not a "
+                                "finite number", (long)v[0]);
+        int nv = !nodes && nf >= 3 ? msh41_type_nodes((int)v[1], NULL) : 0;
+        if (!nodes && (bad || nf < 3 || v[2] < 0 ||
+                       (nv > 0 && nf != 3 + (int)v[2] + nv)))
             return scan_fail(s, "bad element line '%s' (want: tag type "
                                 "number-of-tags tags... nodes...)",
                              s->line);
@@ -343,11 +339,8 @@ static getme_io_status check_msh_file(getme_doc *doc, const msh_impl *impl)
             st = scan_fail(&s, "%s without its section", s.line);
             break;
         }
-        if (strcmp(section, "Nodes") == 0 || strcmp(section, "NOD") == 0)
-            st = scan_nodes(&s);
-        else if (strcmp(section, "Elements") == 0 ||
-                 strcmp(section, "ELM") == 0)
-            st = scan_elements(&s);
+        if (strcmp(section, "Nodes") == 0 || strcmp(section, "Elements") == 0)
+            st = scan_entries(&s, section[0] == 'N');
         /* up to the closing line */
         while (st == GETME_IO_OK) {
             if (scan_line(&s) != 0) {

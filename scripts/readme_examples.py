@@ -67,20 +67,12 @@ def cgns_table():
     return ["| | q*min | qmean | q <= 0.4 | q < 0.1 |", "|---|---|---|---|---|"] + rows
 
 
-PART_GEO = """SetFactory("OpenCASCADE");
-Box(1) = {0, 0, 0, 2, 1, 1};
-Cylinder(2) = {1, 0.5, -0.2, 0, 0, 1.4, 0.3};
-BooleanFragments{ Volume{1}; Delete; }{ Volume{2}; Delete; }
-Physical Volume("matrix") = {3};
-Physical Volume("insert") = {2};
-Physical Surface("clamp") = {1};
-"""
 
 
 def gmsh_run():
-    """docs/gmsh.md: `getme gmsh part.geo -3 -clmax 0.1 --fix clamp`, shortened."""
-    geo = os.path.join(WORK, "part.geo")
-    open(geo, "w").write(PART_GEO)
+    """docs/gmsh.md: `getme gmsh examples/part.geo -3 -clmax 0.1 --fix clamp`,
+    shortened."""
+    shutil.copy(os.path.join(ROOT, "examples", "part.geo"), WORK)
     p = subprocess.run([GETME, "gmsh", "part.geo", "-3", "-clmax", "0.1", "--fix", "clamp",
                         "--threads", "2"], capture_output=True, text=True, cwd=WORK, env=ENV)
     if p.returncode != 0:

@@ -161,6 +161,8 @@ int getme_io_commit(const char *tmp, const char *out);
    writable.  msg gets the one-line reason, naming out_path. */
 getme_io_status getme_io_output_path(const char *out_path, char *buf,
                                      size_t size, char *msg, size_t msg_size);
+/* The directory part of path ("." if none, "/" for "/x"), into buf. */
+void getme_io_dirname(const char *path, char *buf, size_t size);
 /* 1 if a and b name the same existing file (used to refuse -o == input). */
 int getme_io_same_file(const char *a, const char *b);
 

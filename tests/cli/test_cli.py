@@ -23,25 +23,11 @@ import numpy as np
 
 GETME, WORK, CASE = sys.argv[1], sys.argv[2], sys.argv[3]
 os.makedirs(WORK, exist_ok=True)
-failures = []
-passed = 0
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402
 
-
-def check(cond, what):
-    global passed
-    if cond:
-        passed += 1
-    else:
-        failures.append(what)
-        print("FAILED:", what, flush=True)
-
-
-def run(*args, expect=0):
-    p = subprocess.run([GETME, *args], capture_output=True, text=True)
-    if p.returncode != expect:
-        print(p.stdout[-3000:], p.stderr[-3000:])
-    check(p.returncode == expect, f"getme {' '.join(args)} -> {p.returncode}, want {expect}")
-    return p
+T = Checks(GETME)
+check, run = T.check, T.run
 
 
 # ---- independent mean ratio: bench/quality.py (numpy, DESIGN.md §2, written
@@ -235,5 +221,4 @@ if CASE == "errors":
     errors_case()
 else:
     mesh_case(CASE)
-print(f"{passed} passed, {len(failures)} failed")
-sys.exit(1 if failures else 0)
+sys.exit(T.summary())

@@ -29,27 +29,15 @@ import gmsh
 GETME, WORK, CASE = sys.argv[1], os.path.abspath(sys.argv[2]), sys.argv[3]
 shutil.rmtree(WORK, ignore_errors=True)
 os.makedirs(WORK)
-failures = []
-passed = 0
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402
 
-
-def check(cond, what):
-    global passed
-    if cond:
-        passed += 1
-    else:
-        failures.append(what)
-        print("FAILED:", what, flush=True)
+T = Checks(GETME)
+check = T.check
 
 
 def run(*args, expect=0, cwd=None):
-    p = subprocess.run([GETME, *args], capture_output=True, text=True, cwd=cwd,
-                       timeout=300)
-    if p.returncode != expect:
-        print(p.stdout[-3000:], p.stderr[-3000:])
-    check(p.returncode == expect,
-          f"getme {' '.join(args)} -> {p.returncode}, want {expect}")
-    return p
+    return T.run(*args, expect=expect, cwd=cwd, timeout=300)
 
 
 def sha(path):
@@ -547,5 +535,4 @@ def usability_case():
 
 CASES = {"paths": paths_case, "damage": damage_case, "usability": usability_case}
 CASES[CASE]()
-print(f"{passed} passed, {len(failures)} failed")
-sys.exit(1 if failures else 0)
+sys.exit(T.summary())

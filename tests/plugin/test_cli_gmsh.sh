@@ -8,15 +8,8 @@ PY=$2
 fail=0
 ok() { echo "ok: $*"; }
 bad() { echo "FAILED: $*"; fail=1; }
-cat > part.geo <<'GEO'
-SetFactory("OpenCASCADE");
-Box(1) = {0, 0, 0, 2, 1, 1};
-Cylinder(2) = {1, 0.5, -0.2, 0, 0, 1.4, 0.3};
-BooleanFragments{ Volume{1}; Delete; }{ Volume{2}; Delete; }
-Physical Volume("matrix") = {3};
-Physical Volume("insert") = {2};
-Physical Surface("clamp") = {1};
-GEO
+here=$(cd "$(dirname "$0")" && pwd)
+cp "$here/../../examples/part.geo" part.geo
 rm -f part.msh part22.msh
 "$G" gmsh part.geo -3 -clmax 0.15 --fix clamp -o part.msh -v > run.log 2>&1
 rc=$?
@@ -77,7 +70,6 @@ PYEOF
 "$G" gmsh part.geo --bogus 2> err.log; rc=$?; [ $rc -eq 2 ] && grep -q "unknown option" err.log && ok "bad option: 2" || bad "bad option: $rc"
 # getme.geo: the stock gmsh runs `getme gmsh` from the .geo and loads the
 # smoothed mesh (what the GUI does when "Smooth the mesh" is ticked).
-here=$(cd "$(dirname "$0")" && pwd)
 rm -f getme_raw.msh getme_smoothed.msh
 cp "$here/../../examples/gmsh_gui/plate.geo" plate.geo
 printf 'getme_dim = 2;\ngetme_dir = CurrentDirectory;\nInclude "%s";\n' \
