@@ -541,9 +541,10 @@ static void describe(msh41_reader *r, size_t num_entities)
     int len = dot ? (int)(dot - base) : (int)strlen(base);
     getme_mesh *m = r->doc->mesh;
     snprintf(r->doc->info, sizeof r->doc->info,
-             "MSH 4.1 %s, model '%.*s': %zu %s%s, %ld elements, %ld nodes "
+             "MSH %s %s, model '%.*s': %zu %s%s, %ld elements, %ld nodes "
              "(%ld fixed)",
-             r->binary ? "binary" : "ASCII", len, base, num_entities,
+             r->v22 ? "2.2" : "4.1", r->binary ? "binary" : "ASCII", len,
+             base, num_entities,
              r->top_dim == 3 ? "volume" : "surface",
              num_entities > 1 ? "s" : "", (long)getme_mesh_num_elements(m),
              (long)getme_mesh_num_nodes(m), (long)getme_mesh_num_fixed(m));

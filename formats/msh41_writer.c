@@ -1,6 +1,7 @@
 /*
- * msh41_writer.c -- write a natively read MSH 4.1 file back: a byte-for-byte
- * copy of the input in which only node coordinates in $Nodes change.
+ * msh41_writer.c -- write a natively read MSH 4.1 or 2.2 file back: a
+ * byte-for-byte copy of the input in which only node coordinates in $Nodes
+ * change (MSH 2.2: "tag x y z" lines, or int32 tag + 3 doubles records).
  *
  * The input is streamed through msh41_input with its echo on (every byte
  * read is copied to the temporary output); inside $Nodes the echo is
@@ -204,6 +205,88 @@ static int ascii_block(writer *w)
     return rc;
 }
 
+/* ---- MSH 2.2: one node per record ---------------------------------------- */
+
+/* ASCII "tag x y z" (read raw, echo off): the coordinates rewritten after
+   the tag's own text if the node moved. */
+static int ascii_node22(writer *w)
+{
+    char line[8192], *p, *end;
+    size_t n = 0;
+    int c;
+    while ((c = msh41_in_getc(&w->in)) >= 0) {
+        if (n + 1 >= sizeof line)
+            return -1;
+        line[n++] = (char)c;
+        if (c == '\n')
+            break;
+    }
+    line[n] = 0;
+    errno = 0;
+    unsigned long long tag = strtoull(line, &p, 10);
+    if (p == line || errno)
+        return -1;
+    const char *tag_end = p;
+    double old[3];
+    for (int k = 0; k < 3; k++, p = end) {
+        old[k] = strtod(p, &end);
+        if (end == p)
+            return -1;
+    }
+    const double *x = moved(w, tag, old);
+    if (!x)
+        return fwrite(line, 1, n, w->out) == n ? 0 : -1;
+    const char *eol = n >= 2 && line[n - 2] == '\r' ? "\r\n"
+                      : n >= 1 && line[n - 1] == '\n' ? "\n"
+                                                       : "";
+    char num[3][40];
+    for (int k = 0; k < 3; k++)
+        format_double(x[k], num[k], sizeof num[k]);
+    return fwrite(line, 1, (size_t)(tag_end - line), w->out) !=
+                       (size_t)(tag_end - line) ||
+                   fprintf(w->out, " %s %s %s%s", num[0], num[1], num[2],
+                           eol) < 0
+               ? -1
+               : 0;
+}
+
+/* Binary: int32 tag + 3 doubles per node, patched in place. */
+static int bin_node22(writer *w)
+{
+    unsigned char rec[28];
+    if (msh41_in_read(&w->in, rec, sizeof rec))
+        return -1;
+    uint32_t t = (uint32_t)rec[0] | (uint32_t)rec[1] << 8 |
+                 (uint32_t)rec[2] << 16 | (uint32_t)rec[3] << 24;
+    double old[3];
+    for (int k = 0; k < 3; k++) {
+        uint64_t bits = le64(rec + 4 + 8 * k);
+        memcpy(&old[k], &bits, sizeof bits);
+    }
+    const double *x = moved(w, t, old);
+    for (int k = 0; x && k < 3; k++) {
+        uint64_t bits;
+        memcpy(&bits, &x[k], sizeof bits);
+        put_le64(rec + 4 + 8 * k, bits);
+    }
+    return fwrite(rec, 1, sizeof rec, w->out) == sizeof rec ? 0 : -1;
+}
+
+/* The count line, then the nodes (echo off while they are patched). */
+static int nodes22(writer *w)
+{
+    uint64_t count;
+    if (ascii_u64(w, &count) || !msh41_in_eol(&w->in) ||
+        count > (uint64_t)w->m->size / 8)
+        return -1;
+    msh41_in_echo(&w->in, NULL);
+    int rc = 0;
+    for (uint64_t i = 0; rc == 0 && i < count; i++)
+        rc = w->m->binary ? bin_node22(w) : ascii_node22(w);
+    msh41_in_echo(&w->in, w->out);
+    return rc;
+}
+
 /* ---- the file ----------------------------------------------------------- */
 
 /* Copy up to $Nodes, patch the node blocks, copy the rest. */
@@ -215,7 +298,9 @@ static int copy_file(writer *w)
         return -1;
     uint64_t nblocks = 0, skip;
     int rc = 0;
-    if (m->binary)
+    if (m->v22)
+        rc = nodes22(w);
+    else if (m->binary)
         rc = bin_u64(w, &nblocks) || bin_u64(w, &skip) || bin_u64(w, &skip) ||
              bin_u64(w, &skip);
     else

@@ -2,15 +2,17 @@
  * msh_format.c -- the Gmsh MSH adapter (MSH 2.2 / 4.x, ASCII or binary).
  *
  * Two readers:
- *  - MSH 4.1 (ASCII or binary) is read natively by msh41_reader.c in one
- *    streaming pass, without a Gmsh model (a Gmsh model of a 4M-tet mesh
- *    costs about 1 GiB), and written by msh41_writer.c as a copy of the
- *    input with new coordinates in $Nodes.  Fixed nodes, regions and
- *    element order are those the Gmsh path gives for the same file.
- *  - Everything else (MSH 2.2 / 4.0, and the 4.1 files the native reader
- *    declines: parametric nodes, partitioned meshes, planar meshes outside
- *    a plane z = const, element types it does not know...) goes through
- *    Gmsh's own reader via the C API and libgetme_gmsh's model extraction.
+ *  - MSH 4.1 and 2.2 (ASCII or binary) are read natively by
+ *    msh41_reader.c in one streaming pass, without a Gmsh model (a Gmsh
+ *    model of a 4M-tet mesh costs about 1 GiB), and written by
+ *    msh41_writer.c as a copy of the input with new coordinates in $Nodes.
+ *    Fixed nodes, regions and element order are those the Gmsh path gives
+ *    for the same file.
+ *  - Everything else (MSH 4.0, and the files the native reader declines:
+ *    parametric nodes, partitioned meshes, planar meshes outside a plane
+ *    z = const, element types it does not know...) goes through Gmsh's own
+ *    reader via the C API and libgetme_gmsh's model extraction, after
+ *    check_msh_file refused what Gmsh's reader would accept damaged.
  * The environment variable GETME_MSH_READER=gmsh forces the Gmsh path,
  * GETME_MSH_READER=native forces the native one (a file it declines is then
  * an error); anything else, or unset, means "native if it can".  A
@@ -553,18 +555,19 @@ static getme_io_status open_native(getme_doc *doc, msh_impl *impl,
     char why[160] = "";
     int eligible = 1;
     *done = 1;
-    if (impl->version != 4.1)
+    int native = impl->version == 4.1 || impl->version == 2.2;
+    if (!native)
         snprintf(why, sizeof why, "MSH %g", impl->version);
     getme_io_status st =
-        impl->version == 4.1
+        native
             ? msh41_open(doc, opts, &impl->native, &eligible, why, sizeof why)
             : GETME_IO_OK;
-    if (impl->version == 4.1 && eligible)
+    if (native && eligible)
         return st;
     if (choice == 'n')
         return getme_doc_fail(doc, GETME_IO_ERR_UNSUPPORTED,
-                              "'%s': the native MSH reader reads MSH 4.1 "
-                              "only, without %s (GETME_MSH_READER=native)",
+                              "'%s': the native MSH reader reads MSH 4.1 and "
+                              "2.2 only, without %s (GETME_MSH_READER=native)",
                               doc->path, why);
     *done = 0;
     return GETME_IO_OK;
@@ -828,7 +831,7 @@ static void msh_close(getme_doc *doc)
 
 const getme_format getme_format_msh = {
     "msh",
-    "Gmsh MSH 2.2/4.1, ASCII or binary (4.1 read natively, others via the "
+    "Gmsh MSH 2.2/4.1, ASCII or binary (2.2 and 4.1 read natively, others via the "
     "Gmsh SDK)",
     msh_probe,
     msh_open, msh_write, msh_close, ".msh", NULL};

@@ -321,7 +321,7 @@ def damage_case():
     extra.insert(e + 2, extra[e + 1])
     open(path("extra22.msh"), "w").write("\n".join(extra))
     refused(["smooth", path("extra22.msh"), "-o", out, "-q"], 4, [path("extra22.msh")], [out],
-            "holds more entries than it declares")
+            "holds more entries than it declares|wrong count")
 
     # an element block of an entity that does not exist (Gmsh refuses it)
     lines = open(m41).read().split("\n")
