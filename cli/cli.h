@@ -38,6 +38,28 @@ const char *cli_q_min_star(const getme_quality_stats *s, char *buf,
 void cli_print_stats(const cli_log *log, const char *title,
                      const getme_quality_stats *s);
 
+/* Per element type statistics of the analysts' measures (measures.c):
+   stats[type][measure], num_elements 0 for absent types and undefined
+   measures. */
+typedef struct cli_measures {
+    getme_measure_stats stats[GETME_NUM_TYPES][GETME_NUM_MEASURES];
+} cli_measures;
+
+/* 0 on success, -1 if the library failed (out of memory). */
+int cli_measures_compute(getme_mesh *mesh, cli_measures *m);
+/* One line per element type: "TITLE (tet): dihedral 12.34 to 160.21 deg,
+   scaled Jacobian min .. mean .., gamma ..., SICN ...". */
+void cli_print_measures(const cli_log *log, const char *title,
+                        const cli_measures *m);
+/* Compute and print; on failure warn (the statistics stay empty). */
+void cli_measures_log(const cli_log *log, getme_mesh *mesh, const char *title,
+                      cli_measures *m);
+/* Summary and 10-bin histogram of every measure but the mean ratio. */
+void cli_print_measure_histograms(const cli_log *log, const cli_measures *m,
+                                  int type);
+/* {"tet": {"mean_ratio": {...}, "min_dihedral": {...}, ...}, ...} */
+void cli_json_measures(FILE *f, const cli_measures *m);
+
 /* Parse helpers: return 0 on success, print an error and return -1. */
 int cli_parse_int(const char *opt, const char *s, long min, long max, long *out);
 int cli_parse_double(const char *opt, const char *s, double *out);
@@ -128,11 +150,35 @@ typedef struct cli_mesh_counts {
 } cli_mesh_counts;
 void cli_count_mesh(getme_mesh *mesh, cli_mesh_counts *c);
 
+/* The worst elements of a document (worst.c). */
+typedef struct cli_worst_list {
+    getme_worst_element *items;
+    int32_t count;
+} cli_worst_list;
+
+long long cli_element_tag(const getme_doc *doc, int32_t e);
+/* Fill w with the max_count worst elements; 0, or -1 after printing an
+   error.  Free w->items. */
+int cli_worst(getme_doc *doc, int32_t max_count, unsigned flags,
+              cli_worst_list *w);
+/* which: "" or " with a free node". */
+void cli_print_worst(const cli_log *log, const getme_doc *doc,
+                     const cli_worst_list *w, const char *which);
+void cli_json_worst(FILE *f, const getme_doc *doc, const cli_worst_list *w);
+
+/* More for the report: measures (smooth and gmsh), the worst elements
+   (smooth only: they need the document); NULL members are left out. */
+typedef struct cli_report_extra {
+    const getme_doc *doc;
+    const cli_worst_list *worst, *worst_free;
+    const cli_measures *measures_before, *measures_after;
+} cli_report_extra;
+
 int cli_write_report(const char *path, const char *input, const char *output,
                      const getme_params *params, const cli_mesh_counts *mesh,
                      const getme_quality_stats *before,
                      const getme_quality_stats *after,
                      const getme_result *result, const cli_history *history,
-                     const char *format_name);
+                     const char *format_name, const cli_report_extra *extra);
 
 #endif /* GETME_CLI_H */

@@ -331,6 +331,7 @@ typedef struct gmsh_result {
     getme_quality_stats before;
     getme_gmsh_report rep;
     cli_mesh_counts counts;
+    cli_measures mbefore, mafter;
 } gmsh_result;
 
 static int smooth_model(gmsh_args *a, gmsh_result *res)
@@ -360,12 +361,18 @@ static int smooth_model(gmsh_args *a, gmsh_result *res)
                               : GETME_ERR_NOMEM;
     if (st == GETME_OK) {
         res->before = rep->before;
+        memcpy(res->mbefore.stats, rep->measures_before,
+               sizeof res->mbefore.stats);
         cli_print_stats(&so->log, "Quality before", &res->before);
+        cli_print_measures(&so->log, "Measures before", &res->mbefore);
         cli_smooth_begin(so, getme_gmsh_options_params(opt));
         st = getme_gmsh_optimize(0, NULL, 0, opt, rep);
         if (st == GETME_OK) {
             cli_smooth_done(so, &rep->result);
             cli_print_stats(&so->log, "Quality after ", &rep->after);
+            memcpy(res->mafter.stats, rep->measures_after,
+                   sizeof res->mafter.stats);
+            cli_print_measures(&so->log, "Measures after ", &res->mafter);
             count_model(rep->dim, rep, &res->counts);
         }
     }
@@ -412,7 +419,9 @@ static int run(gmsh_args *a)
     if (rc == 0 && a->o.report &&
         cli_write_report(paths.rep, a->input, out, &a->o.params, &res.counts,
                          &res.before, &res.rep.after, &res.rep.result,
-                         &a->o.history, "gmsh") != 0) {
+                         &a->o.history, "gmsh",
+                         &(cli_report_extra){NULL, NULL, NULL, &res.mbefore,
+                                             &res.mafter}) != 0) {
         cli_error("%s: cannot write the report: %s", a->o.report,
                   strerror(errno));
         rc = GETME_IO_ERR_WRITE;

@@ -11,7 +11,10 @@ static const char QUALITY_HELP[] =
     "\n"
     "Print the mean ratio quality of the mesh in IN per element type: q*min\n"
     "(worst element with a free node), qmin, qmean, and a histogram like\n"
-    "Gmsh's. Exit code 6 if the mesh has invalid (inverted) elements.\n";
+    "Gmsh's; then, per element type, min, max, mean and a histogram of the\n"
+    "min and max dihedral angle (planar: corner angles), the scaled\n"
+    "Jacobian (Verdict/CUBIT), Gmsh's gamma and SICN (docs/quality.md).\n"
+    "Exit code 6 if the mesh has invalid (inverted) elements.\n";
 
 static void print_type(const cli_log *log, getme_mesh *mesh, int type)
 {
@@ -81,9 +84,16 @@ int cli_quality(int argc, char **argv)
     cli_describe_mesh(mesh, desc, sizeof desc);
     cli_info(&log, "%s (%s): %s", input, doc->format->name, desc);
     int types = 0;
+    cli_measures measures;
+    if (cli_measures_compute(mesh, &measures) != 0) {
+        cli_error("%s: %s", input, getme_mesh_error(mesh));
+        getme_doc_close(doc);
+        return GETME_IO_ERR_INTERNAL;
+    }
     for (int t = 0; t < GETME_NUM_TYPES; t++)
         if (getme_mesh_num_elements_of_type(mesh, (getme_elem_type)t)) {
             print_type(&log, mesh, t);
+            cli_print_measure_histograms(&log, &measures, t);
             types++;
         }
     if (types > 1)

@@ -21,7 +21,10 @@ static const char SMOOTH_HELP_HEAD[] =
     "\n"
     "options:\n"
     "  -o, --output FILE      output file (required; the input's format and\n"
-    "                         extension; a regular file or a new one)\n";
+    "                         extension; a regular file or a new one)\n"
+    "  --worst N              list the N worst elements after smoothing and\n"
+    "                         why each stays bad (default 10; printed with -v,\n"
+    "                         always in --report)\n";
 
 static const char SMOOTH_HELP_TAIL[] =
     "\n"
@@ -31,11 +34,13 @@ static const char SMOOTH_HELP_TAIL[] =
 
 typedef struct smooth_args {
     const char *input, *output;
+    long worst;
     cli_smooth_opts o;
 } smooth_args;
 
 static int parse(int argc, char **argv, smooth_args *a)
 {
+    a->worst = 10;
     if (cli_smooth_opts_init(&a->o, argc) != 0)
         return 1;
     for (int i = 1; i < argc; i++) {
@@ -50,12 +55,16 @@ static int parse(int argc, char **argv, smooth_args *a)
             fputs(CLI_SMOOTH_OPTIONS_HELP, stdout);
             fputs(SMOOTH_HELP_TAIL, stdout);
             return -1;
-        } else if (!strcmp(o, "-o") || !strcmp(o, "--output")) {
+        } else if (!strcmp(o, "-o") || !strcmp(o, "--output") ||
+                   !strcmp(o, "--worst")) {
             if (i + 1 >= argc) {
                 cli_error("%s needs a value (see getme smooth --help)", o);
                 return EXIT_USAGE;
             }
-            a->output = argv[++i];
+            if (o[2] != 'w')
+                a->output = argv[++i];
+            else if (cli_parse_int(o, argv[++i], 0, 1000000, &a->worst) != 0)
+                return EXIT_USAGE;
         } else if (o[0] == '-' && o[1]) {
             cli_error("unknown option '%s' (see getme smooth --help)", o);
             return EXIT_USAGE;
@@ -104,6 +113,9 @@ static int run(smooth_args *a)
 
     getme_quality_stats before = doc->stats, after;
     cli_print_stats(log, "Quality before", &before);
+    cli_measures mbefore, mafter;
+    cli_measures_log(log, mesh, "Measures before", &mbefore);
+    cli_worst_list worst = {0}, worst_free = {0};
     cli_smooth_begin(so, NULL);
     getme_result res;
     getme_status st = getme_smooth(mesh, &so->params, &res);
@@ -111,12 +123,33 @@ static int run(smooth_args *a)
         cli_error("%s: %s", a->input, getme_mesh_error(mesh));
         code = st == GETME_ERR_INVALID_MESH ? GETME_IO_ERR_INVALID
                                             : GETME_IO_ERR_INTERNAL;
-        getme_doc_close(doc);
-        return code;
+        goto out;
     }
     cli_smooth_done(so, &res);
     getme_mesh_quality_stats(mesh, -1, &after);
     cli_print_stats(log, "Quality after ", &after);
+    cli_measures_log(log, mesh, "Measures after ", &mafter);
+    if (res.corner_sj_initial < 1.0 || res.corner_sj < 1.0)
+        cli_info(log, "Worst corner scaled Jacobian (hex, prism, pyramid, "
+                      "quad): %.4f before, %.4f after",
+                 res.corner_sj_initial, res.corner_sj);
+    if (cli_worst(doc, (int32_t)a->worst, 0, &worst) != 0 ||
+        cli_worst(doc, (int32_t)a->worst, GETME_WORST_FREE_ONLY,
+                  &worst_free) != 0) {
+        code = GETME_IO_ERR_INTERNAL;
+        goto out;
+    }
+    int fixed_worst = after.num_free > 0 && after.q_min < after.q_min_star;
+    if (fixed_worst)
+        cli_warning(log, "qmin %.4f is below q*min %.4f: the worst elements "
+                         "have no free node, no node move can fix them "
+                         "(see --worst, -v)",
+                    after.q_min, after.q_min_star);
+    if (log->verbose) {
+        cli_print_worst(log, doc, &worst, "");
+        if (fixed_worst)
+            cli_print_worst(log, doc, &worst_free, " with a free node");
+    }
 
     cli_info(log, "Writing '%s'...", a->output);
     cli_guard guard = {0};
@@ -129,16 +162,21 @@ static int run(smooth_args *a)
         cli_info(log, "Done writing '%s'", a->output);
         cli_mesh_counts counts;
         cli_count_mesh(mesh, &counts);
+        cli_report_extra extra = {doc, &worst, &worst_free, &mbefore,
+                                  &mafter};
         if (so->report &&
             cli_write_report(paths.rep, a->input, a->output, &so->params,
                              &counts, &before, &after, &res, &so->history,
-                             doc->format->name) != 0) {
+                             doc->format->name, &extra) != 0) {
             cli_error("%s: cannot write the report: %s", so->report,
                       strerror(errno));
             code = GETME_IO_ERR_WRITE;
         }
     }
     cli_write_guard(&guard, 0);
+out:
+    free(worst.items);
+    free(worst_free.items);
     getme_doc_close(doc);
     return code;
 }

@@ -64,7 +64,8 @@ int cli_write_report(const char *path, const char *input, const char *output,
                      const getme_params *p, const cli_mesh_counts *mesh,
                      const getme_quality_stats *before,
                      const getme_quality_stats *after, const getme_result *r,
-                     const cli_history *h, const char *format_name)
+                     const cli_history *h, const char *format_name,
+                     const cli_report_extra *x)
 {
     /* Through a temporary file next to it and a rename, like the mesh. */
     char tmp[4200];
@@ -87,9 +88,13 @@ int cli_write_report(const char *path, const char *input, const char *output,
             p->method == GETME_METHOD_ADAPTIVE ? "getme" : "laplace");
     fprintf(f, "  \"params\": {\"max_iter\": %d, \"tol\": %.17g, \"sigma\": %.17g, "
                "\"threshold_fraction\": %.17g, \"max_no_min_improve\": %d, \"min_tol\": %.17g, "
-               "\"keep_best\": %d, \"num_threads\": %d, \"renumber\": %d},\n",
+               "\"keep_best\": %d, \"finish\": %d, \"finish_fraction\": %.17g, "
+               "\"finish_max_passes\": %d, \"corner_guard\": %d, "
+               "\"corner_floor\": %.17g, \"num_threads\": %d, \"renumber\": %d},\n",
             p->max_iter, p->tol, p->sigma, p->threshold_fraction,
-            p->max_no_min_improve, p->min_tol, p->keep_best, p->num_threads, p->renumber);
+            p->max_no_min_improve, p->min_tol, p->keep_best, p->finish,
+            p->finish_fraction, p->finish_max_passes, p->corner_guard,
+            p->corner_floor, p->num_threads, p->renumber);
     fprintf(f, "  \"nodes\": %d,\n  \"fixed_nodes\": %d,\n  \"elements\": {",
             (int)mesh->nodes, (int)mesh->fixed);
     int first = 1;
@@ -105,9 +110,27 @@ int cli_write_report(const char *path, const char *input, const char *output,
     json_stats(f, before);
     fputs(",\n  \"after\": ", f);
     json_stats(f, after);
+    if (x && x->measures_before && x->measures_after) {
+        fputs(",\n  \"measures\": {\"before\": ", f);
+        cli_json_measures(f, x->measures_before);
+        fputs(",\n    \"after\": ", f);
+        cli_json_measures(f, x->measures_after);
+        fputc('}', f);
+    }
     fprintf(f, ",\n  \"iterations\": {\"total\": %d, \"mean_stage\": %d, "
-               "\"min_stage\": %d, \"min_cycles\": %d},\n",
-            r->iterations, r->iterations_mean, r->iterations_min, r->cycles_min);
+               "\"min_stage\": %d, \"min_cycles\": %d, \"finish_passes\": %d, "
+               "\"finish_improved\": %d},\n",
+            r->iterations, r->iterations_mean, r->iterations_min, r->cycles_min,
+            r->passes_finish, (int)r->moved_finish);
+    fprintf(f, "  \"corner_sj\": {\"before\": %.17g, \"after\": %.17g},\n",
+            r->corner_sj_initial, r->corner_sj);
+    if (x && x->doc && x->worst && x->worst_free) {
+        fputs("  \"worst_elements\": ", f);
+        cli_json_worst(f, x->doc, x->worst);
+        fputs(",\n  \"worst_free_elements\": ", f);
+        cli_json_worst(f, x->doc, x->worst_free);
+        fputs(",\n", f);
+    }
     fprintf(f, "  \"seconds\": %.6f,\n  \"stop_reason\": \"%s\",\n",
             r->seconds, stop_name(r->stop_reason));
     fputs("  \"history\": [", f);

@@ -22,9 +22,16 @@ const char CLI_SMOOTH_OPTIONS_HELP[] =
     "  --free-interfaces      let nodes on region interfaces move\n"
     "  --param NAME=VALUE     any smoothing parameter: sigma (1.5), tol (1e-4),\n"
     "                         threshold_fraction (0.005), max_no_min_improve (5),\n"
-    "                         keep_best (1), renumber (1)\n"
-    "  --report FILE.json     write before/after statistics, iterations and\n"
-    "                         the per-iteration history as JSON\n"
+    "                         min_tol (1e-5), keep_best (1), renumber (1),\n"
+    "                         finish (1: finishing step after the q*min stage;\n"
+    "                         0: the paper's GETMe adaptive alone),\n"
+    "                         finish_fraction (0.001), finish_max_passes (100),\n"
+    "                         corner_guard (1: no hex/prism/pyramid/quad corner\n"
+    "                         ends below max(input's worst, corner_floor)),\n"
+    "                         corner_floor (0)\n"
+    "  --report FILE.json     write before/after statistics, iterations,\n"
+    "                         the worst elements (smooth) and the\n"
+    "                         per-iteration history as JSON\n"
     "  -q, --quiet            print errors only\n"
     "  -v, --verbose          print the quality histograms\n";
 
@@ -150,7 +157,13 @@ static int on_progress(const getme_progress *p, void *data)
     const char *stage = p->stage == GETME_STAGE_MEAN  ? "qmean stage"
                         : p->stage == GETME_STAGE_MIN ? "q*min stage"
                                                       : "smart Laplace";
-    if (p->stage == GETME_STAGE_MIN)
+    if (p->stage == GETME_STAGE_FINISH)
+        cli_info(&o->log, "Finishing pass %d: q*min %.4f, qmean %.4f, %d "
+                          "elements below %.4f worked on, %d raised (%.2f s)",
+                 p->iteration, p->q_min_star, p->q_mean,
+                 (int)p->num_transformed, p->threshold, (int)p->num_relaxed,
+                 p->elapsed);
+    else if (p->stage == GETME_STAGE_MIN)
         cli_info(&o->log, "It %4d (%s, cycle %d, q_t %.4f): q*min %.4f, "
                           "qmean %.4f, %d transformed, %d relaxed (%.2f s)",
                  p->iteration, stage, p->cycle, p->threshold, p->q_min_star,

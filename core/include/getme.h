@@ -230,6 +230,198 @@ GETME_API getme_status getme_mesh_quality_stats(getme_mesh *mesh, int type,
 GETME_API getme_status getme_mesh_element_qualities(getme_mesh *mesh,
                                                     double *q);
 
+/* ---- the worst elements and why they stay bad -------------------------- */
+
+typedef enum getme_worst_reason {
+    GETME_WORST_IMPROVABLE = 0,   /* a node move that raises it exists: the
+                                     smoother stopped on its limits          */
+    GETME_WORST_ALL_FIXED = 1,    /* every node fixed (skin, fixed sets): no
+                                     node move can change it; a topological
+                                     optimiser (Gmsh's optimize) can         */
+    GETME_WORST_INTERFACE = 2,    /* every node fixed, some only because they
+                                     lie on a region interface (freeing
+                                     interfaces would let it move)          */
+    GETME_WORST_LOCAL_OPTIMUM = 3 /* each free node, and all of them
+                                     together, at a local optimum: no small
+                                     move raises the worst quality of the
+                                     elements around them                   */
+} getme_worst_reason;
+
+typedef struct getme_worst_element {
+    int32_t element;          /* caller's element index                     */
+    getme_elem_type type;
+    double quality;           /* mean ratio                                  */
+    double corner_sj;         /* worst corner scaled Jacobian (hex, prism,
+                                 pyramid, quad; 1 for tets and triangles)    */
+    int num_nodes, num_free;  /* its nodes, and how many are free            */
+    getme_worst_reason reason;
+} getme_worst_element;
+
+/* Flags of getme_mesh_worst_elements(). */
+enum {
+    GETME_WORST_FREE_ONLY = 1 /* only elements with at least one free node */
+};
+
+/*
+ * The max_count elements of lowest quality (ties by index), worst first,
+ * into out[0..*count), each with the reason it cannot improve further
+ * (getme_worst_reason): all elements, or with GETME_WORST_FREE_ONLY only
+ * those with a free node (the ones behind q*_min).  The probes move no
+ * node: the mesh is unchanged bit for bit.
+ */
+GETME_API getme_status getme_mesh_worst_elements(getme_mesh *mesh,
+                                                 int32_t max_count,
+                                                 unsigned flags,
+                                                 getme_worst_element *out,
+                                                 int32_t *count);
+
+/* A static English description of a reason ("all nodes fixed", ...). */
+GETME_API const char *getme_worst_reason_string(getme_worst_reason reason);
+
+/* ------------------------------------------------------------------------ */
+/* Quality measures for analysts (docs/quality.md)                          */
+/* ------------------------------------------------------------------------ */
+
+/*
+ * The shape measures FE analysts read, besides the smoother's own mean
+ * ratio.  Corners are the node simplices of getme_element_quality(): hex
+ * every node with its 3 edge neighbours, prism every node with its 2
+ * triangle neighbours and its vertical edge, pyramid the 4 base nodes with
+ * their 2 base neighbours and the apex, quad every node with its 2
+ * neighbours.  Planar types use x and y only and are oriented
+ * counter-clockwise in the xy plane (mesh statistics use the mesh's
+ * orientation, see getme.h conventions).
+ *
+ *  MEAN_RATIO       getme_element_quality(): (0, 1], 1 regular, 0 invalid.
+ *  MIN_DIHEDRAL,    degrees.  3-D: the interior angle between the two faces
+ *  MAX_DIHEDRAL     at each edge, measured at both ends of the edge (faces
+ *                   may be non-planar: at end a the half-planes through the
+ *                   edge and a's neighbour in each face), in [0, 180];
+ *                   regular tet 70.5288, hex 90, prism 60/90, pyramid
+ *                   54.7356/109.4712.  2-D: the interior angle at each
+ *                   corner, in [0, 360) (> 180 at a reflex corner).
+ *                   Unsigned: an inverted tet has the angles of its mirror
+ *                   image.
+ *  SCALED_JACOBIAN  Verdict / CUBIT corner-based, signed (never clamped at
+ *                   0), 1 for the regular element:
+ *                   tet  sqrt2 det(e01,e02,e03) / max over the 4 nodes of
+ *                        the product of the 3 edge lengths at the node;
+ *                   hex  min over the 8 corners and the centre (principal
+ *                        axes) of det of the 3 unit edge vectors;
+ *                   prism 2/sqrt3 * min over the 6 corners of det of the 3
+ *                        unit edge vectors;
+ *                   pyramid sqrt2 * min over the 4 base corners of det of
+ *                        the 3 unit edge vectors, capped at 1 (a pyramid
+ *                        taller than the regular one would reach sqrt2);
+ *                   tri  2/sqrt3 cross(e01,e02) / max over the 3 nodes of
+ *                        the product of the 2 edge lengths at the node;
+ *                   quad min over the 4 corners of cross of the 2 unit
+ *                        edge vectors.
+ *                   Range [-1, 1]; prism [-2/sqrt3, 1] and pyramid
+ *                   [-sqrt2, 1] (a fully inverted element's worst corner
+ *                   can be its right-angled one).  0 for a zero-length
+ *                   edge.
+ *  GAMMA            Gmsh's gamma (its "gamma" element quality, 4.8.4):
+ *                   tet 3 r/R (inscribed / circumscribed sphere radius),
+ *                   tri 2 r/R (circles), both unsigned in [0, 1];
+ *                   prism min over the 6 corners of |det| of the 3 unit
+ *                   edge vectors times 2/sqrt3 (unsigned);
+ *                   quad s (1 - max |90 - a_k| / 90), a_k the angles
+ *                   between consecutive edge vectors in degrees, s = -1 if
+ *                   a corner is inverted.  Not defined (NaN, not counted)
+ *                   for hex and pyramid: Gmsh 4.8.4 returns 0 for them.
+ *  SICN             Gmsh's signed inverse condition number ("minSICN"):
+ *                   min over the corners of n det(S) / (|S|_F |cof S|_F)
+ *                   (2-D: 2 det(S) / |S|_F^2), S the corner's edge matrix
+ *                   times the inverse of the regular element's (the
+ *                   mean ratio's W); in [-1, 1], negative if inverted.
+ *
+ * Values are NaN when the measure is not defined for the type.  A
+ * degenerate element gives 0 (SICN, gamma, scaled Jacobian), never NaN,
+ * for finite coordinates.
+ */
+typedef enum getme_measure {
+    GETME_MEASURE_MEAN_RATIO = 0,
+    GETME_MEASURE_MIN_DIHEDRAL = 1,
+    GETME_MEASURE_MAX_DIHEDRAL = 2,
+    GETME_MEASURE_SCALED_JACOBIAN = 3,
+    GETME_MEASURE_GAMMA = 4,
+    GETME_MEASURE_SICN = 5,
+    GETME_NUM_MEASURES = 6
+} getme_measure;
+
+/* "mean_ratio", "min_dihedral", "max_dihedral", "scaled_jacobian",
+   "gamma", "sicn"; "unknown" for anything else. */
+GETME_API const char *getme_measure_name(getme_measure measure);
+/* 1 if the measure is defined for the type, else 0. */
+GETME_API int getme_measure_defined(getme_elem_type type,
+                                    getme_measure measure);
+/* The histogram range of a measure: [0, 1] for mean ratio, gamma, SICN and
+   scaled Jacobian (negative values are counted apart), [0, 180] degrees
+   for the dihedral angles.  Returns GETME_ERR_ARGUMENT if unknown. */
+GETME_API getme_status getme_measure_range(getme_measure measure,
+                                           double *lo, double *hi);
+
+/* One measure of one element (nodes as for getme_element_quality()).
+   NaN if the measure is not defined for the type or an argument is bad. */
+GETME_API double getme_element_measure(getme_elem_type type,
+                                       getme_measure measure,
+                                       const double *xyz);
+
+typedef struct getme_measure_stats {
+    int64_t num_elements; /* elements counted (the measure is defined)      */
+    int64_t num_negative; /* of them with a value < 0 (inverted corner)     */
+    int64_t num_below;    /* value < hist_lo: not in the histogram          */
+    double min, max, mean;/* 0 if num_elements is 0; mean in element order  */
+    int32_t min_element;  /* global index of the first element with min,    */
+    int32_t max_element;  /* ... with max; -1 if none                       */
+    double hist_lo, hist_hi;            /* getme_measure_range()            */
+    int64_t histogram[GETME_HIST_BINS]; /* values in [lo, hi] per bin, in
+                                           equal bins; values above hi in
+                                           the last one (mean ratio: invalid
+                                           elements, 0, are in the first
+                                           bin, unlike getme_quality_stats) */
+} getme_measure_stats;
+
+/*
+ * Statistics of one measure over the elements of one type (0..5) or of all
+ * types (-1; types where the measure is not defined are skipped).  The
+ * values are computed in parallel and reduced in element order:
+ * bit-identical for any thread count.
+ */
+GETME_API getme_status getme_mesh_measure_stats(getme_mesh *mesh, int type,
+                                                getme_measure measure,
+                                                getme_measure_stats *stats);
+
+/*
+ * Every measure of every element type at once: stats[type *
+ * GETME_NUM_MEASURES + measure] (GETME_NUM_TYPES * GETME_NUM_MEASURES
+ * entries) as getme_mesh_measure_stats(mesh, type, measure) gives them,
+ * num_elements 0 for absent types and undefined measures.  One pass over
+ * the elements per measure.
+ */
+GETME_API getme_status getme_mesh_measure_all(getme_mesh *mesh,
+                                              getme_measure_stats *stats);
+
+/*
+ * One line summarising the measures of one element type, for logs:
+ * "dihedral 12.34 to 160.21 deg, scaled Jacobian min 0.2342 mean 0.7812,
+ * gamma min 0.1012 mean 0.8011, SICN min 0.3101 mean 0.8327" ("angles" for
+ * planar types; " (N negative)" after a measure with negative values).
+ * stats: the type's GETME_NUM_MEASURES entries, e.g.
+ * &all[type * GETME_NUM_MEASURES] from getme_mesh_measure_all().  Writes
+ * "" if the type has no element.  Returns what snprintf returns.
+ */
+GETME_API int getme_measure_summary(getme_elem_type type,
+                                    const getme_measure_stats *stats,
+                                    char *buf, size_t size);
+
+/* One measure of every element (num_elements doubles; NaN where not
+   defined) into values. */
+GETME_API getme_status getme_mesh_element_measures(getme_mesh *mesh,
+                                                   getme_measure measure,
+                                                   double *values);
+
 /* ------------------------------------------------------------------------ */
 /* Smoothing parameters                                                     */
 /* ------------------------------------------------------------------------ */
@@ -242,19 +434,24 @@ typedef enum getme_method {
 typedef enum getme_stage {
     GETME_STAGE_MEAN = 1,   /* q_mean oriented first stage                    */
     GETME_STAGE_MIN = 2,    /* q*_min oriented cycles                         */
-    GETME_STAGE_LAPLACE = 3 /* smart Laplace iteration                        */
+    GETME_STAGE_LAPLACE = 3,/* smart Laplace iteration                        */
+    GETME_STAGE_FINISH = 4  /* a pass of the finishing step (params.finish)   */
 } getme_stage;
 
 /* What the progress callback sees after every iteration. */
 typedef struct getme_progress {
-    int iteration;          /* 1-based, over both stages                     */
+    int iteration;          /* 1-based, over both stages; in the finishing
+                               step the pass number                          */
     getme_stage stage;
     int cycle;              /* q*_min cycle number (0 in the first stage)    */
     double q_min_star;      /* after this iteration                          */
     double q_mean;
-    double threshold;       /* transformation threshold q_t in force          */
-    int32_t num_transformed;/* elements transformed this iteration            */
-    int32_t num_relaxed;    /* nodes that needed more than one relaxation step*/
+    double threshold;       /* transformation threshold q_t in force (finish:
+                               the quality bound of the pass's elements)     */
+    int32_t num_transformed;/* elements transformed this iteration (finish:
+                               elements worked on)                           */
+    int32_t num_relaxed;    /* nodes that needed more than one relaxation step
+                               (finish: elements whose quality rose)         */
     double elapsed;         /* seconds since getme_smooth() started           */
 } getme_progress;
 
@@ -285,6 +482,32 @@ typedef struct getme_params {
                                   Threshold), see README for the choice      */
     int keep_best;             /* 1: end on the coordinates with the best
                                   q*_min seen in the q*_min stage            */
+    int finish;                /* 1: after the q*_min stage, the finishing
+                                  step: worst elements first, local max-min
+                                  optimisation of their free nodes; q*_min
+                                  never decreases in it (README "Method
+                                  notes").  0: the paper's method alone     */
+    double finish_fraction;    /* 0.001: each finishing pass works on the
+                                  elements below the quality at this
+                                  position of the sorted free elements (at
+                                  least 64 elements), worst first           */
+    int finish_max_passes;     /* 100: at most this many finishing passes;
+                                  they stop earlier once a pass raises
+                                  q*_min by no more than min_tol            */
+    int corner_guard;          /* 1: the corner guard.  A hex, prism,
+                                  pyramid or quad whose worst corner scaled
+                                  Jacobian would fall below both its old
+                                  value and the floor counts as invalid in
+                                  the relaxation (and the finishing step),
+                                  so the mesh's worst corner never ends
+                                  below the floor.  The floor is the
+                                  input's worst corner, or corner_floor if
+                                  that is higher                            */
+    double corner_floor;       /* 0: see corner_guard; in [-1, 1].  Raising
+                                  it protects corners more but blocks moves
+                                  that pass through a bad corner: on the
+                                  benchmark's distorted hexes 0.2 ends at
+                                  q*_min 0.12 against 0.85 with 0          */
     int num_threads;           /* 0: OpenMP default                          */
     int renumber;              /* 1: reorder internally for cache locality
                                   (results stay bit-identical for any thread
@@ -300,8 +523,9 @@ GETME_API void getme_params_init(getme_params *params);
 /*
  * Set a numeric parameter by name: "method" (0 adaptive, 1 laplace),
  * "max_iter", "tol", "sigma", "max_no_min_improve", "min_tol",
- * "threshold_fraction",
- * "keep_best", "num_threads", "renumber".  Returns GETME_ERR_ARGUMENT for
+ * "threshold_fraction", "keep_best", "finish", "finish_fraction",
+ * "finish_max_passes", "corner_guard", "corner_floor", "num_threads",
+ * "renumber".  Returns GETME_ERR_ARGUMENT for
  * an unknown name or a value out of range.  For bindings (Python, CLI).
  */
 GETME_API getme_status getme_params_set(getme_params *params, const char *name,
@@ -330,6 +554,11 @@ typedef struct getme_result {
     int iterations_mean;      /* first (q_mean) stage, or Laplace iterations  */
     int iterations_min;       /* q*_min stage                                 */
     int cycles_min;           /* q*_min cycles                                */
+    int passes_finish;        /* finishing passes (params.finish)             */
+    int32_t moved_finish;     /* elements the finishing step improved        */
+    double corner_sj_initial; /* worst corner scaled Jacobian of the hexes,
+                                 prisms, pyramids and quads (1 if none)      */
+    double corner_sj;         /* the same after smoothing                    */
     double q_min_star_initial, q_mean_initial;
     double q_min_star, q_mean, q_min;
     double threshold;         /* last transformation threshold q_t           */

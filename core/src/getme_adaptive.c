@@ -383,19 +383,23 @@ static inline uint64_t bits_of(double v)
 }
 
 /* DetermineTransformationThreshold: the quality at position
-   fraction * n of the sorted qualities of the elements with a free node
+   fraction * n (at least min_count - 1) of the sorted qualities of the
+   elements with a free node
    (elements without one can never change, so they would only dilute it).
    Without copying all n qualities: they are positive, so their bit
    patterns sort like their values; a histogram of the top 16 bits, then
    of the next 16 inside the chosen bin, leaves a handful of candidates for
    the quickselect.  Returns -1 if out of memory. */
-static double determine_threshold(getme_run *run)
+double getme__threshold(const getme_run *run, double fraction,
+                        int32_t min_count)
 {
     const getme_ws *ws = run->ws;
     int32_t n = ws->num_free_elem;
     if (n == 0)
         return 0.0;
-    double pos = run->params->threshold_fraction * (double)n;
+    double pos = fraction * (double)n;
+    if (pos < (double)min_count - 1.0)
+        pos = (double)min_count - 1.0;
     int64_t k = pos >= (double)(n - 1) ? n - 1 : pos <= 0.0 ? 0 : (int64_t)pos;
     int64_t *hist = malloc(65536 * sizeof *hist);
     if (!hist)
@@ -479,6 +483,10 @@ getme_status getme__adaptive(getme_run *run)
     if (p->keep_best && !best)
         goto done;
     lists_all(run);
+    run->guard = p->corner_guard;
+    run->corner_floor = p->corner_floor > res->corner_sj_initial
+                            ? p->corner_floor
+                            : res->corner_sj_initial;
 
     double q_mean = res->q_mean_initial, q_min = res->q_min_star_initial;
     /* best_min: best q*_min since the end of the q_mean stage (its mesh is
@@ -543,7 +551,7 @@ getme_status getme__adaptive(getme_run *run)
             record = best_min;
             state = MIN_RUNNING;
             counter = 0;
-            qt = determine_threshold(run);
+            qt = getme__threshold(run, p->threshold_fraction, 0);
             if (qt < 0.0 || (st = start_tlist(run, qt)) != GETME_OK) {
                 st = GETME_ERR_NOMEM;
                 break;
@@ -560,6 +568,8 @@ getme_status getme__adaptive(getme_run *run)
         getme__ws_qualities(ws, run->q);
         getme__ws_summary(ws, run->q, &q_mean, &q_min, NULL);
     }
+    if (st == GETME_OK && p->finish)
+        st = getme__finish(run);
     getme__ws_summary(ws, run->q, &res->q_mean, &res->q_min_star, &res->q_min);
     res->threshold = qt;
 done:

@@ -62,6 +62,22 @@ extern const getme_edge_table getme__edges[GETME_NUM_TYPES];
 /* Mean ratio of one element, 0 when invalid; see getme_element_quality(). */
 double getme__quality(int type, const double *x);
 
+/* The element's worst corner: the minimum over its node simplices of
+   det(e1, e2, e3) / (|e1| |e2| |e3|), scaled so that the regular element's
+   corners give 1 (the corner scaled Jacobian of Verdict/CUBIT for hex,
+   prism and pyramid base corners; quad: the 2-D analogue).  Negative for an
+   inverted corner, -1 for a collapsed edge.  Simplices return 1: their mean
+   ratio already measures their only corner. */
+double getme__corner_sj(int type, const double *x);
+
+/* Types whose mean ratio averages several corners, so that one corner can
+   collapse while q stays fair: the corner guard applies to them. */
+static inline int getme__has_corners(int type)
+{
+    return type == GETME_HEX || type == GETME_PRISM ||
+           type == GETME_PYRAMID || type == GETME_QUAD;
+}
+
 double getme__quality_tet(const double *x);
 double getme__quality_hex(const double *x);
 double getme__quality_prism(const double *x);
@@ -97,12 +113,38 @@ struct getme_mesh {
     int32_t num_nodes;
     int32_t num_elements;
     double *coords;   /* 3 * num_nodes, caller's node order */
-    uint8_t *fixed;   /* num_nodes, 1 = fixed */
+    uint8_t *fixed;   /* num_nodes, 0 = free, else why it is fixed (a bit
+                         set of GETME__FIXED_*); the public mask is 0/1  */
     getme_block *blocks;
     int num_blocks, cap_blocks;
     int mirror;       /* planar meshes: 1 if all elements are clockwise */
     char error[512];  /* message of the last failure */
 };
+
+/* Why a node is fixed: bits of getme_mesh.fixed.  Only the worst-element
+   report (worst.c) asks; everything else tests fixed != 0. */
+enum {
+    GETME__FIXED_USER = 1,      /* getme_mesh_set_fixed_mask / fix_nodes   */
+    GETME__FIXED_SKIN = 2,      /* on the skin (or a non-manifold face)    */
+    GETME__FIXED_INTERFACE = 4, /* on a face between two regions           */
+    GETME__FIXED_UNUSED = 8     /* used by no element                      */
+};
+
+/* Gather element e of block bl (local index) into x (nv triples) with y
+   times ysign: -1 for a mirrored planar mesh (mesh->mirror == 1), else 1. */
+static inline void getme__gather_local(const getme_mesh *mesh,
+                                       const getme_block *bl, int32_t e,
+                                       double ysign, double *x)
+{
+    int nv = getme__nv[bl->type];
+    const int32_t *c = bl->conn + (int64_t)e * nv;
+    for (int i = 0; i < nv; i++) {
+        const double *p = mesh->coords + 3 * (int64_t)c[i];
+        x[3 * i] = p[0];
+        x[3 * i + 1] = ysign * p[1];
+        x[3 * i + 2] = p[2];
+    }
+}
 
 /* Record a printf-style message on the mesh and return status. */
 getme_status getme__fail(getme_mesh *mesh, getme_status status,

@@ -219,7 +219,7 @@ getme_status getme_mesh_set_fixed_mask(getme_mesh *mesh, const uint8_t *fixed)
         return GETME_ERR_ARGUMENT;
     for (int32_t i = 0; i < mesh->num_nodes; i++)
         if (fixed[i])
-            mesh->fixed[i] = 1;
+            mesh->fixed[i] |= GETME__FIXED_USER;
     return GETME_OK;
 }
 
@@ -234,7 +234,7 @@ getme_status getme_mesh_fix_nodes(getme_mesh *mesh, int32_t count,
                                "fixed node index %d out of range (%d nodes)",
                                (int)nodes[k], (int)mesh->num_nodes);
     for (int32_t k = 0; k < count; k++)
-        mesh->fixed[nodes[k]] = 1;
+        mesh->fixed[nodes[k]] |= GETME__FIXED_USER;
     return GETME_OK;
 }
 
@@ -248,7 +248,8 @@ getme_status getme_mesh_get_fixed_mask(const getme_mesh *mesh, uint8_t *fixed)
 {
     if (!mesh || (!fixed && mesh->num_nodes))
         return GETME_ERR_ARGUMENT;
-    memcpy(fixed, mesh->fixed, (size_t)mesh->num_nodes);
+    for (int32_t i = 0; i < mesh->num_nodes; i++)
+        fixed[i] = mesh->fixed[i] != 0;
     return GETME_OK;
 }
 

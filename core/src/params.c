@@ -35,6 +35,11 @@ void getme_params_init(getme_params *p)
     p->min_tol = 1e-5;
     p->threshold_fraction = DEFAULT_THRESHOLD_FRACTION;
     p->keep_best = 1;
+    p->finish = 1;
+    p->finish_fraction = 0.001;
+    p->finish_max_passes = 100;
+    p->corner_guard = 1;
+    p->corner_floor = 0.0;
     p->num_threads = 0;
     p->renumber = 1;
 }
@@ -79,6 +84,26 @@ getme_status getme_params_set(getme_params *p, const char *name, double v)
         if (v != 0.0 && v != 1.0)
             return GETME_ERR_ARGUMENT;
         p->keep_best = (int)v;
+    } else if (!strcmp(name, "finish")) {
+        if (v != 0.0 && v != 1.0)
+            return GETME_ERR_ARGUMENT;
+        p->finish = (int)v;
+    } else if (!strcmp(name, "finish_fraction")) {
+        if (!(v >= 0.0 && v <= 1.0))
+            return GETME_ERR_ARGUMENT;
+        p->finish_fraction = v;
+    } else if (!strcmp(name, "finish_max_passes")) {
+        if (!is_int(v) || v < 0 || v > 1e6)
+            return GETME_ERR_ARGUMENT;
+        p->finish_max_passes = (int)v;
+    } else if (!strcmp(name, "corner_guard")) {
+        if (v != 0.0 && v != 1.0)
+            return GETME_ERR_ARGUMENT;
+        p->corner_guard = (int)v;
+    } else if (!strcmp(name, "corner_floor")) {
+        if (!(v >= -1.0 && v <= 1.0))
+            return GETME_ERR_ARGUMENT;
+        p->corner_floor = v;
     } else if (!strcmp(name, "num_threads")) {
         if (!is_int(v) || v < 0 || v > 4096)
             return GETME_ERR_ARGUMENT;
@@ -138,6 +163,12 @@ const char *getme__params_problem(const getme_params *p)
         return "threshold_fraction must be in [0, 1]";
     if (p->num_threads < 0)
         return "num_threads must be >= 0";
+    if (!(p->finish_fraction >= 0.0 && p->finish_fraction <= 1.0))
+        return "finish_fraction must be in [0, 1]";
+    if (p->finish_max_passes < 0)
+        return "finish_max_passes must be >= 0";
+    if (!(p->corner_floor >= -1.0 && p->corner_floor <= 1.0))
+        return "corner_floor must be in [-1, 1]";
     const double *tab[2] = {p->relax_mean, p->relax_min};
     int num[2] = {p->num_relax_mean, p->num_relax_min};
     for (int s = 0; s < 2; s++) {

@@ -321,3 +321,65 @@ double getme_element_quality(getme_elem_type type, const double *xyz)
         return 0.0;
     return getme__quality((int)type, xyz);
 }
+
+/* ---- worst corner (the guard of docs/method.md, "no corner left behind") */
+
+/* det / (|e1| |e2| |e3|) of one corner, times the factor that makes the
+   regular element's corner 1; -1 if an edge has length 0 or a value is
+   not finite (the caller treats it as the worst possible corner). */
+static inline double corner_sj3(const double *x, int a, int b, int c, int d,
+                                double scale)
+{
+    double e1[3], e2[3], e3[3];
+    edge(x, a, b, e1);
+    edge(x, a, c, e2);
+    edge(x, a, d, e3);
+    double l = dot3(e1, e1) * dot3(e2, e2) * dot3(e3, e3);
+    double s = scale * det3(e1, e2, e3) / sqrt(l);
+    return l > 0.0 && isfinite(s) ? s : -1.0;
+}
+
+static inline double corner_sj2(const double *x, int k, int next, int prev)
+{
+    double l = len2_xy(x, k, next) * len2_xy(x, k, prev);
+    double s = cross2(x, k, next, prev) / sqrt(l);
+    return l > 0.0 && isfinite(s) ? s : -1.0;
+}
+
+double getme__corner_sj(int type, const double *x)
+{
+    double m = 1.0;
+    switch (type) {
+    case GETME_HEX:
+        for (int k = 0; k < 8; k++)
+            m = fmin(m, corner_sj3(x, hex_corners[k][0], hex_corners[k][1],
+                                   hex_corners[k][2], hex_corners[k][3], 1.0));
+        return m;
+    case GETME_PRISM: {
+        /* triangle corners span 60 degrees: 2/sqrt3 makes them 1 */
+        static const unsigned char pc[6][4] = {{0, 1, 2, 3}, {1, 2, 0, 4},
+                                               {2, 0, 1, 5}, {3, 5, 4, 0},
+                                               {4, 3, 5, 1}, {5, 4, 3, 2}};
+        for (int k = 0; k < 6; k++)
+            m = fmin(m, corner_sj3(x, pc[k][0], pc[k][1], pc[k][2], pc[k][3],
+                                   2.0 * GETME_INV_SQRT3));
+        return m;
+    }
+    case GETME_PYRAMID: {
+        /* base corner of the all-edges-1 pyramid: det = 1/sqrt2 */
+        static const unsigned char yc[4][3] = {{0, 1, 3}, {1, 2, 0},
+                                               {2, 3, 1}, {3, 0, 2}};
+        for (int k = 0; k < 4; k++)
+            m = fmin(m, corner_sj3(x, yc[k][0], yc[k][1], yc[k][2], 4,
+                                   GETME_SQRT2));
+        return m;
+    }
+    case GETME_QUAD:
+        m = fmin(m, corner_sj2(x, 0, 1, 3));
+        m = fmin(m, corner_sj2(x, 1, 2, 0));
+        m = fmin(m, corner_sj2(x, 2, 3, 1));
+        return fmin(m, corner_sj2(x, 3, 0, 2));
+    default:
+        return 1.0; /* simplices: their mean ratio is their only corner */
+    }
+}

@@ -21,6 +21,26 @@ static inline void place(getme_run *run, int32_t i, double rho)
                            : (1.0 - rho) * x[d] + rho * ph[d];
 }
 
+/* Quality of element e at the trial coordinates xnew, 0 if it is invalid
+   there or if the corner guard rejects it: its worst corner fell below
+   both its old value (at ws->x) and the floor.  An element at its old
+   shape is never rejected, so the relaxation's reset argument holds. */
+static inline double trial_quality(const getme_run *run, int32_t e)
+{
+    const getme_ws *ws = run->ws;
+    double x[3 * GETME_MAX_NV];
+    int t = getme__ws_type(ws, e);
+    getme__ws_gather(ws, run->xnew, t, e, x);
+    double q = getme__quality(t, x);
+    if (!run->guard || !getme__has_corners(t) || !(q > 0.0))
+        return q;
+    double sj = getme__corner_sj(t, x);
+    if (sj >= run->corner_floor)
+        return q;
+    getme__ws_gather(ws, ws->x, t, e, x);
+    return sj < getme__corner_sj(t, x) ? 0.0 : q;
+}
+
 /* How many elements of the list are invalid at xnew (parallel count). */
 static int32_t count_invalid(const getme_run *run)
 {
@@ -73,7 +93,7 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
     }
 #pragma omp parallel for schedule(static) num_threads(nt) if (ne > GETME_PAR_MIN)
     for (int32_t k = 0; k < ne; k++)
-        q[elems[k]] = getme__ws_quality(ws, run->xnew, elems[k]);
+        q[elems[k]] = trial_quality(run, elems[k]);
 
     /* Step the nodes of invalid elements down the table until none is
        invalid.  Only elements around a stepped node change, so only they
@@ -93,7 +113,7 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
         for (int32_t j = 0; j < m; j++) {
             int32_t i = run->list[j];
             for (int64_t k = ws->star_ptr[i]; k < ws->star_ptr[i + 1]; k++)
-                q[ws->star[k]] = getme__ws_quality(ws, run->xnew, ws->star[k]);
+                q[ws->star[k]] = trial_quality(run, ws->star[k]);
         }
     }
 

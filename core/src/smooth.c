@@ -216,6 +216,7 @@ getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
         goto done;
     getme__ws_summary(&ws, run.q, &result->q_mean_initial,
                       &result->q_min_star_initial, NULL);
+    result->corner_sj_initial = result->corner_sj = getme__ws_corner_min(&ws);
     if (ws.num_free_nodes == 0) {
         getme__ws_summary(&ws, run.q, &result->q_mean, &result->q_min_star,
                           &result->q_min);
@@ -224,8 +225,10 @@ getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
     }
     st = params->method == GETME_METHOD_SMART_LAPLACE ? getme__laplace(&run)
                                                       : getme__adaptive(&run);
-    if (st == GETME_OK || st == GETME_ERR_CANCELLED)
+    if (st == GETME_OK || st == GETME_ERR_CANCELLED) {
+        result->corner_sj = getme__ws_corner_min(&ws);
         getme__ws_store(&ws, mesh);
+    }
     if (st == GETME_ERR_CANCELLED)
         getme__fail(mesh, st, "stopped by the progress callback after "
                               "%d iterations", result->iterations);

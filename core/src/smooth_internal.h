@@ -48,6 +48,11 @@ typedef struct getme_run {
     double *qold;       /* q*_min stage: qualities of run->elems before the
                            relaxation step (NULL: sums are recomputed)      */
     int64_t cap_qold;
+    /* The corner guard (params.corner_guard): relaxation and the finishing
+       step treat a hex/prism/pyramid/quad whose worst corner falls below
+       min(its old value, corner_floor) like an invalid element. */
+    int guard;
+    double corner_floor; /* max(params.corner_floor, the input's worst)   */
 } getme_run;
 
 getme_status getme__run_alloc(getme_run *run);
@@ -83,6 +88,20 @@ int getme__report(getme_run *run, int iteration, getme_stage stage, int cycle,
 /* GETMe adaptive; run->adj must be built (getme_smooth does it before the
    run's arrays, so that its temporaries do not add to the peak). */
 getme_status getme__adaptive(getme_run *run);
+
+/* The quality at position fraction * n (at least min_count - 1, at most
+   n - 1) of the sorted qualities of the free elements; 0 without free
+   elements, -1 if out of memory (getme_adaptive.c). */
+double getme__threshold(const getme_run *run, double fraction,
+                        int32_t min_count);
+
+/* Worst corner scaled Jacobian over the elements with corners (1 if none),
+   at ws->x; parallel min, so thread-count independent. */
+double getme__ws_corner_min(const getme_ws *ws);
+
+/* The finishing step (finish.c): passes of worst-first local max-min
+   optimisation until q*_min stops rising.  Needs run->q up to date. */
+getme_status getme__finish(getme_run *run);
 getme_status getme__laplace(getme_run *run);
 
 #endif /* GETME_SMOOTH_INTERNAL_H */

@@ -15,18 +15,11 @@ getme_status getme_mesh_element_qualities(getme_mesh *mesh, double *q)
         getme__detect_orientation(mesh);
     for (int b = 0; b < mesh->num_blocks; b++) {
         const getme_block *bl = &mesh->blocks[b];
-        int nv = getme__nv[bl->type];
         double ysign = mesh->mirror == 1 ? -1.0 : 1.0;
 #pragma omp parallel for schedule(static)
         for (int32_t e = 0; e < bl->count; e++) {
             double x[3 * GETME_MAX_NV];
-            const int32_t *c = bl->conn + (int64_t)e * nv;
-            for (int i = 0; i < nv; i++) {
-                const double *p = mesh->coords + 3 * (int64_t)c[i];
-                x[3 * i] = p[0];
-                x[3 * i + 1] = ysign * p[1];
-                x[3 * i + 2] = p[2];
-            }
+            getme__gather_local(mesh, bl, e, ysign, x);
             q[bl->first + e] = getme__quality(bl->type, x);
         }
     }

@@ -22,18 +22,21 @@ static int32_t region_of(const getme_mesh *mesh, int32_t e)
 }
 
 /* Must face f of workspace element e be fixed, given the element across
-   it (fnb)?  A face shared by three or more elements is fixed too: it is
-   no skin, but such a mesh is not a manifold there and moving its nodes
-   has no clear meaning. */
+   it (fnb)?  0, or the GETME__FIXED_* reason.  A face shared by three or
+   more elements is fixed too: it is no skin, but such a mesh is not a
+   manifold there and moving its nodes has no clear meaning. */
 static int face_fixed(const getme_mesh *mesh, const getme_ws *ws, int32_t e,
                       int32_t nb, unsigned flags)
 {
     if (nb == -1)
-        return (flags & GETME_FIX_SKIN) != 0;
+        return flags & GETME_FIX_SKIN ? GETME__FIXED_SKIN : 0;
     if (nb == GETME_FACE_IRREGULAR)
-        return (flags & (GETME_FIX_SKIN | GETME_FIX_INTERFACES)) != 0;
+        return flags & (GETME_FIX_SKIN | GETME_FIX_INTERFACES)
+                   ? GETME__FIXED_SKIN : 0;
     return (flags & GETME_FIX_INTERFACES) &&
-           region_of(mesh, ws->elem_orig[e]) != region_of(mesh, ws->elem_orig[nb]);
+                   region_of(mesh, ws->elem_orig[e]) !=
+                       region_of(mesh, ws->elem_orig[nb])
+               ? GETME__FIXED_INTERFACE : 0;
 }
 
 getme_status getme_mesh_fix_boundary(getme_mesh *mesh, unsigned flags,
@@ -59,15 +62,16 @@ getme_status getme_mesh_fix_boundary(getme_mesh *mesh, unsigned flags,
         for (int32_t e = ws.tstart[t]; e < ws.tstart[t + 1]; e++) {
             const int32_t *c = getme__ws_nodes(&ws, t, e);
             const int32_t *f = fnb + foff[t] + (int64_t)(e - ws.tstart[t]) * ft->num_faces;
-            for (int k = 0; k < ft->num_faces; k++)
-                if (face_fixed(mesh, &ws, e, f[k], flags))
-                    for (int j = 0; j < ft->size[k]; j++)
-                        mesh->fixed[ws.node_orig[c[ft->node[k][j]]]] = 1;
+            for (int k = 0; k < ft->num_faces; k++) {
+                int why = face_fixed(mesh, &ws, e, f[k], flags);
+                for (int j = 0; why && j < ft->size[k]; j++)
+                    mesh->fixed[ws.node_orig[c[ft->node[k][j]]]] |= (uint8_t)why;
+            }
         }
     }
     for (int32_t i = 0; i < ws.nn; i++)
         if (ws.star_ptr[i + 1] == ws.star_ptr[i])
-            mesh->fixed[ws.node_orig[i]] = 1; /* used by no element */
+            mesh->fixed[ws.node_orig[i]] |= GETME__FIXED_UNUSED;
     free(fnb);
     getme__ws_free(&ws);
     if (num_fixed)

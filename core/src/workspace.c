@@ -422,3 +422,21 @@ void getme__ws_summary(const getme_ws *ws, const double *q, double *q_mean,
     if (q_min)
         *q_min = mn;
 }
+
+double getme__ws_corner_min(const getme_ws *ws)
+{
+    double m = 1.0;
+    for (int t = 0; t < GETME_NUM_TYPES; t++) {
+        if (!getme__has_corners(t))
+            continue;
+#pragma omp parallel for schedule(static) num_threads(ws->nt) \
+    reduction(min : m)
+        for (int32_t e = ws->tstart[t]; e < ws->tstart[t + 1]; e++) {
+            double x[3 * GETME_MAX_NV];
+            getme__ws_gather(ws, ws->x, t, e, x);
+            double s = getme__corner_sj(t, x);
+            m = s < m ? s : m;
+        }
+    }
+    return m;
+}

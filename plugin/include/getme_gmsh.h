@@ -118,6 +118,11 @@ typedef struct getme_gmsh_report {
     double wall;                /* seconds for the whole call (wall, CPU)    */
     double cpu;
     char message[512];          /* "" on success, else the error             */
+    /* The analysts' measures (dihedral angles, scaled Jacobian, gamma,
+       SICN; getme.h) per element type, before and after:
+       [type][measure] as getme_mesh_measure_all() gives them. */
+    getme_measure_stats measures_before[GETME_NUM_TYPES][GETME_NUM_MEASURES];
+    getme_measure_stats measures_after[GETME_NUM_TYPES][GETME_NUM_MEASURES];
 } getme_gmsh_report;
 
 /*
@@ -141,8 +146,9 @@ GETME_GMSH_API getme_status getme_gmsh_optimize(
 
 /*
  * Mean-ratio statistics of the current model's elements (same selection
- * rules and fixed nodes as getme_gmsh_optimize()) into report->before (and
- * a copy in report->after); nothing is smoothed, nothing is logged.
+ * rules and fixed nodes as getme_gmsh_optimize()) into report->before and
+ * the measures into report->measures_before (and copies in ->after,
+ * ->measures_after); nothing is smoothed, nothing is logged.
  */
 /* Each of names[0..n) names a physical group of the current model (its
    name or "dim:tag"): GETME_OK, else GETME_ERR_ARGUMENT and "Unknown
@@ -164,6 +170,11 @@ GETME_GMSH_API getme_status getme_gmsh_quality(
 GETME_GMSH_API double getme_gmsh_report_value(const getme_gmsh_report *report,
                                               const char *name);
 GETME_GMSH_API size_t getme_gmsh_report_sizeof(void);
+/* &report->measures_before[type][measure] (after != 0: measures_after), for
+   bindings; NULL for a bad argument. */
+GETME_GMSH_API const getme_measure_stats *
+getme_gmsh_report_measure(const getme_gmsh_report *report, int after,
+                          int type, int measure);
 /* report->message, for bindings. */
 GETME_GMSH_API const char *
 getme_gmsh_report_message(const getme_gmsh_report *report);

@@ -157,6 +157,10 @@ void gg_log(const char *level, const char *fmt, ...)
 #endif
     ;
 void gg_log_histogram(const getme_quality_stats *s);
+/* One "Measures WHEN (type): ..." line per element type present in m
+   (getme_gmsh_report.measures_before/after). */
+void gg_log_measures(const char *when,
+                     const getme_measure_stats (*m)[GETME_NUM_MEASURES]);
 int gg_log_progress(const getme_progress *p, void *user);
 
 #endif /* GETME_GMSH_INTERNAL_H */

@@ -122,6 +122,7 @@ static void log_start(gg_run *run)
            "(worst over elements with a free node):",
            r->before.q_min_star, r->before.q_mean);
     gg_log_histogram(&r->before);
+    gg_log_measures("before", r->measures_before);
 }
 
 static void log_end(gg_run *run)
@@ -131,6 +132,7 @@ static void log_end(gg_run *run)
     gg_log("info", "Optimization ends with worst = %.6g / average = %.6g:",
            r->after.q_min_star, r->after.q_mean);
     gg_log_histogram(&r->after);
+    gg_log_measures("after", r->measures_after);
     if (run->params.method == GETME_METHOD_SMART_LAPLACE)
         gg_log("info", "%d Laplace iterations, %ld nodes moved",
                res->iterations, (long)r->num_moved);
@@ -158,6 +160,8 @@ static getme_status read_and_check(gg_run *run, const int *dim_tags,
     r->num_elements = getme_mesh_num_elements(mesh);
     r->num_fixed = getme_mesh_num_fixed(mesh);
     st = getme_mesh_quality_stats(mesh, -1, &r->before);
+    if (st == GETME_OK)
+        st = getme_mesh_measure_all(mesh, &r->measures_before[0][0]);
     if (st != GETME_OK)
         return fail(run, st, getme_mesh_error(mesh));
     return check_valid(run);
@@ -176,6 +180,8 @@ static getme_status smooth_and_apply(gg_run *run, int niter)
         return fail(run, st, getme_mesh_error(mesh));
     /* A cancelled run still leaves a valid, partly smoothed mesh. */
     getme_status st2 = getme_mesh_quality_stats(mesh, -1, &run->rep->after);
+    if (st2 == GETME_OK)
+        st2 = getme_mesh_measure_all(mesh, &run->rep->measures_after[0][0]);
     char text[GG_MSG];
     if (st2 == GETME_OK)
         st2 = getme_gmsh_model_apply(run->model, getme_mesh_coords(mesh),
@@ -258,7 +264,11 @@ getme_status getme_gmsh_quality(const int *dim_tags, size_t dim_tags_n,
     run.rep->num_elements = getme_mesh_num_elements(mesh);
     run.rep->num_fixed = getme_mesh_num_fixed(mesh);
     st = getme_mesh_quality_stats(mesh, -1, &run.rep->before);
+    if (st == GETME_OK)
+        st = getme_mesh_measure_all(mesh, &run.rep->measures_before[0][0]);
     run.rep->after = run.rep->before;
+    memcpy(run.rep->measures_after, run.rep->measures_before,
+           sizeof run.rep->measures_after);
     if (st != GETME_OK)
         snprintf(run.rep->message, sizeof run.rep->message, "%s",
                  getme_mesh_error(mesh));

@@ -11,6 +11,17 @@
 
 size_t getme_gmsh_report_sizeof(void) { return sizeof(getme_gmsh_report); }
 
+const getme_measure_stats *getme_gmsh_report_measure(const getme_gmsh_report *r,
+                                                     int after, int type,
+                                                     int measure)
+{
+    if (!r || type < 0 || type >= GETME_NUM_TYPES || measure < 0 ||
+        measure >= GETME_NUM_MEASURES)
+        return NULL;
+    return after ? &r->measures_after[type][measure]
+                 : &r->measures_before[type][measure];
+}
+
 const char *getme_gmsh_report_message(const getme_gmsh_report *r)
 {
     return r ? r->message : "";

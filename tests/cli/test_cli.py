@@ -34,6 +34,8 @@ check, run = T.check, T.run
 # apart from libgetme and checked against it by the bench_quality test) -----
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "bench"))
 from quality import element_quality  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from gmsh_helpers import structured_hex_volume, two_unit_boxes  # noqa: E402
 
 
 GMSH_TYPES = {4: "tet", 5: "hex", 6: "prism", 7: "pyramid", 2: "tri", 3: "quad"}
@@ -99,20 +101,12 @@ def make(case, path):
         gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 1)
         gm.mesh.generate(3)
     elif case == "mixed":
-        b1 = occ.addBox(0, 0, 0, 1, 1, 1)
-        b2 = occ.addBox(1, 0, 0, 1, 1, 1)
-        occ.fragment([(3, b1)], [(3, b2)])
-        occ.synchronize()
+        two_unit_boxes()
         top = [s for s in gm.getBoundary([(3, 2)], oriented=False)
                if abs(occ.getCenterOfMass(2, s[1])[2] - 1) < 1e-9][0]
         occ.extrude([top], 0, 0, 0.5, numElements=[3], recombine=True)
         occ.synchronize()
-        for c in gm.getEntities(1):
-            gm.mesh.setTransfiniteCurve(c[1], 7)
-        for s in gm.getBoundary([(3, 1)], oriented=False):
-            gm.mesh.setTransfiniteSurface(s[1])
-            gm.mesh.setRecombine(2, s[1])
-        gm.mesh.setTransfiniteVolume(1)
+        structured_hex_volume(1, 7)
         gm.mesh.generate(3)
     elif case in ("tri", "quad"):
         r = occ.addRectangle(0, 0, 0, 2, 1)
@@ -162,7 +156,39 @@ def mesh_case(case):
           "report's qmean equals the independent one")
     check(rep["iterations"]["mean_stage"] > 0 and rep["iterations"]["min_stage"] > 0,
           "both stages ran")
-    check(len(rep["history"]) == rep["iterations"]["total"], "one history record per iteration")
+    its = [h for h in rep["history"] if h["stage"] != 4]
+    passes = [h for h in rep["history"] if h["stage"] == 4]
+    check(len(its) == rep["iterations"]["total"], "one history record per iteration")
+    check(len(passes) == rep["iterations"]["finish_passes"], "one history record per finishing pass")
+    # The finishing step never lowers q*min: its passes climb from where the
+    # q*min stage (with keep_best) ended, and the result is the last pass.
+    qs = [h["q_min_star"] for h in passes]
+    check(all(b >= a for a, b in zip(qs, qs[1:])), "q*min never decreases over the finishing passes")
+    check(not qs or abs(qs[-1] - rep["after"]["q_min_star"]) < 1e-12, "the result is the last pass's q*min")
+    # The worst elements of the report, checked against the output's own
+    # qualities: the worst overall is the minimum over all elements.
+    worst = rep["worst_elements"]
+    check(len(worst) == min(10, rep["after"]["elements"]) and
+          abs(worst[0]["quality"] - rep["after"]["q_min"]) < 1e-12, "worst element = qmin")
+    check(all(a["quality"] <= b["quality"] for a, b in zip(worst, worst[1:])), "worst first")
+    wf = rep["worst_free_elements"]
+    check(wf and abs(wf[0]["quality"] - rep["after"]["q_min_star"]) < 1e-12 and
+          all(w["free_nodes"] > 0 for w in wf), "worst element with a free node = q*min")
+    # the analysts' measures (docs/quality.md): per type, before and after
+    meas = rep["measures"]
+    for k in kinds:
+        b, a = meas["before"][k], meas["after"][k]
+        check(a["sicn"]["elements"] == len(q1[k]) and sum(a["sicn"]["histogram"]) == len(q1[k]),
+              f"{k}: SICN counted for every element")
+        check(a["sicn"]["min"] > b["sicn"]["min"] and a["scaled_jacobian"]["min"] > 0,
+              f"{k}: SICN min improved, scaled Jacobian positive after smoothing")
+        check(abs(a["mean_ratio"]["min"] - min(q1[k])) < 1e-9,
+              f"{k}: report's per-type mean ratio min equals the independent one")
+        check(("gamma" in a) == (k not in ("hex", "pyramid")), f"{k}: gamma only where Gmsh has one")
+    p = run("quality", out1)
+    for k in kinds:
+        check(f"{k} SICN: min" in p.stdout and f"{k} scaled Jacobian: min" in p.stdout,
+              f"getme quality prints the {k} measures")
     print(f"{case}: {', '.join(f'{k} {len(q0[k])}' for k in kinds)}; q*min {mn0:.4f} -> "
           f"getme {mn1:.4f} (laplace {mnl:.4f}); qmean {mean0:.4f} -> {mean1:.4f} "
           f"(laplace {meanl:.4f}); iterations {rep['iterations']['mean_stage']}/"

@@ -40,22 +40,7 @@ static double srand1(void) { return 2.0 * urand() - 1.0; }
 
 /* ---- element tables ----------------------------------------------------- */
 
-#define S3_2 0.86602540378443864676
-
-static const double reg_tet[] = {0, 0, 0, 1, 0, 0, 0.5, S3_2, 0,
-                                 0.5, 0.28867513459481288225,
-                                 0.81649658092772603273};
-static const double reg_hex[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0,
-                                 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1};
-static const double reg_prism[] = {0, 0, 0, 1, 0, 0, 0.5, S3_2, 0,
-                                   0, 0, 1, 1, 0, 1, 0.5, S3_2, 1};
-static const double reg_pyramid[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0,
-                                     0.5, 0.5, 0.70710678118654752440};
-static const double reg_tri[] = {0, 0, 0, 1, 0, 0, 0.5, S3_2, 0};
-static const double reg_quad[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
-
-static const double *const regular[GETME_NUM_TYPES] = {
-    reg_tet, reg_hex, reg_prism, reg_pyramid, reg_tri, reg_quad};
+#include "regular_elements.h"
 
 /* Edges of each type (planar: the boundary cycle). */
 static const int num_edges[GETME_NUM_TYPES] = {6, 12, 9, 8, 3, 4};

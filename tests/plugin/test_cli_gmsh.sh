@@ -16,12 +16,15 @@ rc=$?
 [ $rc -eq 0 ] && ok "exit 0" || bad "exit $rc"
 grep -q "^Info    : Optimizing mesh (GETMe adaptive, [0-9]* threads*)...$" run.log && ok "start line" || bad "no start line"
 grep -q "^Info    : 0.90 < quality < 1.00 : " run.log && ok "histogram" || bad "no histogram"
+grep -q "^Info    : Measures after  *(tet): dihedral .* deg, scaled Jacobian min .*, gamma min .*, SICN min " run.log \
+  && ok "measures line" || bad "no measures line"
 grep -q "^Info    : Done optimizing mesh (Wall " run.log && ok "done line" || bad "no done line"
 grep -q "^Info    : Done meshing 3D" run.log && ok "Gmsh's own meshing lines" || bad "no Gmsh lines"
 # the same log lines as getme smooth (one parser, one progress callback)
 "$G" smooth part.msh -o part-again.msh --fix clamp -v > smooth.log 2>&1
 for pat in "^Info    : Quality before: q\*min [0-9.]*, qmin" "^Info    : It    1 (qmean stage): q\*min" \
-           "^Info    : It  *[0-9]* (q\*min stage, cycle 1, q_t" "^Info    : Quality after : q\*min"; do
+           "^Info    : It  *[0-9]* (q\*min stage, cycle 1, q_t" "^Info    : Quality after : q\*min" \
+           "^Info    : Measures before (tet): dihedral" "^Info    : Measures after  (tet): dihedral"; do
   grep -q "$pat" run.log && grep -q "$pat" smooth.log && ok "both log '$pat'" || bad "log line '$pat'"
 done
 grep -q "getme-tmp" run.log && bad "the temporary file's name in the log" || ok "no temporary name in the log"
@@ -33,7 +36,7 @@ rm -f opts.json part-opts.msh
 import json; r = json.load(open('opts.json'))
 assert r['params']['sigma'] == 1.3 and r['params']['threshold_fraction'] == 0.01, r['params']
 assert r['params']['num_threads'] == 1 and r['elements']['tet'] > 100, r
-assert len(r['history']) == r['iterations']['total'] > 0
+assert len(r['history']) == r['iterations']['total'] + r['iterations']['finish_passes'] > 0
 " && ok "gmsh --param/--report" || bad "gmsh --param/--report ($rc)"
 "$G" gmsh part.msh -q -o x.msh --param nonsense=1; rc=$?
 [ $rc -eq 2 ] && ok "gmsh bad --param: 2" || bad "gmsh bad --param: $rc"

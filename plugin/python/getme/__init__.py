@@ -9,11 +9,13 @@ and libgetme_gmsh).
 
 getme.gmsh acts on the current model of the Gmsh library loaded in this
 process, the very same libgmsh.so the gmsh module uses.  getme.quality()
-gives mean-ratio statistics of that model or of numpy arrays.
+gives mean-ratio statistics of that model or of numpy arrays, plus the
+dihedral angles, scaled Jacobian, Gmsh's gamma and SICN per element type;
+getme.element_measure() one of them for one element.
 """
 from ._lib import GetmeError, version
-from .quality import quality
+from .quality import element_measure, quality
 from . import gmsh
 
-__all__ = ["GetmeError", "gmsh", "quality", "version"]
+__all__ = ["GetmeError", "element_measure", "gmsh", "quality", "version"]
 __version__ = version()

@@ -54,6 +54,23 @@ class QualityStats(ctypes.Structure):
                 ("first_invalid", c_int32 * MAX_REPORTED_INVALID)]
 
 
+NUM_TYPES = 6
+NUM_MEASURES = 6
+TYPE_NAMES = ("tet", "hex", "prism", "pyramid", "tri", "quad")
+MEASURE_NAMES = ("mean_ratio", "min_dihedral", "max_dihedral",
+                 "scaled_jacobian", "gamma", "sicn")
+
+
+class MeasureStats(ctypes.Structure):
+    """getme_measure_stats from getme.h (public, stable layout)."""
+    _fields_ = [("num_elements", c_int64), ("num_negative", c_int64),
+                ("num_below", c_int64), ("min", c_double),
+                ("max", c_double), ("mean", c_double),
+                ("min_element", c_int32), ("max_element", c_int32),
+                ("hist_lo", c_double), ("hist_hi", c_double),
+                ("histogram", c_int64 * HIST_BINS)]
+
+
 def _sig(lib, name, restype, *argtypes):
     f = getattr(lib, name)
     f.restype = restype
@@ -73,6 +90,11 @@ _sig(core, "getme_mesh_quality_stats", c_int, c_void_p, c_int,
      POINTER(QualityStats))
 _sig(core, "getme_mesh_element_qualities", c_int, c_void_p,
      POINTER(c_double))
+_sig(core, "getme_mesh_measure_all", c_int, c_void_p, POINTER(MeasureStats))
+_sig(core, "getme_mesh_element_measures", c_int, c_void_p, c_int,
+     POINTER(c_double))
+_sig(core, "getme_element_measure", c_double, c_int, c_int,
+     POINTER(c_double))
 
 _sig(plugin, "getme_gmsh_options_new", c_void_p)
 _sig(plugin, "getme_gmsh_options_free", None, c_void_p)
@@ -87,6 +109,8 @@ _sig(plugin, "getme_gmsh_quality", c_int, POINTER(c_int), c_size_t,
 _sig(plugin, "getme_gmsh_report_sizeof", c_size_t)
 _sig(plugin, "getme_gmsh_report_value", c_double, c_void_p, c_char_p)
 _sig(plugin, "getme_gmsh_report_message", c_char_p, c_void_p)
+_sig(plugin, "getme_gmsh_report_measure", POINTER(MeasureStats), c_void_p,
+     c_int, c_int, c_int)
 _sig(plugin, "getme_gmsh_model_read", c_int, POINTER(c_void_p), POINTER(c_int),
      c_size_t, c_void_p, c_char_p, c_size_t)
 _sig(plugin, "getme_gmsh_model_free", None, c_void_p)
@@ -96,6 +120,29 @@ _sig(plugin, "getme_gmsh_model_apply", c_int, c_void_p, POINTER(c_double),
 _sig(core, "getme_mesh_coords", POINTER(c_double), c_void_p)
 _sig(core, "getme_mesh_distort", c_int, c_void_p, ctypes.c_uint64, c_double,
      c_double, c_int)
+
+
+def measure_dict(get):
+    """{type: {measure: stats}} from get(type, measure) -> MeasureStats,
+    for the types present and the measures defined for them (docs/quality.md:
+    angles in degrees; min, max, mean, num_negative, and a histogram of
+    HIST_BINS equal bins over histogram_range, values below it in
+    num_below)."""
+    out = {}
+    for t, tname in enumerate(TYPE_NAMES):
+        per = {}
+        for m, mname in enumerate(MEASURE_NAMES):
+            s = get(t, m)
+            if s.num_elements:
+                per[mname] = {"num_elements": s.num_elements,
+                              "num_negative": s.num_negative,
+                              "num_below": s.num_below, "min": s.min,
+                              "max": s.max, "mean": s.mean,
+                              "histogram_range": (s.hist_lo, s.hist_hi),
+                              "histogram": list(s.histogram)}
+        if per:
+            out[tname] = per
+    return out
 
 
 MAX_RELAX = 16
@@ -110,6 +157,9 @@ class Params(ctypes.Structure):
                 ("relax_min", c_double * MAX_RELAX),
                 ("max_no_min_improve", c_int), ("min_tol", c_double),
                 ("threshold_fraction", c_double), ("keep_best", c_int),
+                ("finish", c_int), ("finish_fraction", c_double),
+                ("finish_max_passes", c_int), ("corner_guard", c_int),
+                ("corner_floor", c_double),
                 ("num_threads", c_int), ("renumber", c_int),
                 ("progress", c_void_p), ("progress_data", c_void_p)]
 
@@ -129,7 +179,11 @@ def defaults():
             "max_iter": p.max_iter, "tol": p.tol, "sigma": p.sigma,
             "max_no_min_improve": p.max_no_min_improve, "min_tol": p.min_tol,
             "threshold_fraction": p.threshold_fraction,
-            "keep_best": p.keep_best, "renumber": p.renumber}
+            "keep_best": p.keep_best, "finish": p.finish,
+            "finish_fraction": p.finish_fraction,
+            "finish_max_passes": p.finish_max_passes,
+            "corner_guard": p.corner_guard, "corner_floor": p.corner_floor,
+            "renumber": p.renumber}
 
 
 def version():

@@ -16,7 +16,10 @@ params     any libgetme parameter: sigma, max_iter, tol, threshold_fraction,
            fix_skin, fix_interfaces (0/1)
 
 Returns a dict: iterations (total, mean stage, min stage, cycles),
-q_min_star / q_min / q_mean before and after, nodes moved, seconds.
+q_min_star / q_min / q_mean before and after, nodes moved, seconds, and
+measures_before / measures_after: {type: {measure: {"min", "max", "mean",
+"num_elements", "num_negative", "histogram", ...}}} for the dihedral
+angles, scaled Jacobian, Gmsh's gamma and SICN (docs/quality.md).
 Raises getme.GetmeError (with the Gmsh-logged message) on bad use; the
 model is then unchanged.
 """
@@ -75,6 +78,10 @@ def _report_dict(rep):
         out["num_invalid_" + when] = int(val(when + "_num_invalid"))
         out["histogram_" + when] = [int(val("%s_hist%d" % (when, b)))
                                     for b in range(_lib.HIST_BINS)]
+        after = when == "after"
+        out["measures_" + when] = _lib.measure_dict(
+            lambda t, m: _lib.plugin.getme_gmsh_report_measure(
+                rep, after, t, m).contents)
     return out
 
 
@@ -111,7 +118,8 @@ def model_quality(dimTags=(), fix=()):
             "q_min_star": d["q_min_star_before"],
             "q_mean": d["q_mean_before"], "q_max": d["q_max_before"],
             "num_invalid": d["num_invalid_before"],
-            "histogram": d["histogram_before"]}
+            "histogram": d["histogram_before"],
+            "measures": d["measures_before"]}
 
 
 def distort(seed=1, amount=0.4, rounds=5, dimTags=(), fix=()):

@@ -22,6 +22,27 @@ def stats_dict(s):
             "histogram": list(s.histogram)}
 
 
+def _mesh_measures(mesh):
+    table = (_lib.MeasureStats * (_lib.NUM_TYPES * _lib.NUM_MEASURES))()
+    st = _lib.core.getme_mesh_measure_all(mesh, table)
+    if st:
+        raise GetmeError(_lib.core.getme_mesh_error(mesh).decode(), st)
+    return _lib.measure_dict(lambda t, m: table[t * _lib.NUM_MEASURES + m])
+
+
+def element_measure(kind, measure, xyz):
+    """One measure ("mean_ratio", "min_dihedral", "max_dihedral",
+    "scaled_jacobian", "gamma", "sicn") of one element of kind "tet", ...
+    with nodes xyz ((nv, 3) array, getme/Gmsh node order); NaN where the
+    measure is not defined (gamma of hex and pyramid)."""
+    x = np.ascontiguousarray(xyz, dtype=np.float64)
+    if x.shape != (NODES[kind], 3):
+        raise GetmeError("a %s needs a (%d, 3) array" % (kind, NODES[kind]))
+    return _lib.core.getme_element_measure(
+        TYPES[kind], _lib.MEASURE_NAMES.index(measure),
+        x.ctypes.data_as(POINTER(c_double)))
+
+
 def _array_quality(nodes, elements):
     xyz = np.ascontiguousarray(nodes, dtype=np.float64)
     if xyz.ndim != 2 or xyz.shape[1] != 3:
@@ -54,6 +75,7 @@ def _array_quality(nodes, elements):
             mesh, q.ctypes.data_as(POINTER(c_double)))
         out = stats_dict(s)
         out["qualities"] = q
+        out["measures"] = _mesh_measures(mesh)
         return out
     finally:
         _lib.core.getme_mesh_free(mesh)
@@ -65,6 +87,10 @@ def quality(nodes=None, elements=None, dimTags=()):
     quality(nodes, elements): nodes an (n, 3) array, elements a dict
     {"tet": (m, 4) zero-based int array, "hex": ..., ...}; the result also
     holds "qualities", one value per element in dict order.
+    Both forms also give "measures": {type: {measure: {"min", "max",
+    "mean", "num_elements", "num_negative", "histogram", ...}}} for the
+    dihedral angles, scaled Jacobian, Gmsh's gamma and SICN
+    (docs/quality.md).
     quality(dimTags=[...]): the current Gmsh model (same entity selection
     as getme.gmsh.optimize; q_min_star over elements with a free node).
     """

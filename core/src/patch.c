@@ -1,0 +1,335 @@
+/*
+ * patch.c -- local max-min optimisation of a few nodes (patch.h).
+ */
+#include "patch.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define D_MAX (3 * GETME_PATCH_MAX_MOVE)
+
+void getme__patch_free(getme_patch *p)
+{
+    free(p->type);
+    free(p->conn);
+    free(p->id);
+    free(p->q);
+    free(p->sj);
+    free(p->qt);
+    memset(p, 0, sizeof *p);
+}
+
+/* Grow every per-element array to cap entries. */
+static getme_status grow(getme_patch *p, int32_t cap)
+{
+    void *a = realloc(p->type, (size_t)cap * sizeof *p->type);
+    if (!a)
+        return GETME_ERR_NOMEM;
+    p->type = a;
+    if (!(a = realloc(p->conn, (size_t)cap * sizeof *p->conn)))
+        return GETME_ERR_NOMEM;
+    p->conn = a;
+    if (!(a = realloc(p->id, (size_t)cap * sizeof *p->id)))
+        return GETME_ERR_NOMEM;
+    p->id = a;
+    if (!(a = realloc(p->q, (size_t)cap * sizeof *p->q)))
+        return GETME_ERR_NOMEM;
+    p->q = a;
+    if (!(a = realloc(p->sj, (size_t)cap * sizeof *p->sj)))
+        return GETME_ERR_NOMEM;
+    p->sj = a;
+    if (!(a = realloc(p->qt, (size_t)cap * D_MAX * sizeof *p->qt)))
+        return GETME_ERR_NOMEM;
+    p->qt = a; /* also holds the active gradients: D_MAX per element */
+    p->cap = cap;
+    return GETME_OK;
+}
+
+getme_status getme__patch_init(getme_patch *p, int32_t cap)
+{
+    memset(p, 0, sizeof *p);
+    return grow(p, cap > 64 ? cap : 64);
+}
+
+getme_status getme__patch_add(getme_patch *p, int type, const int32_t *conn,
+                              int32_t id)
+{
+    if (p->n == p->cap && grow(p, 2 * p->cap) != GETME_OK)
+        return GETME_ERR_NOMEM;
+    p->type[p->n] = (int8_t)type;
+    p->conn[p->n] = conn;
+    p->id[p->n] = id;
+    p->n++;
+    return GETME_OK;
+}
+
+/* Quality of patch element i at p->x; its worst corner into *sj when the
+   corner guard applies to its type. */
+static double elem_q(const getme_patch *p, int32_t i, double *sj)
+{
+    double x[3 * GETME_MAX_NV];
+    int t = p->type[i];
+    const int32_t *c = p->conn[i];
+    for (int j = 0; j < getme__nv[t]; j++) {
+        const double *s = p->x + 3 * (int64_t)c[j];
+        x[3 * j] = s[0];
+        x[3 * j + 1] = p->mirror ? -s[1] : s[1];
+        x[3 * j + 2] = s[2];
+    }
+    if (p->guard && getme__has_corners(t))
+        *sj = getme__corner_sj(t, x);
+    return getme__quality(t, x);
+}
+
+double getme__patch_eval(getme_patch *p)
+{
+    double m = INFINITY;
+    for (int32_t i = 0; i < p->n; i++) {
+        p->sj[i] = 1.0;
+        p->q[i] = elem_q(p, i, &p->sj[i]);
+        m = fmin(m, p->q[i]);
+    }
+    return m;
+}
+
+/* Trial qualities into p->qt at the moved coordinates.  Returns 1 if the
+ * move is acceptable:
+ *  - every element ends above cur, the patch's minimum, so the minimum
+ *    strictly rises (by gain);
+ *  - the patch's total quality falls by at most p->loss times gain.  Pure
+ *    max-min steps would otherwise buy a tiny rise of the worst element
+ *    with large losses around it (measured on the bundled bracket: q_mean
+ *    0.843 -> 0.829 for a q*_min gain of 0.001);
+ *  - with the corner guard, no corner of a hex, prism, pyramid or quad
+ *    falls below min(its old value, floor). */
+static int trial(getme_patch *p, double cur)
+{
+    double m = INFINITY, sum_new = 0.0, sum_old = 0.0;
+    for (int32_t i = 0; i < p->n; i++) {
+        double sj = 1.0;
+        double q = elem_q(p, i, &sj);
+        if (!(q > cur))
+            return 0;
+        if (sj < p->sj[i] && sj < p->floor && p->guard)
+            return 0;
+        p->qt[i] = q;
+        m = fmin(m, q);
+        sum_new += q;
+        sum_old += p->q[i];
+    }
+    return sum_new - sum_old >= -(m - cur) * p->loss;
+}
+
+/* Accept the trial: qualities become current. */
+static void accept(getme_patch *p)
+{
+    memcpy(p->q, p->qt, (size_t)p->n * sizeof *p->q);
+}
+
+static inline double *coord(const getme_patch *p, int32_t node, int d)
+{
+    return p->x + 3 * (int64_t)node + d;
+}
+
+/* Set the moving nodes to base + s * u (D = 3k values). */
+static void place(getme_patch *p, const int32_t *mv, int k, const double *base,
+                  double s, const double *u)
+{
+    for (int j = 0; j < k; j++)
+        for (int d = 0; d < 3; d++)
+            *coord(p, mv[j], d) = base[3 * j + d] + s * u[3 * j + d];
+}
+
+static void restore(getme_patch *p, const int32_t *mv, int k,
+                    const double *base)
+{
+    for (int j = 0; j < k; j++)
+        for (int d = 0; d < 3; d++)
+            *coord(p, mv[j], d) = base[3 * j + d];
+}
+
+/* Shortest edge of the patch that touches a moving node: the length scale
+   of steps and difference quotients. */
+static double edge_scale(const getme_patch *p, const int32_t *mv, int k)
+{
+    double l2 = INFINITY;
+    for (int32_t i = 0; i < p->n; i++) {
+        const getme_edge_table *et = &getme__edges[p->type[i]];
+        const int32_t *c = p->conn[i];
+        for (int j = 0; j < et->num_edges; j++) {
+            int32_t a = c[et->node[j][0]], b = c[et->node[j][1]];
+            int moving = 0;
+            for (int m = 0; m < k; m++)
+                moving |= a == mv[m] || b == mv[m];
+            if (!moving)
+                continue;
+            double s = 0.0;
+            for (int d = 0; d < 3; d++) {
+                double v = *coord(p, a, d) - *coord(p, b, d);
+                s += v * v;
+            }
+            l2 = fmin(l2, s);
+        }
+    }
+    return sqrt(l2);
+}
+
+/* Central-difference gradient of element i's quality with respect to the
+   moving nodes (zero for the nodes it does not contain). */
+static void gradient(getme_patch *p, int32_t i, const int32_t *mv, int k,
+                     double h, double *g)
+{
+    const int32_t *c = p->conn[i];
+    int nv = getme__nv[p->type[i]];
+    double sj;
+    for (int j = 0; j < k; j++) {
+        int in = 0;
+        for (int v = 0; v < nv; v++)
+            in |= c[v] == mv[j];
+        for (int d = 0; d < 3; d++) {
+            double *x = coord(p, mv[j], d), x0 = *x;
+            if (!in) {
+                g[3 * j + d] = 0.0;
+                continue;
+            }
+            *x = x0 + h;
+            double qp = elem_q(p, i, &sj);
+            *x = x0 - h;
+            double qm = elem_q(p, i, &sj);
+            *x = x0;
+            g[3 * j + d] = (qp - qm) / (2.0 * h);
+        }
+    }
+}
+
+static double dot(const double *a, const double *b, int n)
+{
+    double s = 0.0;
+    for (int i = 0; i < n; i++)
+        s += a[i] * b[i];
+    return s;
+}
+
+/* Minimum-norm point z of the convex hull of the m vectors g (n values
+   each) by Frank-Wolfe with exact line search: the steepest ascent
+   direction of min_a g_a . z.  A fixed number of steps keeps it
+   deterministic and cheap; an approximate z is still an ascent direction
+   when min_a g_a . z > 0, which the caller checks. */
+static void min_norm(const double *g, int32_t m, int n, double *z)
+{
+    int32_t best = 0;
+    for (int32_t a = 1; a < m; a++)
+        if (dot(g + a * n, g + a * n, n) < dot(g + best * n, g + best * n, n))
+            best = a;
+    memcpy(z, g + best * n, (size_t)n * sizeof *z);
+    for (int it = 0; it < 64; it++) {
+        double zz = dot(z, z, n);
+        int32_t s = 0;
+        double smin = INFINITY;
+        for (int32_t a = 0; a < m; a++) {
+            double v = dot(g + a * n, z, n);
+            if (v < smin)
+                smin = v, s = a;
+        }
+        if (zz - smin <= 1e-12 * zz)
+            break;
+        double diff[D_MAX], dd = 0.0;
+        for (int i = 0; i < n; i++) {
+            diff[i] = g[s * n + i] - z[i];
+            dd += diff[i] * diff[i];
+        }
+        double t = (zz - smin) / dd;
+        t = t > 1.0 ? 1.0 : t;
+        for (int i = 0; i < n; i++)
+            z[i] += t * diff[i];
+    }
+}
+
+/* One ascent step; returns 1 if accepted (apply) or found (probe). */
+static int step(getme_patch *p, const int32_t *mv, int k, double L,
+                int apply)
+{
+    int n = 3 * k;
+    double cur = INFINITY;
+    for (int32_t i = 0; i < p->n; i++)
+        cur = fmin(cur, p->q[i]);
+    /* The active set: elements within 20 % of the minimum.  Wider sets
+       give safer directions, narrower ones faster steps; the line search
+       below protects the others either way. */
+    double band = cur + 0.2 * cur + 1e-12;
+    double *g = p->qt; /* room for D_MAX per element; qt is free here */
+    int32_t m = 0;
+    for (int32_t i = 0; i < p->n; i++)
+        if (p->q[i] <= band)
+            gradient(p, i, mv, k, 1e-7 * L, g + (int64_t)m++ * n);
+    double z[D_MAX];
+    min_norm(g, m, n, z);
+    double zn = sqrt(dot(z, z, n)), worst = INFINITY;
+    for (int32_t a = 0; a < m; a++)
+        worst = fmin(worst, dot(g + (int64_t)a * n, z, n));
+    if (!(zn > 0.0) || !(worst > 0.0))
+        return 0; /* stationary: no ascent direction */
+    double base[D_MAX], u[D_MAX];
+    for (int j = 0; j < k; j++)
+        for (int d = 0; d < 3; d++)
+            base[3 * j + d] = *coord(p, mv[j], d);
+    for (int i = 0; i < n; i++)
+        u[i] = z[i] / zn;
+    /* Halve from half the shortest edge down to ~1e-7 of it. */
+    for (int h = 1; h <= 24; h++) {
+        double s = L * ldexp(1.0, -h);
+        place(p, mv, k, base, s, u);
+        if (trial(p, cur)) {
+            if (!apply) {
+                restore(p, mv, k, base);
+                return 1;
+            }
+            accept(p);
+            return 1;
+        }
+    }
+    restore(p, mv, k, base);
+    return 0;
+}
+
+int getme__patch_climb(getme_patch *p, const int32_t *mv, int k,
+                       int max_steps, int apply)
+{
+    if (k < 1 || k > GETME_PATCH_MAX_MOVE || p->n == 0)
+        return 0;
+    double L = edge_scale(p, mv, k);
+    if (!(L > 0.0) || !isfinite(L))
+        return 0;
+    int done = 0;
+    while (done < max_steps && step(p, mv, k, L, apply)) {
+        done++;
+        if (!apply)
+            break;
+    }
+    return done;
+}
+
+int getme__patch_toward(getme_patch *p, const int32_t *mv, int k,
+                        const double *tg)
+{
+    if (k < 1 || k > GETME_PATCH_MAX_MOVE || p->n == 0)
+        return 0;
+    double cur = INFINITY, base[D_MAX], u[D_MAX];
+    for (int32_t i = 0; i < p->n; i++)
+        cur = fmin(cur, p->q[i]);
+    for (int j = 0; j < k; j++)
+        for (int d = 0; d < 3; d++) {
+            base[3 * j + d] = *coord(p, mv[j], d);
+            u[3 * j + d] = tg[3 * j + d] - base[3 * j + d];
+        }
+    for (int h = 1; h <= 6; h++) {
+        place(p, mv, k, base, ldexp(1.0, -h), u);
+        if (trial(p, cur)) {
+            accept(p);
+            return 1;
+        }
+    }
+    restore(p, mv, k, base);
+    return 0;
+}

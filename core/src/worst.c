@@ -1,0 +1,215 @@
+/*
+ * worst.c -- getme_mesh_worst_elements(): the worst elements of a mesh and
+ * why each one cannot get better by moving nodes (README "Method notes").
+ *
+ * The reasons, tested in this order:
+ *  - every node fixed, at least one of them only because it lies on a
+ *    region interface: freeing interfaces would let it move;
+ *  - every node fixed (skin, fixed sets): no node move can change it; a
+ *    topological optimiser (edge and face swaps) can;
+ *  - each free node, and all of them together, sits at a local optimum of
+ *    the finishing step's max-min problem (patch.h): no small move raises
+ *    the worst quality among the elements around them;
+ *  - otherwise a move exists that the smoother did not make (it stopped on
+ *    its iteration or pass limits).
+ */
+#include "patch.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+const char *getme_worst_reason_string(getme_worst_reason r)
+{
+    switch (r) {
+    case GETME_WORST_IMPROVABLE: return "a node move can still raise it";
+    case GETME_WORST_ALL_FIXED: return "all nodes fixed";
+    case GETME_WORST_INTERFACE: return "all nodes fixed, on a region interface";
+    case GETME_WORST_LOCAL_OPTIMUM:
+        return "free nodes at a local optimum of their elements";
+    }
+    return "unknown";
+}
+
+static const int32_t *nodes_of(const getme_mesh *mesh, int32_t e, int *type)
+{
+    int32_t local;
+    const getme_block *b = getme__find_block(mesh, e, &local);
+    *type = b->type;
+    return b->conn + (int64_t)local * getme__nv[b->type];
+}
+
+/* Insert (q, e) into the ascending list w of at most max entries. */
+static void keep_worst(getme_worst_element *w, int32_t *n, int32_t max,
+                       double q, int32_t e)
+{
+    if (*n == max && !(q < w[max - 1].quality))
+        return; /* ties keep the lower index, which came first */
+    int32_t i = *n < max ? (*n)++ : max - 1;
+    while (i > 0 && q < w[i - 1].quality) {
+        w[i] = w[i - 1];
+        i--;
+    }
+    memset(&w[i], 0, sizeof w[i]);
+    w[i].quality = q;
+    w[i].element = e;
+}
+
+/* The elements around the free nodes of the n reported elements, found in
+   one scan of the mesh (the mesh has no node stars), into *cand. */
+static getme_status candidates(const getme_mesh *mesh,
+                               const getme_worst_element *w, int32_t n,
+                               int32_t **cand, int32_t *num)
+{
+    uint8_t *mark = calloc((size_t)mesh->num_nodes, 1);
+    if (!mark)
+        return GETME_ERR_NOMEM;
+    for (int32_t i = 0; i < n; i++) {
+        int t;
+        const int32_t *c = nodes_of(mesh, w[i].element, &t);
+        for (int j = 0; j < getme__nv[t]; j++)
+            mark[c[j]] = !mesh->fixed[c[j]];
+    }
+    int32_t m = 0, cap = 256;
+    int32_t *list = malloc((size_t)cap * sizeof *list);
+    for (int b = 0; b < mesh->num_blocks && list; b++) {
+        const getme_block *bl = &mesh->blocks[b];
+        int nv = getme__nv[bl->type];
+        for (int32_t e = 0; e < bl->count && list; e++) {
+            const int32_t *c = bl->conn + (int64_t)e * nv;
+            int hit = 0;
+            for (int i = 0; i < nv; i++)
+                hit |= mark[c[i]];
+            if (!hit)
+                continue;
+            if (m == cap) {
+                int32_t *grown = realloc(list, 2 * (size_t)cap * sizeof *list);
+                if (!grown)
+                    free(list);
+                list = grown, cap *= 2;
+                if (!list)
+                    break;
+            }
+            list[m++] = bl->first + e;
+        }
+    }
+    free(mark);
+    *cand = list, *num = m;
+    return list ? GETME_OK : GETME_ERR_NOMEM;
+}
+
+/* The patch of the candidate elements containing any of the k nodes mv. */
+static getme_status fill(const getme_mesh *mesh, getme_patch *p,
+                         const int32_t *cand, int32_t num, const int32_t *mv,
+                         int k)
+{
+    getme__patch_clear(p);
+    for (int32_t i = 0; i < num; i++) {
+        int t;
+        const int32_t *c = nodes_of(mesh, cand[i], &t);
+        int hit = 0;
+        for (int v = 0; v < getme__nv[t]; v++)
+            for (int j = 0; j < k; j++)
+                hit |= c[v] == mv[j];
+        if (hit && getme__patch_add(p, t, c, cand[i]) != GETME_OK)
+            return GETME_ERR_NOMEM;
+    }
+    getme__patch_eval(p);
+    return GETME_OK;
+}
+
+/* Is there a move of the free nodes mv (each alone, then all together)
+   that raises the worst quality around them?  1 yes, 0 no, -1 no memory.
+   Probes move coordinates and put them back bit for bit. */
+static int can_improve(const getme_mesh *mesh, getme_patch *p,
+                       const int32_t *cand, int32_t num, const int32_t *mv,
+                       int k)
+{
+    for (int j = 0; j <= k; j++) {
+        const int32_t *set = j < k ? &mv[j] : mv;
+        int n = j < k ? 1 : k;
+        if (j == k && k < 2)
+            break;
+        if (fill(mesh, p, cand, num, set, n) != GETME_OK)
+            return -1;
+        if (getme__patch_climb(p, set, n, 1, 0))
+            return 1;
+    }
+    return 0;
+}
+
+/* Has element e a free node? */
+static int has_free(const getme_mesh *mesh, int32_t e)
+{
+    int t;
+    const int32_t *c = nodes_of(mesh, e, &t);
+    for (int j = 0; j < getme__nv[t]; j++)
+        if (!mesh->fixed[c[j]])
+            return 1;
+    return 0;
+}
+
+getme_status getme_mesh_worst_elements(getme_mesh *mesh, int32_t max_count,
+                                       unsigned flags,
+                                       getme_worst_element *out,
+                                       int32_t *count)
+{
+    if (!mesh || max_count < 0 || (!out && max_count > 0) || !count)
+        return GETME_ERR_ARGUMENT;
+    *count = 0;
+    if (max_count == 0 || mesh->num_elements == 0)
+        return GETME_OK;
+    double *q = malloc((size_t)mesh->num_elements * sizeof *q);
+    if (!q)
+        return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
+    getme_mesh_element_qualities(mesh, q);
+    int32_t n = 0;
+    for (int32_t e = 0; e < mesh->num_elements; e++)
+        if (!(flags & GETME_WORST_FREE_ONLY) || has_free(mesh, e))
+            keep_worst(out, &n, max_count, q[e], e);
+    free(q);
+
+    getme_patch p;
+    int32_t *cand = NULL, num = 0;
+    if (candidates(mesh, out, n, &cand, &num) != GETME_OK ||
+        getme__patch_init(&p, 64) != GETME_OK) {
+        free(cand);
+        return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
+    }
+    p.x = mesh->coords;
+    p.mirror = mesh->mirror == 1;
+    p.loss = GETME_PATCH_LOSS;
+    getme_status st = GETME_OK;
+    for (int32_t i = 0; i < n && st == GETME_OK; i++) {
+        getme_worst_element *w = &out[i];
+        int t;
+        const int32_t *c = nodes_of(mesh, w->element, &t);
+        double x[3 * GETME_MAX_NV];
+        getme__gather(mesh, w->element, x);
+        w->type = (getme_elem_type)t;
+        w->corner_sj = getme__corner_sj(t, x);
+        w->num_nodes = getme__nv[t];
+        int32_t mv[GETME_PATCH_MAX_MOVE];
+        int k = 0, interface_only = 0;
+        for (int j = 0; j < getme__nv[t]; j++) {
+            uint8_t f = mesh->fixed[c[j]];
+            if (!f)
+                mv[k++] = c[j];
+            interface_only |= f == GETME__FIXED_INTERFACE;
+        }
+        w->num_free = k;
+        if (k == 0) {
+            w->reason = interface_only ? GETME_WORST_INTERFACE
+                                       : GETME_WORST_ALL_FIXED;
+            continue;
+        }
+        int r = can_improve(mesh, &p, cand, num, mv, k);
+        if (r < 0)
+            st = getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
+        w->reason = r ? GETME_WORST_IMPROVABLE : GETME_WORST_LOCAL_OPTIMUM;
+    }
+    getme__patch_free(&p);
+    free(cand);
+    *count = st == GETME_OK ? n : 0;
+    return st;
+}
