@@ -845,16 +845,24 @@ static getme_io_status read_element_block(msh41_reader *r)
                      : read_ascii_elements(r, b, count, nv, fix);
 }
 
-static getme_io_status read_elements(msh41_reader *r)
+/* Entering $Elements (both versions): after $Nodes, only once. */
+static getme_io_status elements_begin(msh41_reader *r)
 {
-    uint64_t nblocks = 0, n, lo, hi;
     r->section = "Elements";
     if (!r->have_nodes)
         return msh41_fail(r, GETME_IO_ERR_PARSE, "$Elements before $Nodes");
     if (r->have_elements)
         return msh41_decline(r, "several $Elements sections");
     r->have_elements = 1;
-    getme_io_status st = read_count(r, &nblocks, "number of element blocks", 8);
+    return GETME_IO_OK;
+}
+
+static getme_io_status read_elements(msh41_reader *r)
+{
+    uint64_t nblocks = 0, n, lo, hi;
+    getme_io_status st = elements_begin(r);
+    if (st == GETME_IO_OK)
+        st = read_count(r, &nblocks, "number of element blocks", 8);
     if (st == GETME_IO_OK)
         st = read_count(r, &n, "number of elements", 8);
     if (st == GETME_IO_OK)
@@ -1117,17 +1125,14 @@ static getme_io_status binary_block22(msh41_reader *r, uint64_t *left)
 static getme_io_status read_elements22(msh41_reader *r)
 {
     uint64_t n = 0;
-    r->section = "Elements";
-    if (!r->have_nodes)
-        return msh41_fail(r, GETME_IO_ERR_PARSE, "$Elements before $Nodes");
-    if (r->have_elements)
-        return msh41_decline(r, "several $Elements sections");
-    r->have_elements = 1;
+    getme_io_status st = elements_begin(r);
+    if (st != GETME_IO_OK)
+        return st;
     int nw = r->opts ? r->opts->num_fix + r->opts->num_free : 0;
     if (nw && !r->fix_found &&
         !(r->fix_found = calloc((size_t)nw, sizeof *r->fix_found)))
         return oom(r);
-    getme_io_status st = read_count22(r, &n, "number of elements", 8);
+    st = read_count22(r, &n, "number of elements", 8);
     if (r->binary)
         for (uint64_t left = n; st == GETME_IO_OK && left > 0;)
             st = binary_block22(r, &left);

@@ -145,7 +145,9 @@ static int format_double(double v, char *buf, size_t size)
     return n;
 }
 
-/* One coordinate line (read raw, echo off): rewritten if the node moved. */
+/* One node's line (read raw, echo off): "x y z" (MSH 4.1, tag given) or
+   "tag x y z" (MSH 2.2, tag == 0: read from the line, its text kept);
+   the coordinates are rewritten if the node moved. */
 static int ascii_coord_line(writer *w, uint64_t tag)
 {
     char line[8192], *p = line, *end;
@@ -159,6 +161,13 @@ static int ascii_coord_line(writer *w, uint64_t tag)
             break;
     }
     line[n] = 0;
+    if (tag == 0) {
+        errno = 0;
+        tag = strtoull(line, &p, 10);
+        if (p == line || errno || tag == 0)
+            return -1;
+    }
+    size_t prefix = (size_t)(p - line); /* the tag's text, kept */
     double old[3];
     for (int k = 0; k < 3; k++, p = end) {
         old[k] = strtod(p, &end);
@@ -174,7 +183,9 @@ static int ascii_coord_line(writer *w, uint64_t tag)
     char num[3][40];
     for (int k = 0; k < 3; k++)
         format_double(x[k], num[k], sizeof num[k]);
-    return fprintf(w->out, "%s %s %s%s", num[0], num[1], num[2], eol) < 0
+    return fwrite(line, 1, prefix, w->out) != prefix ||
+                   fprintf(w->out, "%s%s %s %s%s", prefix ? " " : "", num[0],
+                           num[1], num[2], eol) < 0
                ? -1
                : 0;
 }
@@ -206,49 +217,6 @@ static int ascii_block(writer *w)
 }
 
 /* ---- MSH 2.2: one node per record ---------------------------------------- */
-
-/* ASCII "tag x y z" (read raw, echo off): the coordinates rewritten after
-   the tag's own text if the node moved. */
-static int ascii_node22(writer *w)
-{
-    char line[8192], *p, *end;
-    size_t n = 0;
-    int c;
-    while ((c = msh41_in_getc(&w->in)) >= 0) {
-        if (n + 1 >= sizeof line)
-            return -1;
-        line[n++] = (char)c;
-        if (c == '\n')
-            break;
-    }
-    line[n] = 0;
-    errno = 0;
-    unsigned long long tag = strtoull(line, &p, 10);
-    if (p == line || errno)
-        return -1;
-    const char *tag_end = p;
-    double old[3];
-    for (int k = 0; k < 3; k++, p = end) {
-        old[k] = strtod(p, &end);
-        if (end == p)
-            return -1;
-    }
-    const double *x = moved(w, tag, old);
-    if (!x)
-        return fwrite(line, 1, n, w->out) == n ? 0 : -1;
-    const char *eol = n >= 2 && line[n - 2] == '\r' ? "\r\n"
-                      : n >= 1 && line[n - 1] == '\n' ? "\n"
-                                                       : "";
-    char num[3][40];
-    for (int k = 0; k < 3; k++)
-        format_double(x[k], num[k], sizeof num[k]);
-    return fwrite(line, 1, (size_t)(tag_end - line), w->out) !=
-                       (size_t)(tag_end - line) ||
-                   fprintf(w->out, " %s %s %s%s", num[0], num[1], num[2],
-                           eol) < 0
-               ? -1
-               : 0;
-}
 
 /* Binary: int32 tag + 3 doubles per node, patched in place. */
 static int bin_node22(writer *w)
@@ -282,7 +250,7 @@ static int nodes22(writer *w)
     msh41_in_echo(&w->in, NULL);
     int rc = 0;
     for (uint64_t i = 0; rc == 0 && i < count; i++)
-        rc = w->m->binary ? bin_node22(w) : ascii_node22(w);
+        rc = w->m->binary ? bin_node22(w) : ascii_coord_line(w, 0);
     msh41_in_echo(&w->in, w->out);
     return rc;
 }
