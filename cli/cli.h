@@ -96,6 +96,16 @@ int cli_check_paths(cli_paths *p);
    0 or EXIT_USAGE (printed). */
 int cli_check_read_files(const cli_paths *p, const getme_doc *doc);
 
+/* A file's identity at one moment (device, inode; or absent). */
+typedef struct cli_file_stamp {
+    int exists;
+    uint64_t dev, ino;
+} cli_file_stamp;
+void cli_stamp(const char *path, cli_file_stamp *s);
+/* 1 if path now exists and is not the file it was at the stamp: something
+   (a writer's rename) created or replaced it since. */
+int cli_replaced(const char *path, const cli_file_stamp *before);
+
 /* Hold termination signals while files are written (on = 1), deliver them
    after (on = 0): a Ctrl-C leaves the whole output or none. */
 typedef struct cli_guard {

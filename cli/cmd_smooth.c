@@ -154,10 +154,17 @@ static int run(smooth_args *a)
     cli_info(log, "Writing '%s'...", a->output);
     cli_guard guard = {0};
     cli_write_guard(&guard, 1);
+    cli_file_stamp report_was;
+    cli_stamp(paths.rep, &report_was);
     getme_io_status ios = getme_doc_write(doc, paths.out);
     if (ios != GETME_IO_OK) {
         cli_error("%s", getme_doc_error(doc));
         code = ios;
+    } else if (so->report && cli_replaced(paths.rep, &report_was)) {
+        /* the report names a file the output wrote (an INP include copy) */
+        cli_error("report %s: it is a file the output just wrote; not "
+                  "replacing it (choose another report file)", so->report);
+        code = EXIT_USAGE;
     } else {
         cli_info(log, "Done writing '%s'", a->output);
         cli_mesh_counts counts;

@@ -120,6 +120,25 @@ int cli_check_read_files(const cli_paths *p, const getme_doc *doc)
     return 0;
 }
 
+void cli_stamp(const char *path, cli_file_stamp *s)
+{
+    struct stat sb;
+    memset(s, 0, sizeof *s);
+    if (path && stat(path, &sb) == 0) {
+        s->exists = 1;
+        s->dev = (uint64_t)sb.st_dev;
+        s->ino = (uint64_t)sb.st_ino;
+    }
+}
+
+int cli_replaced(const char *path, const cli_file_stamp *before)
+{
+    cli_file_stamp now;
+    cli_stamp(path, &now);
+    return now.exists && (!before->exists || now.dev != before->dev ||
+                          now.ino != before->ino);
+}
+
 /* Termination signals wait while files are written, so that a Ctrl-C or
    kill leaves either the complete output or nothing (never a temporary
    file); they take their usual effect once writing ends.  Only SIGKILL and

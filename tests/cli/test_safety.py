@@ -138,6 +138,14 @@ def paths_case():
     os.link(path("nodes.inc"), path("nodes-link.inp"))
     refused(["smooth", deck, "-o", path("nodes-link.inp"), "-q"], 2,
             [deck, path("nodes.inc")], [], "overwrite")
+    # --report naming the include copy the output writes
+    # ("<output stem>.<included name>"): the mesh is written, the copy is
+    # not replaced by JSON
+    p = run("smooth", deck, "-o", path("deck-out.inp"), "--report",
+            path("deck-out.nodes.inc"), "-q", expect=2)
+    check("a file the output just wrote" in p.stderr, "report = include copy refused")
+    check(open(path("deck-out.nodes.inc")).read().startswith("1, 0, 0, 0"),
+          "the include copy is still the nodes, not JSON")
     run("smooth", deck, "-o", path("deck-out.inp"), "--report", path("deck.json"), "-q")
     check(os.path.exists(path("deck.json")), "report written next to a deck with includes")
 
