@@ -165,6 +165,9 @@ def report_fields(report):
     return {
         "iterations_mean": iters.get("mean_stage"),
         "iterations_min": iters.get("min_stage"),
+        "finish_passes": iters.get("finish_passes"),
+        "corner_sj_before": (report.get("corner_sj") or {}).get("before"),
+        "corner_sj_after": (report.get("corner_sj") or {}).get("after"),
         "seconds": report.get("seconds"),
         "report_q_min_star": after.get("q_min_star"),
         "report_q_mean": after.get("q_mean"),
@@ -213,7 +216,9 @@ def run_method(ctx, case, method, src, ref, params=(), tag=None):
         with open(report) as f:
             row.update(report_fields(json.load(f)))
         im, imin = row.get("iterations_mean"), row.get("iterations_min")
-        row["iterations"] = (f"{im}/{imin}" if method.args[1] == "getme" else f"{im}")
+        passes = row.get("finish_passes") or 0
+        row["iterations"] = (f"{im}/{imin}" + (f"+{passes}" if passes else "")
+                             if method.args[1] == "getme" else f"{im}")
     else:
         row["seconds"] = r.last_json().get("seconds")
         row["iterations"] = "1" if method.tool == "gmsh" else "5 steps"
@@ -280,7 +285,7 @@ def check_row(row, notes):
     bad = False
     if row.get("status") != "ok":
         return True
-    if row["method"].startswith(("getme", "laplace")):
+    if row["method"].startswith(("getme", "paper", "laplace")):
         if row["topology"] != "no" or row["invalid"]:
             notes.append(f"  ERROR: {row['label']}: topology {row['topology']}, "
                          f"{row['invalid']} invalid elements")

@@ -15,7 +15,8 @@ Works on rows of old result files too (it needs no field they lack).
 """
 
 STAGE_MEAN = 1  # GETME_STAGE_MEAN in getme.h
-SMOOTHERS = {"getme": "GETMe adaptive", "laplace": "smart Laplace"}
+SMOOTHERS = {"getme": "GETMe adaptive", "paper": "GETMe adaptive, paper only",
+             "laplace": "smart Laplace"}
 
 
 def _ns(seconds, elements, iterations):
@@ -42,7 +43,7 @@ def cost_fields(row):
     iters = (row.get("iterations_mean") or 0) + (row.get("iterations_min") or 0)
     out = {"threads": threads(row),
            "ns_el_it": _ns(row.get("seconds"), row.get("elements"), iters)}
-    if smoother(row) == "getme":
+    if smoother(row) in ("getme", "paper"):
         n1, end, steady = stage1(row.get("history"))
         out.update({"stage1_iterations": n1, "stage1_seconds": end,
                     "ns_el_it_stage1": _ns(steady, row.get("elements"),
@@ -81,7 +82,7 @@ def speedups(rows):
         if not one or not two:
             continue
         s = {"total": _ratio(one.get("seconds"), two.get("seconds"))}
-        if name == "getme":
+        if name in ("getme", "paper"):
             s["stage1"] = _ratio(one.get("ns_el_it_stage1"), two.get("ns_el_it_stage1"))
         out[name] = s
     return out

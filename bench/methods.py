@@ -25,13 +25,20 @@ class Method:
     params: tuple = field(default=())  # extra --param name=value for getme
 
 
-def _getme(key, label, method, threads):
-    return Method(key, label, "getme", ("--method", method, "--threads", str(threads)))
+def _getme(key, label, method, threads, params=()):
+    return Method(key, label, "getme", ("--method", method, "--threads", str(threads)),
+                  params=params)
 
+
+# The paper's GETMe adaptive alone: no finishing step, no corner guard
+# (README "Method notes"), for the before/after comparison of issue #9.
+PAPER = (("finish", 0), ("corner_guard", 0))
 
 METHODS = (
     _getme("getme-1", "GETMe adaptive", "getme", 1),
     _getme("getme-2", "GETMe adaptive (2 threads)", "getme", 2),
+    _getme("paper-1", "GETMe adaptive, paper only", "getme", 1, PAPER),
+    _getme("paper-2", "GETMe adaptive, paper only (2 threads)", "getme", 2, PAPER),
     _getme("laplace-1", "Smart Laplace", "laplace", 1),
     _getme("laplace-2", "Smart Laplace (2 threads)", "laplace", 2),
     # Gmsh 4.8's own optimizers.  "" is its tet optimizer (it also flips and

@@ -80,6 +80,15 @@ GETME_GMSH_API void getme_gmsh_options_free(getme_gmsh_options *options);
  *   "fix_skin"       1 (default): also fix every node on the mesh skin
  *   "fix_interfaces" 1 (default): also fix nodes on faces between entities
  *                    of different physical groups
+ *   "topology"       0 (default); 1: when some of the worst elements have no
+ *                    free node, so that no node move can fix them (a tet
+ *                    spanning between boundary nodes), first run Gmsh's own
+ *                    topological optimizer (gmshModelMeshOptimize("")),
+ *                    which swaps edges and faces, then GETMe adaptive on the
+ *                    result.  Tetrahedral meshes only; the log says how many
+ *                    elements it changed
+ *   "worst"          10 (default, 0..10): worst elements kept in the report
+ *                    and logged at log level 2
  * GETME_ERR_ARGUMENT for an unknown name or a value out of range (the
  * reason is in getme_gmsh_options_error()).
  */
@@ -105,6 +114,8 @@ getme_gmsh_options_error(const getme_gmsh_options *options);
 /* Optimizing the current model                                             */
 /* ------------------------------------------------------------------------ */
 
+#define GETME_GMSH_MAX_WORST 10 /* worst elements kept in the report */
+
 typedef struct getme_gmsh_report {
     int dim;                    /* 3 or 2: dimension smoothed                */
     int num_entities;           /* entities smoothed together                */
@@ -123,6 +134,21 @@ typedef struct getme_gmsh_report {
        [type][measure] as getme_mesh_measure_all() gives them. */
     getme_measure_stats measures_before[GETME_NUM_TYPES][GETME_NUM_MEASURES];
     getme_measure_stats measures_after[GETME_NUM_TYPES][GETME_NUM_MEASURES];
+    /* The worst elements after smoothing and why each stays bad
+       (getme_mesh_worst_elements; element = index in the smoothed mesh):
+       worst over all elements, worst_free over those with a free node.
+       *_tag: their Gmsh element tags. */
+    int32_t num_worst, num_worst_free;
+    getme_worst_element worst[GETME_GMSH_MAX_WORST];
+    getme_worst_element worst_free[GETME_GMSH_MAX_WORST];
+    size_t worst_tag[GETME_GMSH_MAX_WORST];
+    size_t worst_free_tag[GETME_GMSH_MAX_WORST];
+    /* Option "topology": Gmsh's own optimize("") ran first (1), with the
+       element count before and after it and how many of the elements
+       before it are gone (swapped away). */
+    int topology_ran;
+    int32_t topology_elements_before, topology_elements_after;
+    int32_t topology_changed;
 } getme_gmsh_report;
 
 /*
@@ -164,7 +190,11 @@ GETME_GMSH_API getme_status getme_gmsh_quality(
 /* A report value by name, for bindings: "dim", "num_entities", "num_nodes",
    "num_elements", "num_fixed", "num_moved", "wall", "cpu", "iterations",
    "iterations_mean", "iterations_min", "cycles_min", "stop_reason",
-   "threshold", "seconds", "<before|after>_<q_min_star|q_min|q_mean|q_max|
+   "threshold", "seconds", "passes_finish", "moved_finish",
+   "corner_sj_before", "corner_sj_after", "topology_ran",
+   "topology_changed", "topology_elements_before", "topology_elements_after",
+   "num_worst", "num_worst_free", "<worst|worst_free><i>_<tag|index|type|
+   quality|corner_sj|num_free|num_nodes|reason>", "<before|after>_<q_min_star|q_min|q_mean|q_max|
    num_invalid|num_below_04|num_below_01|num_elements|num_free>",
    "<before|after>_hist<0..9>".  NaN for an unknown name. */
 GETME_GMSH_API double getme_gmsh_report_value(const getme_gmsh_report *report,

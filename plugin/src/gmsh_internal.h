@@ -33,6 +33,8 @@ struct getme_gmsh_options {
     int log;            /* 0, 1, 2 */
     int fix_skin;
     int fix_interfaces;
+    int topology;       /* 0/1: Gmsh's optimize("") first when needed */
+    int worst;          /* 0..GETME_GMSH_MAX_WORST                   */
     int num_fix, cap_fix;
     char **fix;         /* physical group names or "dim:tag" */
     char error[256];

@@ -58,6 +58,13 @@ int gg_log_progress(const getme_progress *p, void *user)
                "Laplace iteration %d: worst = %.6g / average = %.6g "
                "(Wall %.3gs)",
                p->iteration, p->q_min_star, p->q_mean, p->elapsed);
+    else if (p->stage == GETME_STAGE_FINISH)
+        gg_log("info",
+               "GETMe finishing pass %d: worst = %.6g / average = %.6g, %ld "
+               "elements below %.4f worked on, %ld raised (Wall %.3gs)",
+               p->iteration, p->q_min_star, p->q_mean,
+               (long)p->num_transformed, p->threshold, (long)p->num_relaxed,
+               p->elapsed);
     else if (p->stage == GETME_STAGE_MEAN)
         gg_log("info",
                "GETMe iteration %d (mean stage): worst = %.6g / average = "

@@ -12,6 +12,7 @@
 #include <gmshc.h>
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 typedef struct gg_run {
@@ -125,6 +126,20 @@ static void log_start(gg_run *run)
     gg_log_measures("before", r->measures_before);
 }
 
+static void log_worst(const char *title, const getme_worst_element *w,
+                      const size_t *tags, int32_t n)
+{
+    if (n == 0)
+        return;
+    gg_log("info", "%s (tag, type, quality, worst corner, free nodes: why it "
+                   "stays):", title);
+    for (int32_t i = 0; i < n; i++)
+        gg_log("info", "  %zu %s q %.4f sj %.4f, %d/%d free: %s", tags[i],
+               getme_type_name(w[i].type), w[i].quality, w[i].corner_sj,
+               w[i].num_free, w[i].num_nodes,
+               getme_worst_reason_string(w[i].reason));
+}
+
 static void log_end(gg_run *run)
 {
     const getme_gmsh_report *r = run->rep;
@@ -142,7 +157,27 @@ static void log_end(gg_run *run)
                "cycles), %ld nodes moved",
                res->iterations, res->iterations_mean, res->iterations_min,
                res->cycles_min, (long)r->num_moved);
+    if (res->passes_finish)
+        gg_log("info", "%d finishing passes raised %ld elements",
+               res->passes_finish, (long)res->moved_finish);
+    if (res->corner_sj_initial < 1.0 || res->corner_sj < 1.0)
+        gg_log("info", "Worst corner scaled Jacobian (hex, prism, pyramid, "
+                       "quad): %.4g before, %.4g after",
+               res->corner_sj_initial, res->corner_sj);
+    if (r->after.q_min < r->after.q_min_star)
+        gg_log("warning", "Worst element %.4g is below the worst with a free "
+                          "node %.4g: no node move can fix it (option "
+                          "topology=1 lets Gmsh's optimizer swap it away)",
+               r->after.q_min, r->after.q_min_star);
+    if (run->opt->log >= 2) {
+        log_worst("Worst elements", r->worst, r->worst_tag, r->num_worst);
+        if (r->after.q_min < r->after.q_min_star)
+            log_worst("Worst elements with a free node", r->worst_free,
+                      r->worst_free_tag, r->num_worst_free);
+    }
 }
+
+static getme_status check_model(gg_run *run);
 
 static getme_status read_and_check(gg_run *run, const int *dim_tags,
                                    size_t n)
@@ -152,6 +187,13 @@ static getme_status read_and_check(gg_run *run, const int *dim_tags,
                                             run->opt, text, sizeof text);
     if (st != GETME_OK)
         return fail(run, st, text);
+    return check_model(run);
+}
+
+/* Sizes and quality of run->model into the report; refuse invalid ones. */
+static getme_status check_model(gg_run *run)
+{
+    getme_status st;
     getme_mesh *mesh = getme_gmsh_model_mesh(run->model);
     getme_gmsh_report *r = run->rep;
     r->dim = getme_gmsh_model_dim(run->model);
@@ -165,6 +207,26 @@ static getme_status read_and_check(gg_run *run, const int *dim_tags,
     if (st != GETME_OK)
         return fail(run, st, getme_mesh_error(mesh));
     return check_valid(run);
+}
+
+/* The worst elements of the smoothed mesh into the report, with their
+   Gmsh tags. */
+static getme_status fill_worst(gg_run *run)
+{
+    getme_mesh *mesh = getme_gmsh_model_mesh(run->model);
+    getme_gmsh_report *r = run->rep;
+    const size_t *tags = getme_gmsh_model_element_tags(run->model);
+    getme_status st = getme_mesh_worst_elements(mesh, run->opt->worst, 0,
+                                                r->worst, &r->num_worst);
+    if (st == GETME_OK)
+        st = getme_mesh_worst_elements(mesh, run->opt->worst,
+                                       GETME_WORST_FREE_ONLY, r->worst_free,
+                                       &r->num_worst_free);
+    for (int32_t i = 0; st == GETME_OK && i < r->num_worst; i++)
+        r->worst_tag[i] = tags[r->worst[i].element];
+    for (int32_t i = 0; st == GETME_OK && i < r->num_worst_free; i++)
+        r->worst_free_tag[i] = tags[r->worst_free[i].element];
+    return st;
 }
 
 static getme_status smooth_and_apply(gg_run *run, int niter)
@@ -181,6 +243,8 @@ static getme_status smooth_and_apply(gg_run *run, int niter)
     /* A cancelled run still leaves a valid, partly smoothed mesh. */
     getme_status st2 = getme_mesh_quality_stats(mesh, -1, &run->rep->after);
     if (st2 == GETME_OK)
+        st2 = fill_worst(run);
+    if (st2 == GETME_OK)
         st2 = getme_mesh_measure_all(mesh, &run->rep->measures_after[0][0]);
     char text[GG_MSG];
     if (st2 == GETME_OK)
@@ -190,6 +254,77 @@ static getme_status smooth_and_apply(gg_run *run, int niter)
     else
         snprintf(text, sizeof text, "%s", getme_mesh_error(mesh));
     return st2 != GETME_OK ? fail(run, st2, text) : st;
+}
+
+static int cmp_size(const void *a, const void *b)
+{
+    size_t x = *(const size_t *)a, y = *(const size_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Option "topology": if some of the worst elements of the current model
+   have no free node (no node move can fix them) and the mesh is all tets,
+   run Gmsh's own optimizer (edge and face swaps) on it first, and count
+   the elements it replaced.  run->model is freed: the caller reads the
+   changed model again. */
+static getme_status topology_first(gg_run *run, const int *dim_tags,
+                                   size_t n)
+{
+    getme_mesh *mesh = getme_gmsh_model_mesh(run->model);
+    getme_gmsh_report *r = run->rep;
+    getme_worst_element w[GETME_GMSH_MAX_WORST];
+    int32_t nw = 0, stuck = 0;
+    if (getme_mesh_worst_elements(mesh, GETME_GMSH_MAX_WORST, 0, w, &nw) !=
+        GETME_OK)
+        return fail(run, GETME_ERR_NOMEM, "out of memory");
+    for (int32_t i = 0; i < nw; i++)
+        stuck += w[i].num_free == 0;
+    int32_t ne = getme_mesh_num_elements(mesh);
+    if (!stuck || getme_mesh_num_elements_of_type(mesh, GETME_TET) != ne) {
+        if (run->opt->log >= 1)
+            gg_log("info", "Topology: %s; Gmsh's optimizer not needed",
+                   stuck ? "not a tetrahedral mesh"
+                         : "every worst element has a free node");
+        return GETME_OK;
+    }
+    size_t *before = malloc((size_t)ne * sizeof *before);
+    if (!before)
+        return fail(run, GETME_ERR_NOMEM, "out of memory");
+    memcpy(before, getme_gmsh_model_element_tags(run->model),
+           (size_t)ne * sizeof *before);
+    qsort(before, (size_t)ne, sizeof *before, cmp_size);
+    getme_gmsh_model_free(run->model);
+    run->model = NULL;
+    if (run->opt->log >= 1)
+        gg_log("info", "Topology: %d of the %d worst elements have no free "
+                       "node; running Gmsh's optimizer first",
+               (int)stuck, (int)nw);
+    int ierr = 0;
+    gmshModelMeshOptimize("", 1, 1, (int *)dim_tags, n, &ierr);
+    char text[GG_MSG];
+    getme_status st = ierr ? GETME_ERR_STATE
+                           : getme_gmsh_model_read(&run->model, dim_tags, n,
+                                                   run->opt, text,
+                                                   sizeof text);
+    if (st == GETME_OK) {
+        int32_t na = getme_gmsh_model_num_elements(run->model), gone = ne;
+        const size_t *after = getme_gmsh_model_element_tags(run->model);
+        for (int32_t i = 0; i < na; i++)
+            gone -= bsearch(&after[i], before, (size_t)ne, sizeof *before,
+                            cmp_size) != NULL;
+        r->topology_ran = 1;
+        r->topology_elements_before = ne;
+        r->topology_elements_after = na;
+        r->topology_changed = gone;
+        if (run->opt->log >= 1)
+            gg_log("info", "Topology: Gmsh's optimizer changed %d elements "
+                           "(%d -> %d elements)",
+                   (int)gone, (int)ne, (int)na);
+    }
+    free(before);
+    if (st != GETME_OK)
+        return fail(run, st, ierr ? "Gmsh's optimize(\"\") failed" : text);
+    return GETME_OK;
 }
 
 getme_status getme_gmsh_optimize(int niter, const int *dim_tags,
@@ -219,6 +354,10 @@ getme_status getme_gmsh_optimize(int niter, const int *dim_tags,
                    ? "smart Laplace"
                    : "GETMe adaptive");
     getme_status st = read_and_check(&run, dim_tags, dim_tags_n);
+    if (st == GETME_OK && options->topology &&
+        (st = topology_first(&run, dim_tags, dim_tags_n)) == GETME_OK &&
+        run.rep->topology_ran)
+        st = check_model(&run);
     if (st == GETME_OK && options->log >= 1)
         log_start(&run);
     if (st == GETME_OK)

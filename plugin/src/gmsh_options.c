@@ -15,6 +15,7 @@ void gg_options_defaults(getme_gmsh_options *opt)
     opt->log = 2;
     opt->fix_skin = 1;
     opt->fix_interfaces = 1;
+    opt->worst = GETME_GMSH_MAX_WORST;
 }
 
 getme_gmsh_options *getme_gmsh_options_new(void)
@@ -42,7 +43,8 @@ static getme_status bad(getme_gmsh_options *opt, const char *fmt,
     return GETME_ERR_ARGUMENT;
 }
 
-/* Our own names take 0/1 (fix_*) or 0..2 (log); the rest is libgetme's. */
+/* Our own names take 0/1 (fix_*, topology), 0..2 (log) or
+   0..GETME_GMSH_MAX_WORST (worst); the rest is libgetme's. */
 getme_status getme_gmsh_options_set(getme_gmsh_options *opt, const char *name,
                                     double value)
 {
@@ -52,9 +54,13 @@ getme_status getme_gmsh_options_set(getme_gmsh_options *opt, const char *name,
     int *flag = strcmp(name, "log") == 0              ? &opt->log
                 : strcmp(name, "fix_skin") == 0       ? &opt->fix_skin
                 : strcmp(name, "fix_interfaces") == 0 ? &opt->fix_interfaces
+                : strcmp(name, "topology") == 0       ? &opt->topology
+                : strcmp(name, "worst") == 0          ? &opt->worst
                                                       : NULL;
     if (flag) {
-        double hi = flag == &opt->log ? 2 : 1;
+        double hi = flag == &opt->log     ? 2
+                    : flag == &opt->worst ? GETME_GMSH_MAX_WORST
+                                          : 1;
         if (!(value >= 0 && value <= hi) || value != (int)value)
             return bad(opt, "Option '%s' must be an integer in [0, %g]", name,
                        hi);

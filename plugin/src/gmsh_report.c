@@ -4,6 +4,7 @@
  */
 #include "gmsh_internal.h"
 
+#include <ctype.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -52,10 +53,38 @@ static double stats_value(const getme_quality_stats *s, const char *name)
     return NAN;
 }
 
+/* "worst3_quality" and the like: entry i of one of the worst lists. */
+static double worst_value(const getme_gmsh_report *r, const char *name)
+{
+    int free_only = strncmp(name, "worst_free", 10) == 0;
+    const char *p = name + (free_only ? 10 : 5);
+    char *end;
+    long i = strtol(p, &end, 10);
+    int32_t n = free_only ? r->num_worst_free : r->num_worst;
+    if (end == p || *end != '_' || i < 0 || i >= n)
+        return NAN;
+    const getme_worst_element *w = free_only ? &r->worst_free[i] : &r->worst[i];
+    size_t tag = free_only ? r->worst_free_tag[i] : r->worst_tag[i];
+    static const char *const names[] = {"tag", "index", "type", "quality",
+                                        "corner_sj", "num_free", "num_nodes",
+                                        "reason"};
+    const double values[] = {(double)tag, w->element, w->type, w->quality,
+                             w->corner_sj, w->num_free, w->num_nodes,
+                             w->reason};
+    for (size_t k = 0; k < sizeof names / sizeof *names; k++)
+        if (strcmp(end + 1, names[k]) == 0)
+            return values[k];
+    return NAN;
+}
+
 double getme_gmsh_report_value(const getme_gmsh_report *r, const char *name)
 {
     if (!r || !name)
         return NAN;
+    if (strncmp(name, "worst", 5) == 0 && name[5] != 0 &&
+        (isdigit((unsigned char)name[5]) || strncmp(name, "worst_free", 10) == 0) &&
+        strcmp(name, "worst_free") != 0)
+        return worst_value(r, name);
     if (strncmp(name, "before_", 7) == 0)
         return stats_value(&r->before, name + 7);
     if (strncmp(name, "after_", 6) == 0)
@@ -65,7 +94,10 @@ double getme_gmsh_report_value(const getme_gmsh_report *r, const char *name)
         "dim", "num_entities", "num_nodes", "num_elements", "num_fixed",
         "num_moved", "wall", "cpu", "iterations", "iterations_mean",
         "iterations_min", "cycles_min", "stop_reason", "threshold",
-        "seconds"};
+        "seconds", "passes_finish", "moved_finish", "corner_sj_before",
+        "corner_sj_after", "topology_ran", "topology_changed",
+        "topology_elements_before", "topology_elements_after", "num_worst",
+        "num_worst_free"};
     const double values[] = {r->dim,
                              r->num_entities,
                              r->num_nodes,
@@ -80,7 +112,17 @@ double getme_gmsh_report_value(const getme_gmsh_report *r, const char *name)
                              res->cycles_min,
                              (double)res->stop_reason,
                              res->threshold,
-                             res->seconds};
+                             res->seconds,
+                             res->passes_finish,
+                             res->moved_finish,
+                             res->corner_sj_initial,
+                             res->corner_sj,
+                             r->topology_ran,
+                             r->topology_changed,
+                             r->topology_elements_before,
+                             r->topology_elements_after,
+                             r->num_worst,
+                             r->num_worst_free};
     for (size_t i = 0; i < sizeof names / sizeof *names; i++)
         if (strcmp(name, names[i]) == 0)
             return values[i];

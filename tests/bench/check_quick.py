@@ -31,12 +31,12 @@ def check(cond, what):
 
 
 EXPECTED = {  # method keys per case (netgen may be "skipped")
-    "tet": ["getme-1", "getme-2", "laplace-1", "laplace-2", "gmsh-default",
+    "tet": ["getme-1", "getme-2", "paper-1", "paper-2", "laplace-1", "laplace-2", "gmsh-default",
             "gmsh-relocate3d", "netgen"],
-    "hex": ["getme-1", "getme-2", "laplace-1", "laplace-2", "gmsh-default", "gmsh-relocate3d"],
-    "mixed": ["getme-1", "getme-2", "laplace-1", "laplace-2", "gmsh-default", "gmsh-relocate3d"],
-    "tri": ["getme-1", "getme-2", "laplace-1", "laplace-2", "gmsh-laplace2d", "gmsh-relocate2d"],
-    "quad": ["getme-1", "getme-2", "laplace-1", "laplace-2", "gmsh-laplace2d", "gmsh-relocate2d"],
+    "hex": ["getme-1", "getme-2", "paper-1", "paper-2", "laplace-1", "laplace-2", "gmsh-default", "gmsh-relocate3d"],
+    "mixed": ["getme-1", "getme-2", "paper-1", "paper-2", "laplace-1", "laplace-2", "gmsh-default", "gmsh-relocate3d"],
+    "tri": ["getme-1", "getme-2", "paper-1", "paper-2", "laplace-1", "laplace-2", "gmsh-laplace2d", "gmsh-relocate2d"],
+    "quad": ["getme-1", "getme-2", "paper-1", "paper-2", "laplace-1", "laplace-2", "gmsh-laplace2d", "gmsh-relocate2d"],
 }
 
 
@@ -59,7 +59,7 @@ def check_case(case, c):
         check(sum(r["histogram"]) + r["invalid"] == r["elements"],
               f"{case}/{key}: histogram sums to the element count")
         check(r["peak_gib"] > 0 and r["seconds"] >= 0, f"{case}/{key}: measured")
-        if key.startswith(("getme", "laplace")):
+        if key.startswith(("getme", "paper", "laplace")):
             check(r["topology"] == "no" and r["boundary_kept"],
                   f"{case}/{key}: topology {r['topology']}")
             check(r["invalid"] == 0, f"{case}/{key}: {r['invalid']} invalid")
@@ -72,7 +72,11 @@ def check_case(case, c):
             check(r["iterations_mean"] > 0 and len(r["history"]) > 0,
                   f"{case}/{key}: iterations and history")
             check_cost(case, key, r)
-    for a, b in (("getme-1", "getme-2"), ("laplace-1", "laplace-2")):
+    # the finishing step starts from the paper's result and never lowers it
+    if rows["getme-1"]["status"] == "ok" and rows["paper-1"]["status"] == "ok":
+        check(rows["getme-1"]["q_min_star"] >= rows["paper-1"]["q_min_star"],
+              f"{case}: q*min with the finishing step below the paper's")
+    for a, b in (("getme-1", "getme-2"), ("paper-1", "paper-2"), ("laplace-1", "laplace-2")):
         ra, rb = rows[a], rows[b]
         if ra["status"] == "ok" and rb["status"] == "ok":
             check(ra["q_mean"] == rb["q_mean"] and ra["q_min_star"] == rb["q_min_star"]
@@ -95,7 +99,7 @@ def check_cost(case, key, r):
     check(r.get("threads") == int(key.split("-")[1]),
           f"{case}/{key}: threads {r.get('threads')}")
     check(_positive(r.get("ns_el_it")), f"{case}/{key}: ns_el_it {r.get('ns_el_it')}")
-    if key.startswith("getme"):
+    if key.startswith(("getme", "paper")):
         check(r.get("stage1_iterations") == r["iterations_mean"],
               f"{case}/{key}: stage-1 iterations {r.get('stage1_iterations')} "
               f"!= iterations_mean {r['iterations_mean']}")

@@ -228,6 +228,47 @@ def test_gui_logic():
     check(gmsh.onelab.getString("ONELAB/Action") == [""], "action consumed")
 
 
+def test_worst_and_topology():
+    """A cylinder with a coarse curved skin: Gmsh leaves tets that span
+    between skin nodes (no free node).  The report names them as such, the
+    free-node list starts at q*min, and topology=1 hands them to Gmsh's
+    optimizer first, which then changes some elements."""
+    for topology in (0, 1):
+        gmsh.model.add("cyl%d" % topology)
+        gmsh.model.occ.addCylinder(0, 0, 0, 0, 0, 1, 0.3)
+        gmsh.model.occ.synchronize()
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 0.12)
+        gmsh.option.setNumber("Mesh.Optimize", 0)
+        gmsh.model.mesh.generate(3)
+        r = getme.gmsh.optimize(log=0, topology=topology)
+        worst, free = r["worst"], r["worst_free"]
+        check(len(worst) == 10 and len(free) == 10, "ten worst of each kind")
+        check(abs(worst[0]["quality"] - r["q_min_after"]) < 1e-12,
+              "worst = qmin")
+        check(abs(free[0]["quality"] - r["q_min_star_after"]) < 1e-12,
+              "worst with a free node = q*min")
+        check(all(w["num_free"] == 0 and w["reason"] == "all_nodes_fixed"
+                  for w in worst if w["quality"] < r["q_min_star_after"]),
+              "elements below q*min have no free node and say so")
+        check(all(w["num_free"] > 0 and w["reason"] in
+                  ("improvable", "local_optimum") for w in free),
+              "free-node reasons")
+        etags, _ = gmsh.model.mesh.getElementsByType(4)
+        check(set(w["tag"] for w in worst) <= set(etags.tolist()),
+              "worst tags are the model's")
+        stuck = r["q_min_after"] < r["q_min_star_after"]
+        if topology == 0:
+            check(stuck, "the test model has worst elements without a free node")
+            check(r["topology"] is None, "no topology step unless asked")
+        else:
+            t = r["topology"]
+            check(t is not None and t["changed"] > 0 and
+                  t["elements_after"] == len(etags),
+                  "topology=1 ran Gmsh's optimizer: %s" % t)
+        gmsh.model.remove()
+    gmsh.option.setNumber("Mesh.Optimize", 1)
+
+
 if __name__ == "__main__":
     WORK = tempfile.mkdtemp(prefix="getme_plugin_")
     gmsh.initialize()
@@ -243,6 +284,7 @@ if __name__ == "__main__":
                  n, s))
     test_bad_uses()
     test_gui_logic()
+    test_worst_and_topology()
     gmsh.finalize()
     print("plugin_gmsh_python: %d failed" % len(FAILS))
     sys.exit(1 if FAILS else 0)

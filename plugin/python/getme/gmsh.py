@@ -12,11 +12,21 @@ method     "getme" (GETMe adaptive) or "laplace" (smart Laplace)
 fix        physical group names (or "dim:tag") whose nodes stay fixed
 log        0 silent, 1 summary + histograms, 2 also one line per iteration
 params     any libgetme parameter: sigma, max_iter, tol, threshold_fraction,
-           max_no_min_improve, keep_best, num_threads, renumber; and
-           fix_skin, fix_interfaces (0/1)
+           max_no_min_improve, min_tol, keep_best, finish (1: finishing
+           step after the q*min stage; 0: the paper's method alone),
+           finish_fraction, finish_max_passes, corner_guard, corner_floor,
+           num_threads, renumber; and fix_skin, fix_interfaces (0/1),
+           topology (1: Gmsh's own optimize("") first when some of the
+           worst elements have no free node; tet meshes), worst (0..10)
 
-Returns a dict: iterations (total, mean stage, min stage, cycles),
-q_min_star / q_min / q_mean before and after, nodes moved, seconds, and
+Returns a dict: iterations (total, mean stage, min stage, cycles,
+finishing passes), q_min_star / q_min / q_mean before and after, the worst
+corner scaled Jacobian before and after, nodes moved, seconds, "worst" and
+"worst_free": the worst elements (all, and those with a free node) as
+dicts {"tag", "type", "quality", "corner_sj", "num_free", "num_nodes",
+"reason"} with reason one of "improvable", "all_nodes_fixed",
+"fixed_interface", "local_optimum"; "topology": what Gmsh's optimizer did
+(option topology=1) or None; and
 measures_before / measures_after: {type: {measure: {"min", "max", "mean",
 "num_elements", "num_negative", "histogram", ...}}} for the dihedral
 angles, scaled Jacobian, Gmsh's gamma and SICN (docs/quality.md).
@@ -32,7 +42,23 @@ from .quality import stats_dict
 
 _VALUES = ("dim", "num_entities", "num_nodes", "num_elements", "num_fixed",
            "num_moved", "wall", "cpu", "iterations", "iterations_mean",
-           "iterations_min", "cycles_min", "threshold")
+           "iterations_min", "cycles_min", "threshold", "passes_finish",
+           "moved_finish", "corner_sj_before", "corner_sj_after")
+_TYPES = ("tet", "hex", "prism", "pyramid", "tri", "quad")
+_REASONS = ("improvable", "all_nodes_fixed", "fixed_interface",
+            "local_optimum")
+
+
+def _worst_list(val, which):
+    out = []
+    for i in range(int(val("num_" + which))):
+        get = lambda k: val("%s%d_%s" % (which, i, k))  # noqa: E731
+        out.append({"tag": int(get("tag")), "type": _TYPES[int(get("type"))],
+                    "quality": get("quality"), "corner_sj": get("corner_sj"),
+                    "num_free": int(get("num_free")),
+                    "num_nodes": int(get("num_nodes")),
+                    "reason": _REASONS[int(get("reason"))]})
+    return out
 
 
 def _options(method, fix, log, params):
@@ -69,8 +95,15 @@ def _report_dict(rep):
     out = {k: val(k) for k in _VALUES}
     for k in ("dim", "num_entities", "num_nodes", "num_elements",
               "num_fixed", "num_moved", "iterations", "iterations_mean",
-              "iterations_min", "cycles_min"):
+              "iterations_min", "cycles_min", "passes_finish",
+              "moved_finish"):
         out[k] = int(out[k])
+    out["worst"] = _worst_list(val, "worst")
+    out["worst_free"] = _worst_list(val, "worst_free")
+    out["topology"] = None
+    if val("topology_ran") == 1:
+        out["topology"] = {k: int(val("topology_" + k)) for k in
+                           ("changed", "elements_before", "elements_after")}
     out["seconds"] = out.pop("wall")
     for when in ("before", "after"):
         for k in ("q_min_star", "q_min", "q_mean", "q_max"):
