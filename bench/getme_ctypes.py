@@ -47,17 +47,25 @@ class Params(C.Structure):  # getme_params of getme.h
                 ("relax_min", C.c_double * MAX_RELAX),
                 ("max_no_min_improve", C.c_int), ("min_tol", C.c_double),
                 ("threshold_fraction", C.c_double), ("keep_best", C.c_int),
+                ("finish", C.c_int), ("finish_fraction", C.c_double),
+                ("finish_max_passes", C.c_int), ("corner_guard", C.c_int),
+                ("corner_floor", C.c_double),
                 ("num_threads", C.c_int), ("renumber", C.c_int),
+                ("untangle", C.c_int),
                 ("progress", PROGRESS_FN), ("progress_data", C.c_void_p)]
 
 
 class Result(C.Structure):
     _fields_ = [("iterations", C.c_int), ("iterations_mean", C.c_int),
                 ("iterations_min", C.c_int), ("cycles_min", C.c_int),
+                ("passes_finish", C.c_int), ("moved_finish", C.c_int32),
+                ("corner_sj_initial", C.c_double), ("corner_sj", C.c_double),
                 ("q_min_star_initial", C.c_double), ("q_mean_initial", C.c_double),
                 ("q_min_star", C.c_double), ("q_mean", C.c_double),
                 ("q_min", C.c_double), ("threshold", C.c_double),
-                ("seconds", C.c_double), ("stop_reason", C.c_int)]
+                ("seconds", C.c_double), ("stop_reason", C.c_int),
+                ("num_invalid_initial", C.c_int64), ("untangle_sweeps", C.c_int),
+                ("untangle_seconds", C.c_double)]
 
 
 class Lib:

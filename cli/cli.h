@@ -3,7 +3,8 @@
  *
  * Exit codes (stable, for scripts): 0 success, 1 internal error, 2 usage,
  * 3 cannot read the input, 4 malformed input, 5 unsupported content,
- * 6 invalid (inverted) elements in the input, 7 cannot write the output.
+ * 6 invalid (inverted) elements in the input (with --no-untangle), 7 cannot
+ * write the output, 8 invalid elements that untangling could not repair.
  * They equal getme_io_status values.
  */
 #ifndef GETME_CLI_H
@@ -130,6 +131,7 @@ typedef struct cli_history {
 typedef struct cli_smooth_opts {
     const char **fix, **free_sets;
     int num_fix, num_free, free_interfaces;
+    int allow_invalid;   /* --allow-invalid: write a partly untangled mesh */
     const char *report;
     getme_params params;
     cli_log log;
@@ -150,6 +152,11 @@ void cli_smooth_doc_options(const cli_smooth_opts *o, getme_doc_options *d);
    decided, "Optimizing mesh (...)..." logged; the parameters are copied to
    *params when that is not o->params. */
 void cli_smooth_begin(cli_smooth_opts *o, getme_params *params);
+/* The thread count decided (OMP_NUM_THREADS or every core) if not given. */
+void cli_smooth_threads(cli_smooth_opts *o);
+/* "N invalid (inverted or degenerate) elements in the input, M remain
+   after untangling (...)". */
+void cli_untangle_warning(const cli_log *log, const getme_untangle_result *ur);
 /* "Done optimizing mesh (Wall ...): N + M iterations (K q*min cycles)". */
 void cli_smooth_done(const cli_smooth_opts *o, const getme_result *res);
 

@@ -32,6 +32,9 @@ static const char GMSH_HELP[] =
     "                        .vtk, .unv, ...), chosen by its extension\n"
     "  -format msh22|msh41   MSH version of the output (default 4.1)\n"
     "  -bin                  binary MSH\n"
+    "  --topology            when some of the worst tets have no free node (no\n"
+    "                        node move can fix them), run Gmsh's optimize(\"\")\n"
+    "                        (edge/face swaps) first, then GETMe adaptive\n"
     "smooth options (as getme smooth; --fix also takes GROUP,GROUP,...):\n";
 
 static const char GMSH_HELP_TAIL[] =
@@ -41,7 +44,7 @@ typedef struct gmsh_args {
     const char *input, *output;
     int dim;
     double clmax, clmin, msh_version;
-    int binary;
+    int binary, topology;
     cli_smooth_opts o;
 } gmsh_args;
 
@@ -69,8 +72,8 @@ static int parse_one(gmsh_args *a, int argc, char **argv, int *i)
         a->dim = o[1] - '0';
         return 0;
     }
-    if (!strcmp(o, "-bin")) {
-        a->binary = 1;
+    if (!strcmp(o, "-bin") || !strcmp(o, "--topology")) {
+        *(o[1] == 'b' ? &a->binary : &a->topology) = 1;
         return 0;
     }
     static const char *const with_value[] = {
@@ -207,12 +210,14 @@ static int open_and_mesh(const gmsh_args *a)
     return GETME_IO_OK;
 }
 
-static int exit_code(getme_status st)
+static int exit_code(getme_status st, const getme_gmsh_report *rep)
 {
     switch (st) {
     case GETME_OK: return 0;
     case GETME_ERR_ARGUMENT: return GETME_IO_ERR_USAGE;
-    case GETME_ERR_INVALID_MESH: return GETME_IO_ERR_INVALID;
+    case GETME_ERR_INVALID_MESH: /* 8 if untangling ran and fell short */
+        return rep->untangle.num_invalid_before ? GETME_IO_ERR_TANGLED
+                                                : GETME_IO_ERR_INVALID;
     case GETME_ERR_STATE:
     case GETME_ERR_TOPOLOGY: return GETME_IO_ERR_UNSUPPORTED;
     default: return GETME_IO_ERR_INTERNAL;
@@ -346,6 +351,8 @@ static int smooth_model(gmsh_args *a, gmsh_result *res)
     }
     getme_gmsh_options_set(opt, "log", 0);
     getme_gmsh_options_set(opt, "fix_interfaces", !so->free_interfaces);
+    getme_gmsh_options_set(opt, "allow_invalid", so->allow_invalid);
+    getme_gmsh_options_set(opt, "topology", a->topology);
     for (int i = 0; i < so->num_fix && rc == 0; i++)
         rc = add_fixed_groups(opt, so->fix[i]);
     if (rc == 0 && so->num_free &&
@@ -367,6 +374,8 @@ static int smooth_model(gmsh_args *a, gmsh_result *res)
         cli_print_measures(&so->log, "Measures before", &res->mbefore);
         cli_smooth_begin(so, getme_gmsh_options_params(opt));
         st = getme_gmsh_optimize(0, NULL, 0, opt, rep);
+        if (rep->untangle.num_invalid_before)
+            cli_untangle_warning(&so->log, &rep->untangle);
         if (st == GETME_OK) {
             cli_smooth_done(so, &rep->result);
             cli_print_stats(&so->log, "Quality after ", &rep->after);
@@ -378,7 +387,7 @@ static int smooth_model(gmsh_args *a, gmsh_result *res)
     }
     if (st != GETME_OK) {
         cli_error("%s", rep->message[0] ? rep->message : getme_status_string(st));
-        rc = exit_code(st);
+        rc = exit_code(st, rep);
     }
     getme_gmsh_options_free(opt);
     return rc;
@@ -414,8 +423,12 @@ static int run(gmsh_args *a)
         rc = smooth_model(a, &res);
     cli_guard guard = {0};
     cli_write_guard(&guard, 1);
-    if (rc == 0)
-        rc = write_output(a, paths.out, out);
+    if (rc == 0 ||
+        (rc == GETME_IO_ERR_TANGLED && a->o.allow_invalid)) {
+        /* --allow-invalid: the partly untangled mesh, exit code kept */
+        int wrc = write_output(a, paths.out, out);
+        rc = rc ? rc : wrc;
+    }
     if (rc == 0 && a->o.report &&
         cli_write_report(paths.rep, a->input, out, &a->o.params, &res.counts,
                          &res.before, &res.rep.after, &res.rep.result,

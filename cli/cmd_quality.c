@@ -4,16 +4,21 @@
  */
 #include "cli.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 static const char QUALITY_HELP[] =
-    "usage: getme quality IN [--fix NAME]... [--free NAME]... [--free-interfaces] [-q]\n"
+    "usage: getme quality IN [--fix NAME]... [--free NAME]... [--free-interfaces]\n"
+    "                        [--worst N] [-q]\n"
     "\n"
     "Print the mean ratio quality of the mesh in IN per element type: q*min\n"
     "(worst element with a free node), qmin, qmean, and a histogram like\n"
     "Gmsh's; then, per element type, min, max, mean and a histogram of the\n"
     "min and max dihedral angle (planar: corner angles), the scaled\n"
     "Jacobian (Verdict/CUBIT), Gmsh's gamma and SICN (docs/quality.md).\n"
+    "With --worst N, the N worst elements, and the N worst with a free node,\n"
+    "each with why it cannot get better by moving nodes (all nodes fixed, on\n"
+    "a fixed interface, free nodes at a local optimum, or still improvable).\n"
     "Exit code 6 if the mesh has invalid (inverted) elements.\n";
 
 static void print_type(const cli_log *log, getme_mesh *mesh, int type)
@@ -40,6 +45,7 @@ int cli_quality(int argc, char **argv)
     cli_log log = {0, 1};
     const char *input = NULL;
     const char *names[64], *frees[64];
+    long worst = 0;
     getme_doc_options opts;
     getme_doc_options_init(&opts);
     opts.fix = names;
@@ -59,6 +65,9 @@ int cli_quality(int argc, char **argv)
             (fix ? names : frees)[(*n)++] = argv[++i];
         } else if (!strcmp(o, "--free-interfaces")) {
             opts.fix_interfaces = 0;
+        } else if (!strcmp(o, "--worst") && i + 1 < argc) {
+            if (cli_parse_int(o, argv[++i], 0, 1000000, &worst) != 0)
+                return EXIT_USAGE;
         } else if (!strcmp(o, "-q") || !strcmp(o, "--quiet")) {
             log.quiet = 1;
         } else if (o[0] == '-' && o[1]) {
@@ -98,6 +107,15 @@ int cli_quality(int argc, char **argv)
         }
     if (types > 1)
         print_type(&log, mesh, -1);
+    cli_worst_list w = {0}, wf = {0};
+    if (worst > 0 && (cli_worst(doc, (int32_t)worst, 0, &w) != 0 ||
+                      cli_worst(doc, (int32_t)worst, GETME_WORST_FREE_ONLY,
+                                &wf) != 0))
+        st = GETME_IO_ERR_INTERNAL;
+    cli_print_worst(&log, doc, &w, "");
+    cli_print_worst(&log, doc, &wf, " with a free node");
+    free(w.items);
+    free(wf.items);
     if (st == GETME_IO_ERR_INVALID)
         cli_error("%s", getme_doc_error(doc));
     getme_doc_close(doc);

@@ -28,9 +28,15 @@ static const char SMOOTH_HELP_HEAD[] =
 
 static const char SMOOTH_HELP_TAIL[] =
     "\n"
+    "An input with invalid elements is untangled first (free nodes near them\n"
+    "move until every element is valid, docs/untangle.md), with a warning\n"
+    "saying how many were invalid and how many remain, then smoothed.\n"
+    "\n"
     "exit codes: 0 ok, 1 internal error, 2 usage, 3 cannot read input,\n"
-    "4 malformed input, 5 unsupported content, 6 invalid elements in input,\n"
-    "7 cannot write output\n";
+    "4 malformed input, 5 unsupported content, 6 invalid elements in input\n"
+    "(--no-untangle) or degenerate ones (a node twice), 7 cannot write output,\n"
+    "8 invalid elements that could not be untangled (named by their ids in\n"
+    "the file; no output unless --allow-invalid)\n";
 
 typedef struct smooth_args {
     const char *input, *output;
@@ -83,6 +89,65 @@ static int parse(int argc, char **argv, smooth_args *a)
     return 0;
 }
 
+/* Writing the output (termination signals held). */
+static int write_output(const smooth_args *a, const cli_paths *paths,
+                        getme_doc *doc, const char *what)
+{
+    cli_info(&a->o.log, "Writing %s'%s'...", what, a->output);
+    getme_io_status ios = getme_doc_write(doc, paths->out);
+    if (ios != GETME_IO_OK) {
+        cli_error("%s", getme_doc_error(doc));
+        return ios;
+    }
+    cli_info(&a->o.log, "Done writing '%s'", a->output);
+    return 0;
+}
+
+/* Elements listed by file id in the error about elements that stay
+   invalid. */
+#define MAX_NAMED 20
+
+/* Untangle an input with invalid elements: one warning line with the
+   counts; the elements that stay invalid named by their file ids.
+   Returns 0, GETME_IO_ERR_TANGLED or GETME_IO_ERR_INTERNAL. */
+static int untangle(smooth_args *a, getme_doc *doc, getme_untangle_result *ur)
+{
+    getme_mesh *mesh = getme_doc_mesh(doc);
+    cli_smooth_threads(&a->o);
+    int threads = a->o.params.num_threads;
+    cli_info(&a->o.log, "Untangling (%d thread%s)...", threads,
+             threads == 1 ? "" : "s");
+    getme_status st = getme_mesh_untangle(mesh, &a->o.params, ur);
+    if (st != GETME_OK && st != GETME_ERR_INVALID_MESH) {
+        cli_error("%s: %s", a->input, getme_mesh_error(mesh));
+        return GETME_IO_ERR_INTERNAL;
+    }
+    cli_untangle_warning(&a->o.log, ur);
+    long long after = (long long)ur->num_invalid_after;
+    if (after == 0)
+        return 0;
+    int32_t ne = getme_mesh_num_elements(mesh);
+    double *q = malloc((size_t)ne * sizeof *q);
+    char list[MAX_NAMED * 22 + 8] = "";
+    size_t len = 0;
+    int named = 0;
+    if (q && getme_mesh_element_qualities(mesh, q) == GETME_OK)
+        for (int32_t e = 0; e < ne && named < MAX_NAMED; e++)
+            if (!(q[e] > 0.0))
+                len += (size_t)snprintf(list + len, sizeof list - len, "%s%lld",
+                                        named++ ? ", " : "",
+                                        (long long)getme_doc_element_id(doc, e));
+    free(q);
+    cli_error("%s: %lld element%s could not be untangled (%lld with every node "
+              "fixed): %s%s; %s",
+              a->input, after, after == 1 ? "" : "s",
+              (long long)ur->num_stuck, list, after > named ? ", ..." : "",
+              a->o.allow_invalid ? "writing the partly untangled mesh as asked"
+                                 : "no output written (--allow-invalid writes "
+                                   "the partly untangled mesh)");
+    return GETME_IO_ERR_TANGLED;
+}
+
 static int run(smooth_args *a)
 {
     cli_smooth_opts *so = &a->o;
@@ -96,7 +161,8 @@ static int run(smooth_args *a)
         return code;
     double t0 = omp_get_wtime();
     cli_info(log, "Reading '%s'...", a->input);
-    getme_doc *doc = cli_open(a->input, &opts, 0, &code, log);
+    getme_doc *doc = cli_open(a->input, &opts, so->params.untangle, &code,
+                              log);
     if (!doc)
         return code;
     if ((code = cli_check_read_files(&paths, doc)) != 0) {
@@ -116,9 +182,24 @@ static int run(smooth_args *a)
     cli_measures mbefore, mafter;
     cli_measures_log(log, mesh, "Measures before", &mbefore);
     cli_worst_list worst = {0}, worst_free = {0};
+    cli_guard guard = {0};
+    getme_untangle_result ur;
+    memset(&ur, 0, sizeof ur);
+    code = 0;
+    if (before.num_invalid > 0 && (code = untangle(a, doc, &ur)) != 0) {
+        if (code == GETME_IO_ERR_TANGLED && so->allow_invalid) {
+            cli_write_guard(&guard, 1);
+            write_output(a, &paths, doc, "partly untangled, not smoothed, ");
+            cli_write_guard(&guard, 0);
+        }
+        goto out;
+    }
     cli_smooth_begin(so, NULL);
     getme_result res;
     getme_status st = getme_smooth(mesh, &so->params, &res);
+    res.num_invalid_initial = ur.num_invalid_before;
+    res.untangle_sweeps = ur.sweeps;
+    res.untangle_seconds = ur.seconds;
     if (st != GETME_OK) {
         cli_error("%s: %s", a->input, getme_mesh_error(mesh));
         code = st == GETME_ERR_INVALID_MESH ? GETME_IO_ERR_INVALID
@@ -151,22 +232,17 @@ static int run(smooth_args *a)
             cli_print_worst(log, doc, &worst_free, " with a free node");
     }
 
-    cli_info(log, "Writing '%s'...", a->output);
-    cli_guard guard = {0};
     cli_write_guard(&guard, 1);
     cli_file_stamp report_was;
     cli_stamp(paths.rep, &report_was);
-    getme_io_status ios = getme_doc_write(doc, paths.out);
-    if (ios != GETME_IO_OK) {
-        cli_error("%s", getme_doc_error(doc));
-        code = ios;
+    if ((code = write_output(a, &paths, doc, "")) != 0) {
+        /* the message is printed */
     } else if (so->report && cli_replaced(paths.rep, &report_was)) {
         /* the report names a file the output wrote (an INP include copy) */
         cli_error("report %s: it is a file the output just wrote; not "
                   "replacing it (choose another report file)", so->report);
         code = EXIT_USAGE;
     } else {
-        cli_info(log, "Done writing '%s'", a->output);
         cli_mesh_counts counts;
         cli_count_mesh(mesh, &counts);
         cli_report_extra extra = {doc, &worst, &worst_free, &mbefore,

@@ -29,8 +29,9 @@ static const char HELP[] =
     "  getme quality part-smooth.msh\n"
     "\n"
     "exit codes: 0 ok, 1 internal error, 2 usage, 3 cannot read input,\n"
-    "4 malformed input, 5 unsupported content, 6 invalid elements in input,\n"
-    "7 cannot write output\n";
+    "4 malformed input, 5 unsupported content, 6 invalid elements in input\n"
+    "(--no-untangle), 7 cannot write output, 8 invalid elements that could\n"
+    "not be untangled\n";
 
 static int list_formats(void)
 {

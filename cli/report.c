@@ -122,6 +122,10 @@ int cli_write_report(const char *path, const char *input, const char *output,
                "\"finish_improved\": %d},\n",
             r->iterations, r->iterations_mean, r->iterations_min, r->cycles_min,
             r->passes_finish, (int)r->moved_finish);
+    fprintf(f, "  \"untangle\": {\"invalid\": %lld, \"sweeps\": %d, "
+               "\"seconds\": %.6f},\n",
+            (long long)r->num_invalid_initial, r->untangle_sweeps,
+            r->untangle_seconds);
     fprintf(f, "  \"corner_sj\": {\"before\": %.17g, \"after\": %.17g},\n",
             r->corner_sj_initial, r->corner_sj);
     if (x && x->doc && x->worst && x->worst_free) {

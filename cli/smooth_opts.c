@@ -20,6 +20,12 @@ const char CLI_SMOOTH_OPTIONS_HELP[] =
     "                         fix no set by name, but the name must exist\n"
     "                         (repeatable)\n"
     "  --free-interfaces      let nodes on region interfaces move\n"
+    "  --no-untangle          refuse an input with invalid (inverted or\n"
+    "                         degenerate) elements (exit 6) instead of\n"
+    "                         untangling it first\n"
+    "  --allow-invalid        if untangling leaves invalid elements, still\n"
+    "                         write the partly untangled (unsmoothed) mesh\n"
+    "                         (the exit code stays 8)\n"
     "  --param NAME=VALUE     any smoothing parameter: sigma (1.5), tol (1e-4),\n"
     "                         threshold_fraction (0.005), max_no_min_improve (5),\n"
     "                         min_tol (1e-5), keep_best (1), renumber (1),\n"
@@ -85,6 +91,10 @@ int cli_smooth_option(cli_smooth_opts *o, int argc, char **argv, int *i)
     if (!takes) {
         if (!strcmp(opt, "--free-interfaces"))
             o->free_interfaces = 1;
+        else if (!strcmp(opt, "--no-untangle"))
+            o->params.untangle = 0;
+        else if (!strcmp(opt, "--allow-invalid"))
+            o->allow_invalid = 1;
         else if (!strcmp(opt, "-q") || !strcmp(opt, "--quiet"))
             o->log.quiet = 1;
         else if (!strcmp(opt, "-v") || !strcmp(opt, "--verbose"))
@@ -177,10 +187,8 @@ static int on_progress(const getme_progress *p, void *data)
     return 0;
 }
 
-void cli_smooth_begin(cli_smooth_opts *o, getme_params *params)
+void cli_smooth_threads(cli_smooth_opts *o)
 {
-    o->params.progress = on_progress;
-    o->params.progress_data = o;
     /* Gmsh's initialisation sets OpenMP's global thread count to 1, so
        "default" must be decided here: OMP_NUM_THREADS if set, else every
        core. */
@@ -189,6 +197,25 @@ void cli_smooth_begin(cli_smooth_opts *o, getme_params *params)
         int n = env ? atoi(env) : 0;
         o->params.num_threads = n > 0 ? n : omp_get_num_procs();
     }
+}
+
+void cli_untangle_warning(const cli_log *log, const getme_untangle_result *ur)
+{
+    long long before = (long long)ur->num_invalid_before,
+              after = (long long)ur->num_invalid_after;
+    cli_warning(log, "%lld invalid (inverted or degenerate) element%s in "
+                     "the input, %lld remain%s after untangling (%d "
+                     "sweep%s, %d nodes moved, %.3f s)",
+                before, before == 1 ? "" : "s", after,
+                after == 1 ? "s" : "", ur->sweeps, ur->sweeps == 1 ? "" : "s",
+                (int)ur->num_moved, ur->seconds);
+}
+
+void cli_smooth_begin(cli_smooth_opts *o, getme_params *params)
+{
+    o->params.progress = on_progress;
+    o->params.progress_data = o;
+    cli_smooth_threads(o);
     /* the parameters actually used (getme gmsh: inside its options) */
     if (params && params != &o->params)
         *params = o->params;

@@ -71,6 +71,11 @@ const char *getme_doc_warning(const getme_doc *doc)
 
 getme_mesh *getme_doc_mesh(getme_doc *doc) { return doc ? doc->mesh : NULL; }
 
+int64_t getme_doc_element_id(const getme_doc *doc, int32_t e)
+{
+    return doc->elem_ids ? doc->elem_ids[e] : (int64_t)e + 1;
+}
+
 /* Name the first invalid elements by their ids in the file. */
 static getme_io_status check_valid(getme_doc *doc)
 {
@@ -83,8 +88,7 @@ static getme_io_status check_valid(getme_doc *doc)
     char list[256] = "";
     size_t len = 0;
     for (int i = 0; i < sp->num_reported_invalid && len < sizeof list; i++) {
-        int32_t e = sp->first_invalid[i];
-        long long id = doc->elem_ids ? (long long)doc->elem_ids[e] : (long long)e + 1;
+        long long id = (long long)getme_doc_element_id(doc, sp->first_invalid[i]);
         len += (size_t)snprintf(list + len, sizeof list - len, "%s%lld",
                                 i ? ", " : "", id);
     }

@@ -513,6 +513,9 @@ typedef struct getme_params {
                                   (results stay bit-identical for any thread
                                   count; they may differ in the last bits
                                   from renumber = 0)                          */
+    int untangle;              /* 1: getme_smooth() first untangles an input
+                                  with invalid elements (getme_mesh_untangle)
+                                  instead of refusing it; 0: refuse          */
     getme_progress_fn progress;/* optional, called after every iteration     */
     void *progress_data;
 } getme_params;
@@ -525,7 +528,7 @@ GETME_API void getme_params_init(getme_params *params);
  * "max_iter", "tol", "sigma", "max_no_min_improve", "min_tol",
  * "threshold_fraction", "keep_best", "finish", "finish_fraction",
  * "finish_max_passes", "corner_guard", "corner_floor", "num_threads",
- * "renumber".  Returns GETME_ERR_ARGUMENT for
+ * "renumber", "untangle".  Returns GETME_ERR_ARGUMENT for
  * an unknown name or a value out of range.  For bindings (Python, CLI).
  */
 GETME_API getme_status getme_params_set(getme_params *params, const char *name,
@@ -564,11 +567,17 @@ typedef struct getme_result {
     double threshold;         /* last transformation threshold q_t           */
     double seconds;           /* wall time of getme_smooth()                  */
     getme_stop_reason stop_reason;
+    int64_t num_invalid_initial; /* invalid elements in the input, untangled
+                                  before smoothing (params->untangle)        */
+    int untangle_sweeps;      /* untangling sweeps (0 if the input was valid)*/
+    double untangle_seconds;  /* wall time of the untangling, part of seconds*/
 } getme_result;
 
 /*
- * Smooth the mesh in place with params (NULL: defaults).  The mesh must be
- * valid: otherwise GETME_ERR_INVALID_MESH, with the count and the first
+ * Smooth the mesh in place with params (NULL: defaults).  An input with
+ * invalid elements is first untangled as by getme_mesh_untangle() (unless
+ * params->untangle is 0); if that leaves invalid elements, or untangling is
+ * off, the result is GETME_ERR_INVALID_MESH, with the count and the first
  * invalid elements in the message, and nothing moves.  Fixed nodes never
  * move (bit for bit); the output is valid.  result may be NULL.
  * GETME_ERR_CANCELLED is returned (with a valid, partly smoothed mesh and a
@@ -577,6 +586,42 @@ typedef struct getme_result {
 GETME_API getme_status getme_smooth(getme_mesh *mesh,
                                     const getme_params *params,
                                     getme_result *result);
+
+/* ------------------------------------------------------------------------ */
+/* Untangling                                                               */
+/* ------------------------------------------------------------------------ */
+
+typedef struct getme_untangle_result {
+    int64_t num_invalid_before; /* invalid elements at the start           */
+    int64_t num_invalid_after;  /* invalid elements at the end (0: success) */
+    int64_t num_stuck;          /* of those, elements without a free node   */
+    int32_t num_reported;       /* entries used in remaining                */
+    int32_t remaining[GETME_MAX_REPORTED_INVALID]; /* smallest indices of
+                                   the elements still invalid              */
+    int32_t num_moved;          /* nodes that moved                         */
+    int sweeps;                 /* sweeps over the moving nodes             */
+    int rings;                  /* rings of nodes added around the invalid
+                                   elements' nodes (0: only their own)      */
+    double seconds;
+} getme_untangle_result;
+
+/*
+ * Untangle the mesh in place: move free nodes near invalid (inverted or
+ * degenerate) elements until every element is valid in the sense of
+ * getme_element_quality() > 0 (docs/untangle.md: Escobar et al.'s modified
+ * mean ratio, minimised node by node in colour order).  Only free nodes of
+ * invalid elements, and if needed up to three rings of free nodes around
+ * them, move; all others stay bit for bit.  Uses params->num_threads and
+ * params->renumber (NULL: defaults); the result is bit-identical for any
+ * thread count.  Returns GETME_OK when no invalid element is left (a valid
+ * input is left unchanged), GETME_ERR_INVALID_MESH when some could not be
+ * untangled (for example all their nodes are fixed): the mesh then holds the
+ * partly untangled coordinates and the message names the first of them.
+ * result may be NULL.
+ */
+GETME_API getme_status getme_mesh_untangle(getme_mesh *mesh,
+                                           const getme_params *params,
+                                           getme_untangle_result *result);
 
 /*
  * Distort the mesh for tests and benchmarks: rounds of random moves of free

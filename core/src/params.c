@@ -42,6 +42,7 @@ void getme_params_init(getme_params *p)
     p->corner_floor = 0.0;
     p->num_threads = 0;
     p->renumber = 1;
+    p->untangle = 1;
 }
 
 size_t getme_params_sizeof(void) { return sizeof(getme_params); }
@@ -112,6 +113,10 @@ getme_status getme_params_set(getme_params *p, const char *name, double v)
         if (v != 0.0 && v != 1.0)
             return GETME_ERR_ARGUMENT;
         p->renumber = (int)v;
+    } else if (!strcmp(name, "untangle")) {
+        if (v != 0.0 && v != 1.0)
+            return GETME_ERR_ARGUMENT;
+        p->untangle = (int)v;
     } else {
         return GETME_ERR_ARGUMENT;
     }

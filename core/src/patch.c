@@ -20,28 +20,20 @@ void getme__patch_free(getme_patch *p)
     memset(p, 0, sizeof *p);
 }
 
-/* Grow every per-element array to cap entries. */
+/* Grow every per-element array to cap entries; qt also holds the active
+   gradients, D_MAX values per element.  RESIZE keeps a field unchanged
+   when realloc fails. */
+#define RESIZE(field, n)                                                   \
+    ((tmp = realloc(p->field, (n) * sizeof *p->field)) ? (p->field = tmp, 0) \
+                                                       : -1)
+
 static getme_status grow(getme_patch *p, int32_t cap)
 {
-    void *a = realloc(p->type, (size_t)cap * sizeof *p->type);
-    if (!a)
+    size_t n = (size_t)cap;
+    void *tmp;
+    if (RESIZE(type, n) || RESIZE(conn, n) || RESIZE(id, n) || RESIZE(q, n) ||
+        RESIZE(sj, n) || RESIZE(qt, n * D_MAX))
         return GETME_ERR_NOMEM;
-    p->type = a;
-    if (!(a = realloc(p->conn, (size_t)cap * sizeof *p->conn)))
-        return GETME_ERR_NOMEM;
-    p->conn = a;
-    if (!(a = realloc(p->id, (size_t)cap * sizeof *p->id)))
-        return GETME_ERR_NOMEM;
-    p->id = a;
-    if (!(a = realloc(p->q, (size_t)cap * sizeof *p->q)))
-        return GETME_ERR_NOMEM;
-    p->q = a;
-    if (!(a = realloc(p->sj, (size_t)cap * sizeof *p->sj)))
-        return GETME_ERR_NOMEM;
-    p->sj = a;
-    if (!(a = realloc(p->qt, (size_t)cap * D_MAX * sizeof *p->qt)))
-        return GETME_ERR_NOMEM;
-    p->qt = a; /* also holds the active gradients: D_MAX per element */
     p->cap = cap;
     return GETME_OK;
 }

@@ -163,6 +163,45 @@ static getme_status check_valid(getme_mesh *mesh, const getme_ws *ws,
                        bad > nfirst ? ", ..." : "");
 }
 
+/* Untangle an invalid input on the workspace (nothing is stored if some
+   element stays invalid: the caller's mesh does not move). */
+static getme_status untangle(getme_mesh *mesh, getme_ws *ws, getme_run *run)
+{
+    getme_untangle_result ur;
+    getme_status st = getme__untangle(ws, run->q, &ur);
+    run->result->num_invalid_initial = ur.num_invalid_before;
+    run->result->untangle_sweeps = ur.sweeps;
+    run->result->untangle_seconds = ur.seconds;
+    if (st != GETME_OK)
+        return getme__fail(mesh, st, "out of memory untangling %d elements",
+                           (int)ws->ne);
+    /* the relaxation's trial coordinates must equal ws->x outside it */
+    memcpy(run->xnew, ws->x, (size_t)ws->nn * 3 * sizeof *run->xnew);
+    return ur.num_invalid_after ? getme__untangle_message(mesh, &ur)
+                                : GETME_OK;
+}
+
+getme_status getme__start(getme_mesh *mesh, const getme_params **params,
+                          getme_params *defaults, getme_ws *ws)
+{
+    if (!*params) {
+        getme_params_init(defaults);
+        *params = defaults;
+    }
+    mesh->error[0] = '\0';
+    if (mesh->num_elements == 0)
+        return getme__fail(mesh, GETME_ERR_STATE, "the mesh has no elements");
+    const char *problem = getme__params_problem(*params);
+    if (problem)
+        return getme__fail(mesh, GETME_ERR_ARGUMENT, "parameters: %s", problem);
+    int nt = (*params)->num_threads > 0 ? (*params)->num_threads
+                                        : omp_get_max_threads();
+    getme_status st = getme__ws_build(ws, mesh, (*params)->renumber, nt);
+    if (st != GETME_OK)
+        return getme__fail(mesh, st, "out of memory building the workspace");
+    return GETME_OK;
+}
+
 getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
                           getme_result *result)
 {
@@ -170,27 +209,14 @@ getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
     getme_result local;
     if (!mesh)
         return GETME_ERR_ARGUMENT;
-    if (!params) {
-        getme_params_init(&defaults);
-        params = &defaults;
-    }
     if (!result)
         result = &local;
     memset(result, 0, sizeof *result);
-    mesh->error[0] = '\0';
     double t0 = omp_get_wtime();
-    if (mesh->num_elements == 0)
-        return getme__fail(mesh, GETME_ERR_STATE, "the mesh has no elements");
-    const char *problem = getme__params_problem(params);
-    if (problem)
-        return getme__fail(mesh, GETME_ERR_ARGUMENT, "parameters: %s", problem);
-    int nt = params->num_threads > 0 ? params->num_threads
-                                     : omp_get_max_threads();
-
     getme_ws ws;
-    getme_status st = getme__ws_build(&ws, mesh, params->renumber, nt);
+    getme_status st = getme__start(mesh, &params, &defaults, &ws);
     if (st != GETME_OK)
-        return getme__fail(mesh, st, "out of memory building the workspace");
+        return st;
     getme_run run;
     memset(&run, 0, sizeof run);
     getme_adj adj;
@@ -212,6 +238,8 @@ getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
         goto done;
     }
     getme__ws_qualities(&ws, run.q);
+    if (params->untangle && (st = untangle(mesh, &ws, &run)) != GETME_OK)
+        goto done;
     if ((st = check_valid(mesh, &ws, run.q)) != GETME_OK)
         goto done;
     getme__ws_summary(&ws, run.q, &result->q_mean_initial,

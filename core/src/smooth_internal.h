@@ -55,6 +55,13 @@ typedef struct getme_run {
     double corner_floor; /* max(params.corner_floor, the input's worst)   */
 } getme_run;
 
+/* The start of getme_smooth() and getme_mesh_untangle(): params NULL ->
+   defaults (filled in), error cleared, a mesh with elements and usable
+   params, the workspace built.  GETME_OK, or a status with the message on
+   the mesh. */
+getme_status getme__start(getme_mesh *mesh, const getme_params **params,
+                          getme_params *defaults, getme_ws *ws);
+
 getme_status getme__run_alloc(getme_run *run);
 void getme__run_free(getme_run *run);
 
@@ -102,6 +109,16 @@ double getme__ws_corner_min(const getme_ws *ws);
 /* The finishing step (finish.c): passes of worst-first local max-min
    optimisation until q*_min stops rising.  Needs run->q up to date. */
 getme_status getme__finish(getme_run *run);
+
+/* Untangle ws in place (untangle.c); q holds the qualities at ws->x and is
+   kept up to date.  GETME_OK (res says how many elements stay invalid) or
+   GETME_ERR_NOMEM. */
+getme_status getme__untangle(getme_ws *ws, double *q,
+                             getme_untangle_result *res);
+/* Record on mesh the message naming the elements res says are still
+   invalid; returns GETME_ERR_INVALID_MESH. */
+getme_status getme__untangle_message(getme_mesh *mesh,
+                                     const getme_untangle_result *res);
 getme_status getme__laplace(getme_run *run);
 
 #endif /* GETME_SMOOTH_INTERNAL_H */

@@ -39,6 +39,8 @@ typedef enum getme_io_status {
     GETME_IO_ERR_UNSUPPORTED = 5, /* element type or feature not supported    */
     GETME_IO_ERR_INVALID = 6,     /* the mesh has invalid (inverted) elements */
     GETME_IO_ERR_WRITE = 7,       /* output could not be written              */
+    GETME_IO_ERR_TANGLED = 8,     /* invalid elements that untangling could not
+                                     repair (named by their file ids)         */
     GETME_IO_ERR_USAGE = 2,       /* bad option, unknown set name...          */
     GETME_IO_ERR_INTERNAL = 1     /* out of memory, library failure           */
 } getme_io_status;
@@ -131,6 +133,10 @@ getme_mesh *getme_doc_mesh(getme_doc *doc);
 const char *getme_doc_error(const getme_doc *doc);
 const char *getme_doc_info(const getme_doc *doc);
 const char *getme_doc_warning(const getme_doc *doc);
+
+/* The id of mesh element e as written in the file (1-based position if
+   the format has no ids). */
+int64_t getme_doc_element_id(const getme_doc *doc, int32_t e);
 
 /* Set doc->error (printf style) and return status. */
 getme_io_status getme_doc_fail(getme_doc *doc, getme_io_status status,

@@ -89,6 +89,13 @@ GETME_GMSH_API void getme_gmsh_options_free(getme_gmsh_options *options);
  *                    elements it changed
  *   "worst"          10 (default, 0..10): worst elements kept in the report
  *                    and logged at log level 2
+ *   "untangle"       1 (default): untangle a mesh with invalid (inverted or
+ *                    degenerate) elements first (getme_mesh_untangle), with
+ *                    a warning giving the counts; 0: refuse it
+ *   "allow_invalid"  0 (default): if untangling leaves invalid elements the
+ *                    model is unchanged; 1: the partly untangled coordinates
+ *                    are written to the model (not smoothed); the call
+ *                    returns GETME_ERR_INVALID_MESH either way
  * GETME_ERR_ARGUMENT for an unknown name or a value out of range (the
  * reason is in getme_gmsh_options_error()).
  */
@@ -126,6 +133,8 @@ typedef struct getme_gmsh_report {
     getme_quality_stats before; /* mean-ratio statistics before and after    */
     getme_quality_stats after;
     getme_result result;        /* iterations per stage, stop reason ...     */
+    getme_untangle_result untangle; /* counts of the untangling step (all 0
+                                   when the mesh was valid)                  */
     double wall;                /* seconds for the whole call (wall, CPU)    */
     double cpu;
     char message[512];          /* "" on success, else the error             */
@@ -163,8 +172,10 @@ typedef struct getme_gmsh_report {
  * Returns GETME_OK, or: GETME_ERR_STATE (Gmsh not initialized, no mesh),
  * GETME_ERR_ARGUMENT (bad entity, unknown group), GETME_ERR_TOPOLOGY
  * (unsupported or second-order elements, non-planar surface),
- * GETME_ERR_INVALID_MESH (inverted elements), GETME_ERR_NOMEM.  On error
- * the model is unchanged.
+ * GETME_ERR_INVALID_MESH (inverted elements that untangling could not
+ * repair, named with their Gmsh tags in the message, or any inverted element
+ * with "untangle" = 0), GETME_ERR_NOMEM.  On error the model is unchanged
+ * (except the partly untangled coordinates with "allow_invalid" = 1).
  */
 GETME_GMSH_API getme_status getme_gmsh_optimize(
     int niter, const int *dim_tags, size_t dim_tags_n,
@@ -193,7 +204,9 @@ GETME_GMSH_API getme_status getme_gmsh_quality(
    "threshold", "seconds", "passes_finish", "moved_finish",
    "corner_sj_before", "corner_sj_after", "topology_ran",
    "topology_changed", "topology_elements_before", "topology_elements_after",
-   "num_worst", "num_worst_free", "<worst|worst_free><i>_<tag|index|type|
+   "num_worst", "num_worst_free", "untangle_invalid_before",
+   "untangle_invalid_after", "untangle_sweeps", "untangle_moved",
+   "untangle_seconds", "<worst|worst_free><i>_<tag|index|type|
    quality|corner_sj|num_free|num_nodes|reason>", "<before|after>_<q_min_star|q_min|q_mean|q_max|
    num_invalid|num_below_04|num_below_01|num_elements|num_free>",
    "<before|after>_hist<0..9>".  NaN for an unknown name. */

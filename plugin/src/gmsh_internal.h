@@ -35,6 +35,7 @@ struct getme_gmsh_options {
     int fix_interfaces;
     int topology;       /* 0/1: Gmsh's optimize("") first when needed */
     int worst;          /* 0..GETME_GMSH_MAX_WORST                   */
+    int allow_invalid;  /* write partly untangled coordinates back */
     int num_fix, cap_fix;
     char **fix;         /* physical group names or "dim:tag" */
     char error[256];

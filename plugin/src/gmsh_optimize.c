@@ -85,28 +85,77 @@ static void describe_entities(const getme_gmsh_model *m, char *buf,
     }
 }
 
+/* "<head>: tetrahedron 12 in volume 1, ...<tail>" naming the elements of
+   list (n of count) by their Gmsh tags. */
+static void name_elements(const gg_run *run, char *text, size_t size,
+                          const char *head, int64_t count, const int32_t *list,
+                          int n, const char *tail)
+{
+    char one[128];
+    int used = snprintf(text, size, "%s: ", head);
+    for (int i = 0; i < n && used < (int)size; i++) {
+        getme_gmsh_model_describe_element(run->model, list[i], one,
+                                          sizeof one);
+        used += snprintf(text + used, size - (size_t)used, "%s%s",
+                         i ? ", " : "", one);
+    }
+    if (used < (int)size)
+        snprintf(text + used, size - (size_t)used, "%s%s",
+                 count > n ? ", ..." : "", tail);
+}
+
+/* With untangling off, an invalid input is refused. */
 static getme_status check_valid(gg_run *run)
 {
     const getme_quality_stats *s = &run->rep->before;
-    if (s->num_invalid == 0)
+    if (s->num_invalid == 0 || run->opt->params.untangle)
         return GETME_OK;
-    char text[GG_MSG], one[128];
-    int used = snprintf(text, sizeof text, "%lld invalid (inverted or "
-                        "degenerate) element%s: ",
-                        (long long)s->num_invalid,
-                        s->num_invalid > 1 ? "s" : "");
-    for (int i = 0; i < s->num_reported_invalid && used < (int)sizeof text;
-         i++) {
-        getme_gmsh_model_describe_element(run->model, s->first_invalid[i],
-                                          one, sizeof one);
-        used += snprintf(text + used, sizeof text - (size_t)used, "%s%s",
-                         i ? ", " : "", one);
-    }
-    if (used < (int)sizeof text)
-        snprintf(text + used, sizeof text - (size_t)used, "%s",
-                 s->num_invalid > s->num_reported_invalid
-                     ? ", ...: GETMe needs a valid mesh"
-                     : ": GETMe needs a valid mesh");
+    char text[GG_MSG], head[96];
+    snprintf(head, sizeof head, "%lld invalid (inverted or degenerate) "
+             "element%s", (long long)s->num_invalid,
+             s->num_invalid > 1 ? "s" : "");
+    name_elements(run, text, sizeof text, head, s->num_invalid,
+                  s->first_invalid, s->num_reported_invalid,
+                  ": GETMe needs a valid mesh");
+    return fail(run, GETME_ERR_INVALID_MESH, text);
+}
+
+/* Untangle an input with invalid elements (getme_mesh_untangle): a warning
+   with the counts; elements that stay invalid are named by their tags, and
+   with allow_invalid the partly untangled coordinates go to the model. */
+static getme_status untangle(gg_run *run)
+{
+    getme_mesh *mesh = getme_gmsh_model_mesh(run->model);
+    getme_untangle_result *u = &run->rep->untangle;
+    getme_status st = getme_mesh_untangle(mesh, &run->opt->params, u);
+    if (st != GETME_OK && st != GETME_ERR_INVALID_MESH)
+        return fail(run, st, getme_mesh_error(mesh));
+    if (run->opt->log >= 1)
+        gg_log("warning", "%lld invalid (inverted or degenerate) element%s, "
+               "%lld remain%s after untangling (%d sweep%s, %ld nodes "
+               "moved, %g s)", (long long)u->num_invalid_before,
+               u->num_invalid_before == 1 ? "" : "s",
+               (long long)u->num_invalid_after,
+               u->num_invalid_after == 1 ? "s" : "", u->sweeps,
+               u->sweeps == 1 ? "" : "s", (long)u->num_moved, u->seconds);
+    if (st == GETME_OK)
+        return GETME_OK;
+    char text[GG_MSG], head[128];
+    if (run->opt->allow_invalid &&
+        getme_mesh_quality_stats(mesh, -1, &run->rep->after) == GETME_OK &&
+        getme_gmsh_model_apply(run->model, getme_mesh_coords(mesh),
+                               &run->rep->num_moved, text,
+                               sizeof text) != GETME_OK)
+        return fail(run, GETME_ERR_NOMEM, text);
+    snprintf(head, sizeof head, "%lld invalid element%s could not be "
+             "untangled (%lld with every node fixed)",
+             (long long)u->num_invalid_after,
+             u->num_invalid_after > 1 ? "s" : "", (long long)u->num_stuck);
+    name_elements(run, text, sizeof text, head, u->num_invalid_after,
+                  u->remaining, u->num_reported,
+                  run->opt->allow_invalid
+                      ? "; the partly untangled mesh was written to the model"
+                      : "; the model is unchanged");
     return fail(run, GETME_ERR_INVALID_MESH, text);
 }
 
@@ -238,6 +287,9 @@ static getme_status smooth_and_apply(gg_run *run, int niter)
     run->params.progress = progress_chain;
     run->params.progress_data = run;
     getme_status st = getme_smooth(mesh, &run->params, &run->rep->result);
+    run->rep->result.num_invalid_initial = run->rep->untangle.num_invalid_before;
+    run->rep->result.untangle_sweeps = run->rep->untangle.sweeps;
+    run->rep->result.untangle_seconds = run->rep->untangle.seconds;
     if (st != GETME_OK && st != GETME_ERR_CANCELLED)
         return fail(run, st, getme_mesh_error(mesh));
     /* A cancelled run still leaves a valid, partly smoothed mesh. */
@@ -360,6 +412,8 @@ getme_status getme_gmsh_optimize(int niter, const int *dim_tags,
         st = check_model(&run);
     if (st == GETME_OK && options->log >= 1)
         log_start(&run);
+    if (st == GETME_OK && run.rep->before.num_invalid > 0)
+        st = untangle(&run);
     if (st == GETME_OK)
         st = smooth_and_apply(&run, niter);
     run.rep->wall = wall_now() - run.wall0;

@@ -43,7 +43,7 @@ static getme_status bad(getme_gmsh_options *opt, const char *fmt,
     return GETME_ERR_ARGUMENT;
 }
 
-/* Our own names take 0/1 (fix_*, topology), 0..2 (log) or
+/* Our own names take 0/1 (fix_*, topology, allow_invalid), 0..2 (log) or
    0..GETME_GMSH_MAX_WORST (worst); the rest is libgetme's. */
 getme_status getme_gmsh_options_set(getme_gmsh_options *opt, const char *name,
                                     double value)
@@ -56,6 +56,7 @@ getme_status getme_gmsh_options_set(getme_gmsh_options *opt, const char *name,
                 : strcmp(name, "fix_interfaces") == 0 ? &opt->fix_interfaces
                 : strcmp(name, "topology") == 0       ? &opt->topology
                 : strcmp(name, "worst") == 0          ? &opt->worst
+                : strcmp(name, "allow_invalid") == 0  ? &opt->allow_invalid
                                                       : NULL;
     if (flag) {
         double hi = flag == &opt->log     ? 2

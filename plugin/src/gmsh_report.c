@@ -97,7 +97,9 @@ double getme_gmsh_report_value(const getme_gmsh_report *r, const char *name)
         "seconds", "passes_finish", "moved_finish", "corner_sj_before",
         "corner_sj_after", "topology_ran", "topology_changed",
         "topology_elements_before", "topology_elements_after", "num_worst",
-        "num_worst_free"};
+        "num_worst_free", "untangle_invalid_before", "untangle_invalid_after",
+        "untangle_sweeps", "untangle_moved", "untangle_seconds"};
+    const getme_untangle_result *u = &r->untangle;
     const double values[] = {r->dim,
                              r->num_entities,
                              r->num_nodes,
@@ -122,7 +124,13 @@ double getme_gmsh_report_value(const getme_gmsh_report *r, const char *name)
                              r->topology_elements_before,
                              r->topology_elements_after,
                              r->num_worst,
-                             r->num_worst_free};
+                             r->num_worst_free,
+
+                             (double)u->num_invalid_before,
+                             (double)u->num_invalid_after,
+                             u->sweeps,
+                             u->num_moved,
+                             u->seconds};
     for (size_t i = 0; i < sizeof names / sizeof *names; i++)
         if (strcmp(name, names[i]) == 0)
             return values[i];

@@ -2,7 +2,7 @@
 """Integration tests of the getme command on Gmsh-generated, distorted meshes.
 
 usage: /usr/bin/python3 test_cli.py GETME_BINARY WORKDIR CASE
-CASE: tet | hex | mixed | tri | quad | errors
+CASE: tet | hex | mixed | tri | quad | errors | untangle
 
 For a mesh case: Gmsh (Python API) generates the mesh, `getme distort`
 distorts it, then `getme smooth` runs with GETMe adaptive (1 and 2 threads)
@@ -234,17 +234,149 @@ def errors_case():
     open(inv, "w").write("\n".join(lines))
     tags = [[int(victim[0])] * 6]
     digest = sha(inv)
-    p = run("smooth", inv, "-o", inv + "-out.msh", expect=6)
+    if os.path.exists(inv + "-out.msh"):  # written by an earlier run
+        os.remove(inv + "-out.msh")
+    p = run("smooth", inv, "-o", inv + "-out.msh", "--no-untangle", expect=6)
     check("invalid" in p.stderr and str(tags[0][5]) in p.stderr,
           "inverted element reported by its Gmsh tag")
     check(sha(inv) == digest and not os.path.exists(inv + "-out.msh"), "input untouched, no output")
+    # by default it is untangled first (issue #12), then smoothed
+    p = run("smooth", inv, "-o", inv + "-out.msh")
+    check("Warning : 1 invalid (inverted or degenerate) element in the input, 0 remain"
+          in p.stdout, "untangling warning line")
+    check(sha(inv) == digest and os.path.exists(inv + "-out.msh"), "input untouched, output written")
     run("quality", inv, expect=6)
     p = run("smooth", good, "-o", good, expect=2)
     check("overwrite" in p.stderr, "refuses to overwrite the input")
 
 
+# ---- tangled inputs (issue #12): Abaqus decks written here, a 6^3 grid of
+# C3D8 hexes (element ids from 101, node ids from 1001, so that file ids
+# differ from indices) with interior nodes pushed through the opposite face
+# of their cell: exit 0 with a warning giving the counts, every element
+# valid by the independent mean ratio, skin bit-identical, 1 = 2 threads;
+# --no-untangle exits 6; a hex whose nodes are all fixed (--fix on an NSET)
+# turned inside out exits 8, named by its file id, no output unless
+# --allow-invalid.
+N, E0, N0 = 6, 101, 1001
+
+
+def gid(i, j, k):
+    return i + (N + 1) * (j + (N + 1) * k)
+
+
+def grid():
+    pts = np.array([(i, j, k) for k in range(N + 1) for j in range(N + 1)
+                    for i in range(N + 1)], dtype=float)
+    hexes = []
+    for k in range(N):
+        for j in range(N):
+            for i in range(N):
+                hexes.append([gid(i, j, k), gid(i + 1, j, k), gid(i + 1, j + 1, k),
+                              gid(i, j + 1, k), gid(i, j, k + 1), gid(i + 1, j, k + 1),
+                              gid(i + 1, j + 1, k + 1), gid(i, j + 1, k + 1)])
+    return pts, np.array(hexes)
+
+
+def write_inp(path, pts, hexes, nset=None):
+    with open(path, "w") as f:
+        f.write("*HEADING\ntangled hex grid\n*NODE\n")
+        for n, p in enumerate(pts):
+            f.write("%d, %.17g, %.17g, %.17g\n" % (N0 + n, *p))
+        f.write("*ELEMENT, TYPE=C3D8, ELSET=SOLID\n")
+        for e, h in enumerate(hexes):
+            f.write("%d, %s\n" % (E0 + e, ", ".join(str(N0 + v) for v in h)))
+        if nset is not None:
+            f.write("*NSET, NSET=STUCK\n%s\n" % ", ".join(str(N0 + v) for v in nset))
+
+
+def read_nodes(path):
+    nodes, on = {}, False
+    with open(path) as f:
+        for line in f:
+            if line.startswith("*"):
+                on = line.upper().startswith("*NODE")
+                continue
+            if on and line.strip():
+                v = line.split(",")
+                nodes[int(v[0])] = np.array([float(x) for x in v[1:4]])
+    return np.array([nodes[N0 + n] for n in range(len(nodes))])
+
+
+def skin(hexes):
+    ids = set()
+    for i in range(N + 1):
+        for j in range(N + 1):
+            for k in range(N + 1):
+                if min(i, j, k) == 0 or max(i, j, k) == N:
+                    ids.add(gid(i, j, k))
+    return sorted(ids)
+
+
+def untangle_case():
+    for name in os.listdir(WORK):  # outputs of an earlier run
+        os.remove(os.path.join(WORK, name))
+    pts, hexes = grid()
+    tangled = pts.copy()
+    tangled[gid(2, 2, 2)] += (1.6, 0.1, 0.05)
+    tangled[gid(4, 3, 4)] += (-0.1, -1.7, 0.1)
+    q0 = element_quality(tangled, hexes, "hex")
+    check((q0 <= 0).sum() > 0, "the input has invalid hexes")
+    src = os.path.join(WORK, "tangled.inp")
+    write_inp(src, tangled, hexes)
+
+    # untangled and smoothed, 1 and 2 threads
+    outs = []
+    for t in (1, 2):
+        out = os.path.join(WORK, "smooth-%d.inp" % t)
+        p = run("smooth", src, "-o", out, "--threads", str(t))
+        warn = [ln for ln in p.stdout.splitlines() if ln.startswith("Warning :")]
+        check(any("%d invalid" % (q0 <= 0).sum() in ln and "0 remain" in ln for ln in warn),
+              "warning line with the counts: %s" % warn)
+        x = read_nodes(out)
+        q = element_quality(x, hexes, "hex")
+        check(q.min() > 0.5, "output valid and smoothed (q_min %.4f)" % q.min())
+        s = skin(hexes)
+        check(np.array_equal(x[s], tangled[s]), "skin nodes bit-identical")
+        outs.append(open(out, "rb").read())
+    check(outs[0] == outs[1], "1 and 2 threads byte-identical")
+
+    # --no-untangle: today's refusal
+    out = os.path.join(WORK, "refused.inp")
+    p = run("smooth", src, "-o", out, "--no-untangle", expect=6)
+    check(not os.path.exists(out), "no output with --no-untangle")
+    check("invalid" in p.stderr, "refusal names the problem")
+
+    # a hex with every node fixed, turned inside out: exit 8, named, no output
+    stuck_pts = pts.copy()
+    cell = 1 + N * (1 + N * 1)
+    stuck_pts[hexes[cell][6]] = (0.8, 0.8, 0.8)
+    stuck = os.path.join(WORK, "stuck.inp")
+    write_inp(stuck, stuck_pts, hexes, nset=hexes[cell])
+    out = os.path.join(WORK, "stuck-out.inp")
+    p = run("smooth", stuck, "-o", out, "--fix", "STUCK", expect=8)
+    check(not os.path.exists(out), "no output when elements stay invalid")
+    err = [ln for ln in p.stderr.splitlines() if "could not be untangled" in ln]
+    check(len(err) == 1 and str(E0 + cell) in err[0],
+          "error names the element by its file id %d: %s" % (E0 + cell, err))
+    check(any(ln.startswith("Warning :") and "remain" in ln for ln in p.stdout.splitlines()),
+          "warning line with the counts")
+    # --allow-invalid: the partly untangled mesh is written, exit code still 8
+    p = run("smooth", stuck, "-o", out, "--fix", "STUCK", "--allow-invalid", expect=8)
+    check(os.path.exists(out), "--allow-invalid writes the partly untangled mesh")
+    if os.path.exists(out):
+        x = read_nodes(out)
+        q = element_quality(x, hexes, "hex")
+        qs = element_quality(stuck_pts, hexes, "hex")
+        check(q[cell] <= 0 and (q <= 0).sum() < (qs <= 0).sum(),
+              "only the stuck part stays invalid (%d -> %d)" % ((qs <= 0).sum(), (q <= 0).sum()))
+        check(np.array_equal(x[hexes[cell]], stuck_pts[hexes[cell]]), "fixed nodes kept")
+
+
 if CASE == "errors":
     errors_case()
+elif CASE == "untangle":
+    untangle_case()
 else:
     mesh_case(CASE)
 sys.exit(T.summary())

@@ -110,6 +110,16 @@ check(wf and wf[0]["index"] == int(np.argmin(np.where(free_el, q1, np.inf))),
 check(open(out1, "rb").read() == open(out2, "rb").read(), "1 and 2 threads byte-identical")
 check(hashlib.sha256(open(DATA, "rb").read()).hexdigest() == sha, "input untouched")
 
+# `getme quality --worst`: on the paper's locked result the worst tet (all 4
+# nodes free) is named with its tag and reported as still improvable; the
+# finishing step is what improves it.
+q = subprocess.run([GETME, "quality", paper_out, "--worst", "2"], capture_output=True, text=True)
+lines = [ln for ln in q.stdout.splitlines() if " tet q " in ln]
+tag = paper["worst_free_elements"][0]["tag"]
+check(q.returncode == 0 and len(lines) == 4, "quality --worst 2 lists 2 + 2 elements")
+check(lines and lines[0].split()[2] == str(tag) and "4/4 free: a node move can still raise it" in lines[0],
+      f"quality --worst names the locked tet {tag}: {lines[:1]}")
+
 print(f"locked ring: q*min {q_in[free_el].min():.4f} -> paper {paper['after']['q_min_star']:.4f}, "
       f"finishing step {rep1['after']['q_min_star']:.4f} in {len(passes)} passes; "
       f"qmean paper {paper['after']['q_mean']:.4f}, finishing {rep1['after']['q_mean']:.4f}")

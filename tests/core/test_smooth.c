@@ -106,12 +106,19 @@ static void check_errors(void)
     int32_t rep[4] = {0, 1, 1, 3};
     CHECK(getme_mesh_add_elements(m, GETME_TET, 1, rep, NULL) == GETME_ERR_TOPOLOGY);
     CHECK(getme_mesh_add_elements(m, GETME_TRI, 1, rep, NULL) == GETME_ERR_ARGUMENT);
-    /* Inverted tet: refused, nothing moves. */
+    /* Inverted tet: refused with untangle = 0, nothing moves; by default
+       untangled (its nodes are free), then smoothed. */
     int32_t inv[4] = {0, 2, 1, 3};
     CHECK(getme_mesh_add_elements(m, GETME_TET, 1, inv, NULL) == GETME_OK);
-    CHECK(getme_smooth(m, NULL, NULL) == GETME_ERR_INVALID_MESH);
+    getme_params off;
+    getme_params_init(&off);
+    off.untangle = 0;
+    CHECK(getme_smooth(m, &off, NULL) == GETME_ERR_INVALID_MESH);
     CHECK(strstr(getme_mesh_error(m), "1 invalid") != NULL);
     CHECK(!memcmp(getme_mesh_coords(m), xyz, sizeof xyz));
+    getme_result res;
+    CHECK(getme_smooth(m, NULL, &res) == GETME_OK);
+    CHECK(res.num_invalid_initial == 1 && res.q_min > 0.0);
     getme_mesh_free(m);
 
     getme_params p;

@@ -66,6 +66,21 @@ names = sorted(gmsh.model.getPhysicalName(d, t) for d, t in gmsh.model.getPhysic
 assert names == ["clamp", "insert", "matrix"], names
 print("ok: part.msh valid, %d tets, groups %s" % (len(p), names))
 PYEOF
+# A tangled input (an interior node pushed through its tets): untangled
+# with a warning line, then smoothed; --no-untangle refuses it (exit 6).
+"$PY" - <<'PYEOF' || bad "writing tangled.msh"
+import gmsh, numpy as np
+gmsh.initialize(); gmsh.option.setNumber("General.Terminal", 0)
+gmsh.open("part.msh")
+t, x, _ = gmsh.model.mesh.getNodes(3, -1)
+gmsh.model.mesh.setNode(int(t[len(t) // 2]), (x.reshape(-1, 3)[len(t) // 2] + [0.3, 0, 0]).tolist(), [])
+gmsh.write("tangled.msh")
+PYEOF
+"$G" gmsh tangled.msh -o untangled.msh > tangled.log 2>&1; rc=$?
+[ $rc -eq 0 ] && grep -q "^Warning : [0-9]* invalid (inverted or degenerate) elements, 0 remain after untangling" tangled.log \
+  && ok "tangled input untangled: 0" || bad "tangled input: $rc"
+"$G" gmsh tangled.msh -q --no-untangle -o refused.msh 2> err.log; rc=$?
+[ $rc -eq 6 ] && [ ! -e refused.msh ] && ok "--no-untangle: 6" || bad "--no-untangle: $rc"
 "$G" gmsh missing.geo -q; rc=$?; [ $rc -eq 3 ] && ok "missing input: 3" || bad "missing input: $rc"
 "$G" gmsh part.geo -q -3 -clmax 0.3 --fix nope -o x.msh 2> err.log; rc=$?
 [ $rc -eq 2 ] && grep -q "Unknown physical group 'nope'" err.log && ok "unknown group: 2" || bad "unknown group: $rc"

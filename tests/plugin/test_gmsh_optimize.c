@@ -256,13 +256,17 @@ static void test_optimize(void)
 }
 
 /* Every bad use: nonzero status, a message, the model unchanged. */
-static void expect_refused(const int *dt, size_t n, getme_status want,
-                           const char *words)
+/* A refused call leaves the model as it was; off (may be NULL) names an
+   option set to 0 for the call. */
+static void expect_refused_with(const int *dt, size_t n, getme_status want,
+                                const char *words, const char *off)
 {
     snap a = take_snap(-1, -1);
     getme_gmsh_report rep;
     getme_gmsh_options *opt = getme_gmsh_options_new();
     getme_gmsh_options_set(opt, "log", 0);
+    if (off)
+        CHECK_EQ_INT(getme_gmsh_options_set(opt, off, 0), GETME_OK);
     getme_status st = getme_gmsh_optimize(0, dt, n, opt, &rep);
     CHECK_EQ_INT(st, want);
     CHECK(strstr(rep.message, words) != NULL);
@@ -272,6 +276,119 @@ static void expect_refused(const int *dt, size_t n, getme_status want,
     CHECK(same_snap(&a, &b));
     free_snap(&a);
     free_snap(&b);
+    getme_gmsh_options_free(opt);
+}
+
+static void expect_refused(const int *dt, size_t n, getme_status want,
+                           const char *words)
+{
+    expect_refused_with(dt, n, want, words, NULL);
+}
+
+/* Inverted tets: untangled and smoothed by default; refused with
+   untangle = 0; named by their tags when every node is fixed. */
+static void test_untangle(void)
+{
+    int ierr = 0;
+    snap all = take_snap(-1, -1);
+    snap vol = take_snap(3, 1);
+    size_t tag = vol.tags[0];
+    double far[3] = {vol.xyz[0] + 5, vol.xyz[1], vol.xyz[2]};
+    gmshModelMeshSetNode(tag, far, 3, NULL, 0, &ierr);
+    expect_refused_with(NULL, 0, GETME_ERR_INVALID_MESH, "invalid",
+                        "untangle");
+    int invalid = 0;
+    min_tet_quality(&invalid);
+    CHECK(invalid > 0);
+    snap bnd0 = boundary_snap();
+    getme_gmsh_report rep;
+    getme_gmsh_options *opt = getme_gmsh_options_new();
+    getme_gmsh_options_set(opt, "log", 1);
+    CHECK_EQ_INT(getme_gmsh_optimize(0, NULL, 0, opt, &rep), GETME_OK);
+    CHECK_EQ_INT(rep.untangle.num_invalid_before, invalid);
+    CHECK_EQ_INT(rep.untangle.num_invalid_after, 0);
+    CHECK(rep.untangle.sweeps > 0);
+    CHECK_EQ_INT(getme_gmsh_report_value(&rep, "untangle_invalid_before"),
+                 invalid);
+    CHECK_EQ_INT(rep.result.num_invalid_initial, invalid);
+    CHECK_EQ_INT(rep.after.num_invalid, 0);
+    CHECK(min_tet_quality(&invalid) > 0.1);
+    CHECK_EQ_INT(invalid, 0);
+    snap bnd1 = boundary_snap();
+    CHECK(same_snap(&bnd0, &bnd1));
+    free_snap(&bnd0);
+    free_snap(&bnd1);
+
+    /* A tet whose 4 nodes are all fixed (classified on the boundary),
+       turned inside out by mirroring one node through the opposite face:
+       named by its tag; the model is unchanged, except with
+       allow_invalid = 1 (partly untangled coordinates). */
+    for (size_t i = 0; i < all.n; i++)
+        gmshModelMeshSetNode(all.tags[i], all.xyz + 3 * i, 3, NULL, 0, &ierr);
+    snap bnd = boundary_snap();
+    size_t *etags = NULL, etn = 0, *enodes = NULL, enn = 0;
+    gmshModelMeshGetElementsByType(4, &etags, &etn, &enodes, &enn, -1, 0, 1,
+                                   &ierr);
+    size_t stuck = 0;
+    for (size_t e = 0; e < etn && !stuck; e++) {
+        int on = 0;
+        for (int v = 0; v < 4; v++)
+            for (size_t k = 0; k < bnd.n; k++)
+                on += bnd.tags[k] == enodes[4 * e + v];
+        if (on < 4)
+            continue;
+        stuck = etags[e];
+        double x[4][3], pc[3], pd;
+        for (int v = 0; v < 4; v++) {
+            double *c = NULL, *pp = NULL;
+            size_t nc = 0, np = 0;
+            gmshModelMeshGetNode(enodes[4 * e + v], &c, &nc, &pp, &np, &ierr);
+            memcpy(x[v], c, sizeof x[v]);
+            gmshFree(c);
+            gmshFree(pp);
+        }
+        /* n = (x1 - x0) x (x2 - x0); x3 -> x3 - 2 ((x3 - x0).n / n.n) n */
+        double u[3], w[3], nrm[3];
+        for (int d = 0; d < 3; d++)
+            u[d] = x[1][d] - x[0][d], w[d] = x[2][d] - x[0][d];
+        nrm[0] = u[1] * w[2] - u[2] * w[1];
+        nrm[1] = u[2] * w[0] - u[0] * w[2];
+        nrm[2] = u[0] * w[1] - u[1] * w[0];
+        pd = 0.0;
+        double nn = 0.0;
+        for (int d = 0; d < 3; d++)
+            pd += (x[3][d] - x[0][d]) * nrm[d], nn += nrm[d] * nrm[d];
+        for (int d = 0; d < 3; d++)
+            pc[d] = x[3][d] - 2.0 * pd / nn * nrm[d];
+        gmshModelMeshSetNode(enodes[4 * e + 3], pc, 3, NULL, 0, &ierr);
+    }
+    gmshFree(etags);
+    gmshFree(enodes);
+    free_snap(&bnd);
+    CHECK(stuck != 0);
+    char want[64];
+    snprintf(want, sizeof want, "tet %zu ", stuck);
+    expect_refused(NULL, 0, GETME_ERR_INVALID_MESH, "could not be untangled");
+    expect_refused(NULL, 0, GETME_ERR_INVALID_MESH, want);
+    /* plus the free node pushed out again: its tets untangle, so the
+       partly untangled coordinates differ from the input */
+    gmshModelMeshSetNode(tag, far, 3, NULL, 0, &ierr);
+    snap before = take_snap(-1, -1);
+    getme_gmsh_options_set(opt, "log", 0);
+    CHECK_EQ_INT(getme_gmsh_options_set(opt, "allow_invalid", 1), GETME_OK);
+    CHECK_EQ_INT(getme_gmsh_optimize(0, NULL, 0, opt, &rep),
+                 GETME_ERR_INVALID_MESH);
+    CHECK(rep.untangle.num_invalid_after >= 1);
+    CHECK(rep.untangle.num_stuck >= 1);
+    CHECK(rep.num_moved > 0);
+    snap after = take_snap(-1, -1);
+    CHECK(!same_snap(&before, &after));
+    free_snap(&before);
+    free_snap(&after);
+    for (size_t i = 0; i < all.n; i++)
+        gmshModelMeshSetNode(all.tags[i], all.xyz + 3 * i, 3, NULL, 0, &ierr);
+    free_snap(&all);
+    free_snap(&vol);
     getme_gmsh_options_free(opt);
 }
 
@@ -289,15 +406,6 @@ static void test_bad_uses(void)
                  GETME_ERR_ARGUMENT);
     CHECK(strstr(rep.message, "\"clamp\" (2:10)") != NULL);
     getme_gmsh_options_free(opt);
-
-    /* An inverted tet: move one free interior node through a face. */
-    snap vol = take_snap(3, 1);
-    size_t tag = vol.tags[0];
-    double far[3] = {vol.xyz[0] + 5, vol.xyz[1], vol.xyz[2]};
-    gmshModelMeshSetNode(tag, far, 3, NULL, 0, &ierr);
-    expect_refused(NULL, 0, GETME_ERR_INVALID_MESH, "invalid");
-    gmshModelMeshSetNode(tag, vol.xyz, 3, NULL, 0, &ierr);
-    free_snap(&vol);
 
     gmshModelMeshSetOrder(2, &ierr);
     expect_refused(NULL, 0, GETME_ERR_TOPOLOGY, "second-order");
@@ -328,6 +436,7 @@ int main(void)
     gmshOptionSetNumber("General.Terminal", 1, &ierr);
     build_model();
     test_optimize();
+    test_untangle();
     test_bad_uses();
     gmshFinalize(&ierr);
     return check_summary("plugin_gmsh_optimize");

@@ -201,6 +201,28 @@ def test_bad_uses():
     gmsh.model.mesh.setOrder(1)
 
 
+def test_untangle():
+    """An interior node pushed far through its tets: refused with
+    untangle=0 (model unchanged), untangled then smoothed by default."""
+    gmsh.open(os.path.join(WORK, "distorted.msh"))
+    bnd0 = boundary_nodes()
+    tags, xyz, _, conn = model_arrays()
+    free = sorted(set(tags.tolist()) - set(bnd0))
+    tag = free[len(free) // 2]
+    i = int(np.searchsorted(tags, tag))
+    gmsh.model.mesh.setNode(tag, (xyz[i] + [0.6, 0.0, 0.0]).tolist(), [])
+    invalid = int((tet_quality(model_arrays()[1], conn) <= 0).sum())
+    check(invalid > 0, "pushed node inverts tets")
+    expect_error(lambda: getme.gmsh.optimize(log=0, untangle=0), "invalid")
+    res = getme.gmsh.optimize(log=0)
+    u = res["untangle"]
+    check(u["invalid_before"] == invalid and u["invalid_after"] == 0 and
+          u["sweeps"] > 0, "untangle counts %s (%d invalid)" % (u, invalid))
+    q = tet_quality(model_arrays()[1], conn)
+    check(q.min() > 0.1, "valid and smoothed after untangling: %.4f" % q.min())
+    check(boundary_nodes() == bnd0, "boundary nodes bit-identical")
+
+
 def test_gui_logic():
     """The ONELAB side of getme.gui without a display: the panel's
     parameters, the demo distortion on "check", Smooth on "getme", the
@@ -226,6 +248,12 @@ def test_gui_logic():
           abs(after[0] - getme.quality()["q_min_star"]) < 1e-12,
           "GUI smoothing result %s (distorted %.4f)" % (after, q_bad))
     check(gmsh.onelab.getString("ONELAB/Action") == [""], "action consumed")
+    passes = gmsh.onelab.getNumber(gui.P + "Result/5Finishing passes")
+    check(passes and passes[0] >= 1, "the panel's finishing step ran: %s" % passes)
+    tag = gmsh.onelab.getNumber(gui.P + "Result/7Worst element tag")
+    etypes, etags, _ = gmsh.model.mesh.getElements(2)
+    check(tag and int(tag[0]) in set(int(t) for ts in etags for t in ts),
+          "the panel names the worst element by its Gmsh tag: %s" % tag)
 
 
 def test_worst_and_topology():
@@ -283,6 +311,7 @@ if __name__ == "__main__":
               % (name, "%.4f" % qin if qin is not None else "-", qmin, qmean,
                  n, s))
     test_bad_uses()
+    test_untangle()
     test_gui_logic()
     test_worst_and_topology()
     gmsh.finalize()

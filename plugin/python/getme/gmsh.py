@@ -15,9 +15,12 @@ params     any libgetme parameter: sigma, max_iter, tol, threshold_fraction,
            max_no_min_improve, min_tol, keep_best, finish (1: finishing
            step after the q*min stage; 0: the paper's method alone),
            finish_fraction, finish_max_passes, corner_guard, corner_floor,
-           num_threads, renumber; and fix_skin, fix_interfaces (0/1),
-           topology (1: Gmsh's own optimize("") first when some of the
-           worst elements have no free node; tet meshes), worst (0..10)
+           num_threads, renumber, untangle (1 by default: a mesh with
+           inverted elements is untangled first, with a Gmsh warning giving
+           the counts; 0 refuses it); and fix_skin, fix_interfaces,
+           allow_invalid (0/1), topology (1: Gmsh's own optimize("") first
+           when some of the worst elements have no free node; tet meshes),
+           worst (0..10)
 
 Returns a dict: iterations (total, mean stage, min stage, cycles,
 finishing passes), q_min_star / q_min / q_mean before and after, the worst
@@ -29,9 +32,13 @@ dicts {"tag", "type", "quality", "corner_sj", "num_free", "num_nodes",
 (option topology=1) or None; and
 measures_before / measures_after: {type: {measure: {"min", "max", "mean",
 "num_elements", "num_negative", "histogram", ...}}} for the dihedral
-angles, scaled Jacobian, Gmsh's gamma and SICN (docs/quality.md).
-Raises getme.GetmeError (with the Gmsh-logged message) on bad use; the
-model is then unchanged.
+angles, scaled Jacobian, Gmsh's gamma and SICN (docs/quality.md), and
+"untangle": invalid_before / invalid_after / sweeps / nodes_moved /
+seconds of the untangling step.
+Raises getme.GetmeError (with the Gmsh-logged message) on bad use, and with
+status 3 when inverted elements could not be untangled (the message names
+them by their Gmsh tags); the model is then unchanged, except with
+allow_invalid=1, which writes the partly untangled coordinates.
 """
 import ctypes
 import os
@@ -115,6 +122,12 @@ def _report_dict(rep):
         out["measures_" + when] = _lib.measure_dict(
             lambda t, m: _lib.plugin.getme_gmsh_report_measure(
                 rep, after, t, m).contents)
+    out["untangle"] = {k: val("untangle_" + k) for k in
+                       ("invalid_before", "invalid_after", "sweeps", "moved",
+                        "seconds")}
+    for k in ("invalid_before", "invalid_after", "sweeps", "moved"):
+        out["untangle"][k] = int(out["untangle"][k])
+    out["untangle"]["nodes_moved"] = out["untangle"].pop("moved")
     return out
 
 

@@ -5,7 +5,8 @@
 opens Gmsh's own graphical interface (gmsh.fltk, Gmsh 4.8) in this process,
 loads and (if needed) meshes the model, and adds a "GETMe adaptive" group to
 the ONELAB panel: method, sigma, maximum iterations, threshold fraction,
-fixed physical groups, and a "Smooth (GETMe)" button that smooths the mesh
+fixed physical groups, the finishing step, Gmsh's swaps first, and a
+"Smooth (GETMe)" button that smooths the mesh
 shown, in place, and redraws it.  Results (q*min / q_mean before and after,
 iterations, nodes moved) appear read-only under "GETMe adaptive/Result"; the
 log lines go to Gmsh's message window.  File > Save Mesh saves the result.
@@ -48,6 +49,15 @@ def parameters():
         {"type": "string", "name": P + "4Fixed groups", "values": [""],
          "help": "comma-separated physical group names or dim:tag; "
                  "available: " + (", ".join(groups) or "none")},
+        {"type": "number", "name": P + "6Finishing step", "values": [1],
+         "choices": [0, 1],
+         "help": "after the q*min stage, raise the worst elements by local "
+                 "max-min moves of their free nodes (0: the paper's method "
+                 "alone)"},
+        {"type": "number", "name": P + "7Gmsh swaps first", "values": [0],
+         "choices": [0, 1],
+         "help": "when some worst tets have no free node, run Gmsh's own "
+                 "optimizer (edge/face swaps) before GETMe"},
         {"type": "number", "name": P + "5Distort mesh now (demo)",
          "values": [0], "choices": [0, 1],
          "help": "random validity-preserving moves of the free nodes, to "
@@ -57,9 +67,11 @@ def parameters():
     ]
 
 
-def number(name):
+def number(name, default=None):
+    """A panel number; ONELAB drops a number whose only value is 0 from the
+    JSON it was given, so such parameters read back empty: default."""
     v = gmsh.onelab.getNumber(P + name)
-    return v[0] if v else None
+    return v[0] if v else default
 
 
 RESULT_ROWS = ["q*min before", "q*min after", "q_mean before",
@@ -97,7 +109,13 @@ def show_result(res):
             ("q_mean before", res["q_mean_before"]),
             ("q_mean after", res["q_mean_after"]),
             ("Iterations", res["iterations"]),
+            ("Finishing passes", res["passes_finish"]),
             ("Nodes moved", res["num_moved"])]
+    if res["worst"]:
+        w = res["worst"][0]
+        rows.append(("Worst element tag", w["tag"]))
+        rows.append(("Worst element quality", w["quality"]))
+        rows.append(("Worst element free nodes", w["num_free"]))
     gmsh.onelab.set(json.dumps([
         {"type": "number", "name": P + "Result/%d%s" % (i, label),
          "values": [float(v)], "readOnly": True}
@@ -126,7 +144,9 @@ def smooth():
         res = gg.optimize(method=method[0] if method else "getme", fix=fix,
                           sigma=number("1Sigma"),
                           max_iter=int(number("2Max iterations")),
-                          threshold_fraction=number("3Threshold fraction"))
+                          threshold_fraction=number("3Threshold fraction"),
+                          finish=int(number("6Finishing step", 1)),
+                          topology=int(number("7Gmsh swaps first", 0)))
         show_result(res)
     except GetmeError as e:
         show_error(str(e))
