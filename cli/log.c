@@ -124,7 +124,12 @@ getme_doc *cli_open(const char *path, const getme_doc_options *opts,
     getme_doc *doc = NULL;
     getme_io_status st = getme_doc_open(&doc, path, opts);
     *code = st;
-    if (st == GETME_IO_OK || (allow_invalid && st == GETME_IO_ERR_INVALID)) {
+    /* allow_invalid: inverted elements found in a complete mesh (to be
+       untangled or reported on); not elements an adapter refused as
+       degenerate (a node twice), which no node move repairs */
+    if (st == GETME_IO_OK ||
+        (allow_invalid && st == GETME_IO_ERR_INVALID && doc->mesh &&
+         doc->stats.num_invalid > 0)) {
         if (doc->warning[0])
             cli_warning(log, "%s", doc->warning);
         return doc;

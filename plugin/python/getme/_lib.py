@@ -161,6 +161,7 @@ class Params(ctypes.Structure):
                 ("finish_max_passes", c_int), ("corner_guard", c_int),
                 ("corner_floor", c_double),
                 ("num_threads", c_int), ("renumber", c_int),
+                ("untangle", c_int),
                 ("progress", c_void_p), ("progress_data", c_void_p)]
 
 
@@ -183,7 +184,7 @@ def defaults():
             "finish_fraction": p.finish_fraction,
             "finish_max_passes": p.finish_max_passes,
             "corner_guard": p.corner_guard, "corner_floor": p.corner_floor,
-            "renumber": p.renumber}
+            "renumber": p.renumber, "untangle": p.untangle}
 
 
 def version():

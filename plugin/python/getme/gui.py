@@ -75,7 +75,9 @@ def number(name, default=None):
 
 
 RESULT_ROWS = ["q*min before", "q*min after", "q_mean before",
-               "q_mean after", "Iterations", "Nodes moved"]
+               "q_mean after", "Iterations", "Finishing passes", "Nodes moved",
+               "Worst element tag", "Worst element quality",
+               "Worst element free nodes"]
 
 
 def clear_result():
@@ -104,22 +106,22 @@ def show_error(message):
 
 def show_result(res):
     clear_result()
-    rows = [("q*min before", res["q_min_star_before"]),
-            ("q*min after", res["q_min_star_after"]),
-            ("q_mean before", res["q_mean_before"]),
-            ("q_mean after", res["q_mean_after"]),
-            ("Iterations", res["iterations"]),
-            ("Finishing passes", res["passes_finish"]),
-            ("Nodes moved", res["num_moved"])]
+    values = {"q*min before": res["q_min_star_before"],
+              "q*min after": res["q_min_star_after"],
+              "q_mean before": res["q_mean_before"],
+              "q_mean after": res["q_mean_after"],
+              "Iterations": res["iterations"],
+              "Finishing passes": res["passes_finish"],
+              "Nodes moved": res["num_moved"]}
     if res["worst"]:
         w = res["worst"][0]
-        rows.append(("Worst element tag", w["tag"]))
-        rows.append(("Worst element quality", w["quality"]))
-        rows.append(("Worst element free nodes", w["num_free"]))
+        values.update({"Worst element tag": w["tag"],
+                       "Worst element quality": w["quality"],
+                       "Worst element free nodes": w["num_free"]})
     gmsh.onelab.set(json.dumps([
         {"type": "number", "name": P + "Result/%d%s" % (i, label),
-         "values": [float(v)], "readOnly": True}
-        for i, (label, v) in enumerate(rows)]))
+         "values": [float(values[label])], "readOnly": True}
+        for i, label in enumerate(RESULT_ROWS) if label in values]))
 
 
 def redraw():
