@@ -61,6 +61,12 @@ void cli_print_measure_histograms(const cli_log *log, const cli_measures *m,
 /* {"tet": {"mean_ratio": {...}, "min_dihedral": {...}, ...}, ...} */
 void cli_json_measures(FILE *f, const cli_measures *m);
 
+/* The smoothing parameters of libgetme's table (getme_param_at): name,
+   default, range and help, one per line, for --help. */
+void cli_print_params(FILE *out);
+/* "[0, 1]", "> 0", ">= 0": a parameter's range for messages. */
+void cli_param_range(const getme_param_info *p, char *buf, size_t size);
+
 /* Parse helpers: return 0 on success, print an error and return -1. */
 int cli_parse_int(const char *opt, const char *s, long min, long max, long *out);
 int cli_parse_double(const char *opt, const char *s, double *out);

@@ -453,6 +453,7 @@ int getme_cli_gmsh(int argc, char **argv)
             fputs(GMSH_HELP, stdout);
             fputs(CLI_SMOOTH_OPTIONS_HELP, stdout);
             fputs(GMSH_HELP_TAIL, stdout);
+            cli_print_params(stdout);
             return 0;
         }
     gmsh_args a;

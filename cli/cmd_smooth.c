@@ -60,6 +60,7 @@ static int parse(int argc, char **argv, smooth_args *a)
             fputs(SMOOTH_HELP_HEAD, stdout);
             fputs(CLI_SMOOTH_OPTIONS_HELP, stdout);
             fputs(SMOOTH_HELP_TAIL, stdout);
+            cli_print_params(stdout);
             return -1;
         } else if (!strcmp(o, "-o") || !strcmp(o, "--output") ||
                    !strcmp(o, "--worst")) {

@@ -138,3 +138,26 @@ getme_doc *cli_open(const char *path, const getme_doc_options *opts,
     getme_doc_close(doc);
     return NULL;
 }
+
+void cli_param_range(const getme_param_info *p, char *buf, size_t size)
+{
+    if (isinf(p->max))
+        snprintf(buf, size, "%s %g", p->open_min ? ">" : ">=", p->min);
+    else
+        snprintf(buf, size, "%c%g, %g]", p->open_min ? '(' : '[', p->min,
+                 p->max);
+}
+
+void cli_print_params(FILE *out)
+{
+    static const char *const kind[] = {"real", "integer", "0/1", "code"};
+    fputs("\nparameters (--param NAME=VALUE; the library's table, getme.h):\n",
+          out);
+    for (int i = 0; i < getme_param_count(); i++) {
+        const getme_param_info *p = getme_param_at(i);
+        char range[64];
+        cli_param_range(p, range, sizeof range);
+        fprintf(out, "  %-19s %-7s default %-6g %-13s %s\n", p->name,
+                kind[p->type], p->default_value, range, p->help);
+    }
+}

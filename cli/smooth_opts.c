@@ -26,15 +26,8 @@ const char CLI_SMOOTH_OPTIONS_HELP[] =
     "  --allow-invalid        if untangling leaves invalid elements, still\n"
     "                         write the partly untangled (unsmoothed) mesh\n"
     "                         (the exit code stays 8)\n"
-    "  --param NAME=VALUE     any smoothing parameter: sigma (1.5), tol (1e-4),\n"
-    "                         threshold_fraction (0.005), max_no_min_improve (5),\n"
-    "                         min_tol (1e-5), keep_best (1), renumber (1),\n"
-    "                         finish (1: finishing step after the q*min stage;\n"
-    "                         0: the paper's GETMe adaptive alone),\n"
-    "                         finish_fraction (0.001), finish_max_passes (100),\n"
-    "                         corner_guard (1: no hex/prism/pyramid/quad corner\n"
-    "                         ends below max(input's worst, corner_floor)),\n"
-    "                         corner_floor (0)\n"
+    "  --param NAME=VALUE     any smoothing parameter (repeatable; the table\n"
+    "                         below)\n"
     "  --report FILE.json     write before/after statistics, iterations,\n"
     "                         the worst elements (smooth) and the\n"
     "                         per-iteration history as JSON\n"
@@ -72,8 +65,18 @@ static int set_param(getme_params *p, const char *arg)
     name[eq - arg] = '\0';
     if (cli_parse_double("--param", eq + 1, &v) != 0)
         return -1;
+    const getme_param_info *info = getme_param_find(name);
+    if (!info) {
+        cli_error("--param %s: unknown parameter '%s' (--help lists them)",
+                  arg, name);
+        return -1;
+    }
     if (getme_params_set(p, name, v) != GETME_OK) {
-        cli_error("--param %s: unknown parameter or value out of range", arg);
+        char range[64];
+        cli_param_range(info, range, sizeof range);
+        cli_error("--param %s: %s takes %s %s", arg, name,
+                  info->type == GETME_PARAM_REAL ? "a number" : "an integer",
+                  range);
         return -1;
     }
     return 0;

@@ -523,16 +523,47 @@ typedef struct getme_params {
 /* Fill params with the paper's defaults (Sec. 3.1) and ours for the rest. */
 GETME_API void getme_params_init(getme_params *params);
 
+/* ---- the parameter table ------------------------------------------------ */
+
+typedef enum getme_param_type {
+    GETME_PARAM_REAL = 0, /* a double                                     */
+    GETME_PARAM_INT = 1,  /* an integer                                   */
+    GETME_PARAM_BOOL = 2, /* 0 or 1                                       */
+    GETME_PARAM_ENUM = 3  /* an integer code (method: 0 adaptive, 1 laplace)*/
+} getme_param_type;
+
+/* One numeric parameter of getme_params: the single definition every
+   binding (CLI, Python, Gmsh options and GUI) lists and checks against. */
+typedef struct getme_param_info {
+    const char *name;      /* "sigma", "threshold_fraction", ...           */
+    getme_param_type type;
+    double default_value;  /* what getme_params_init() sets               */
+    double min, max;       /* allowed range, closed ...                    */
+    int open_min;          /* ... except that min is excluded if set       */
+    size_t offset;         /* of the field in getme_params (int or double) */
+    const char *help;      /* one line                                     */
+} getme_param_info;
+
+/* How many parameters the table has; the i-th (NULL outside 0..count-1);
+   the one named name (NULL if unknown). */
+GETME_API int getme_param_count(void);
+GETME_API const getme_param_info *getme_param_at(int i);
+GETME_API const getme_param_info *getme_param_find(const char *name);
+
 /*
- * Set a numeric parameter by name: "method" (0 adaptive, 1 laplace),
- * "max_iter", "tol", "sigma", "max_no_min_improve", "min_tol",
- * "threshold_fraction", "keep_best", "finish", "finish_fraction",
+ * Set a numeric parameter by name (any name of the table above: "method"
+ * (0 adaptive, 1 laplace), "max_iter", "tol", "sigma", "max_no_min_improve",
+ * "min_tol", "threshold_fraction", "keep_best", "finish", "finish_fraction",
  * "finish_max_passes", "corner_guard", "corner_floor", "num_threads",
- * "renumber", "untangle".  Returns GETME_ERR_ARGUMENT for
- * an unknown name or a value out of range.  For bindings (Python, CLI).
+ * "renumber", "untangle").  Returns GETME_ERR_ARGUMENT for an unknown name
+ * or a value out of range (an integer kind given a fraction included).
  */
 GETME_API getme_status getme_params_set(getme_params *params, const char *name,
                                         double value);
+/* Read a numeric parameter by name into *value; GETME_ERR_ARGUMENT for an
+   unknown name. */
+GETME_API getme_status getme_params_get(const getme_params *params,
+                                        const char *name, double *value);
 /* Set a relaxation table: stage GETME_STAGE_MEAN or GETME_STAGE_MIN; values
    descending in [0,1], n in 1..GETME_MAX_RELAX, last value must be 0. */
 GETME_API getme_status getme_params_set_relax(getme_params *params,

@@ -469,6 +469,19 @@ static void free_adaptive(getme_run *run)
     run->tlist = NULL, run->tflag = NULL, run->stamps = NULL;
 }
 
+/* The corner guard's floor and its skip bounds (smooth_internal.h); the
+   margins keep a rounding in q or in the bound from skipping an element
+   whose computed corner would be just below the floor. */
+static void set_corner_floor(getme_run *run, double floor)
+{
+    run->corner_floor = floor;
+    double f = floor > 0.0 ? floor * (1.0 + 1e-9) + 1e-12 : 0.0;
+    for (int t = 0; t < GETME_NUM_TYPES; t++)
+        run->guard_skip_q[t] = 2.0;
+    run->guard_skip_q[GETME_HEX] = (7.0 + cbrt(f * f)) / 8.0 + 1e-12;
+    run->guard_skip_q[GETME_QUAD] = (3.0 + f) / 4.0 + 1e-12;
+}
+
 getme_status getme__adaptive(getme_run *run)
 {
     getme_ws *ws = run->ws;
@@ -484,9 +497,9 @@ getme_status getme__adaptive(getme_run *run)
         goto done;
     lists_all(run);
     run->guard = p->corner_guard;
-    run->corner_floor = p->corner_floor > res->corner_sj_initial
-                            ? p->corner_floor
-                            : res->corner_sj_initial;
+    set_corner_floor(run, p->corner_floor > res->corner_sj_initial
+                              ? p->corner_floor
+                              : res->corner_sj_initial);
 
     double q_mean = res->q_mean_initial, q_min = res->q_min_star_initial;
     /* best_min: best q*_min since the end of the q_mean stage (its mesh is

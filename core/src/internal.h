@@ -162,8 +162,8 @@ const getme_block *getme__find_block(const getme_mesh *mesh, int32_t e,
    that are mirrored get y negated.  Returns the element type. */
 int getme__gather(const getme_mesh *mesh, int32_t e, double *x);
 
-/* NULL if params are usable, else a description of the problem. */
-const char *getme__params_problem(const getme_params *params);
+/* 0 if params are usable, else -1 with a description in buf. */
+int getme__params_problem(const getme_params *params, char *buf, size_t size);
 
 /* Decide mesh->mirror for planar meshes (majority orientation). */
 void getme__detect_orientation(getme_mesh *mesh);

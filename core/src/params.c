@@ -5,6 +5,8 @@
 #include "internal.h"
 
 #include <math.h>
+#include <stddef.h>
+#include <stdio.h>
 #include <string.h>
 
 /* Our choice for DetermineTransformationThreshold's position (the paper
@@ -18,108 +20,137 @@
    larger fractions are clearly worse (as DESIGN's prototype found). */
 #define DEFAULT_THRESHOLD_FRACTION 0.005
 
+/* The one table of the numeric parameters: name, kind, default, range and
+   help.  getme_params_init, getme_params_set, getme_params_get, the whole-set
+   check and every binding's list (getme_param_info: the CLI's --help and
+   --param, Python, the Gmsh options) come from it, so a parameter is
+   defined here once.  Ranges are closed; "open_min" makes the lower bound
+   exclusive (sigma > 0). */
+#define FIELD(f) offsetof(getme_params, f)
+static const getme_param_info PARAMS[] = {
+    {"method", GETME_PARAM_ENUM, 0, 0, 1, 0, FIELD(method),
+     "0 GETMe adaptive, 1 smart Laplace (the baseline)"},
+    {"max_iter", GETME_PARAM_INT, 1000, 0, 1e9, 0, FIELD(max_iter),
+     "iterations over both stages"},
+    {"tol", GETME_PARAM_REAL, 1e-4, 0, HUGE_VAL, 0, FIELD(tol),
+     "end the q_mean stage (and Laplace) when an iteration gains less"},
+    {"sigma", GETME_PARAM_REAL, 1.5, 0, HUGE_VAL, 1, FIELD(sigma),
+     "transformation parameter (paper: 3/2)"},
+    {"max_no_min_improve", GETME_PARAM_INT, 5, 1, 1e6, 0,
+     FIELD(max_no_min_improve),
+     "iterations without q*min gain that end a q*min cycle"},
+    {"min_tol", GETME_PARAM_REAL, 1e-5, 0, HUGE_VAL, 0, FIELD(min_tol),
+     "a q*min gain counts only above this"},
+    {"threshold_fraction", GETME_PARAM_REAL, DEFAULT_THRESHOLD_FRACTION, 0, 1,
+     0, FIELD(threshold_fraction),
+     "q*min cycles transform the elements below the quality at this "
+     "position of the sorted free elements"},
+    {"keep_best", GETME_PARAM_BOOL, 1, 0, 1, 0, FIELD(keep_best),
+     "end on the best q*min mesh of the q*min stage"},
+    {"finish", GETME_PARAM_BOOL, 1, 0, 1, 0, FIELD(finish),
+     "finishing step after the q*min stage (0: the paper's method alone)"},
+    {"finish_fraction", GETME_PARAM_REAL, 0.001, 0, 1, 0,
+     FIELD(finish_fraction),
+     "finishing passes work on the elements below the quality at this "
+     "position (at least 64)"},
+    {"finish_max_passes", GETME_PARAM_INT, 100, 0, 1e6, 0,
+     FIELD(finish_max_passes), "at most this many finishing passes"},
+    {"corner_guard", GETME_PARAM_BOOL, 1, 0, 1, 0, FIELD(corner_guard),
+     "no hex/prism/pyramid/quad corner ends below max(input's worst, "
+     "corner_floor)"},
+    {"corner_floor", GETME_PARAM_REAL, 0, -1, 1, 0, FIELD(corner_floor),
+     "floor of the corner guard (scaled Jacobian)"},
+    {"num_threads", GETME_PARAM_INT, 0, 0, 4096, 0, FIELD(num_threads),
+     "OpenMP threads (0: OpenMP's default); results do not depend on it"},
+    {"renumber", GETME_PARAM_BOOL, 1, 0, 1, 0, FIELD(renumber),
+     "reorder internally for cache locality"},
+    {"untangle", GETME_PARAM_BOOL, 1, 0, 1, 0, FIELD(untangle),
+     "untangle an input with invalid elements first (0: refuse it)"},
+};
+#define NUM_PARAMS ((int)(sizeof PARAMS / sizeof *PARAMS))
+
+int getme_param_count(void) { return NUM_PARAMS; }
+
+const getme_param_info *getme_param_at(int i)
+{
+    return i >= 0 && i < NUM_PARAMS ? &PARAMS[i] : NULL;
+}
+
+const getme_param_info *getme_param_find(const char *name)
+{
+    for (int i = 0; name && i < NUM_PARAMS; i++)
+        if (!strcmp(PARAMS[i].name, name))
+            return &PARAMS[i];
+    return NULL;
+}
+
+/* Is v a value parameter d may take? */
+static int in_range(const getme_param_info *d, double v)
+{
+    if (isnan(v) || (d->type == GETME_PARAM_REAL && !isfinite(v)))
+        return 0;
+    if (d->type != GETME_PARAM_REAL && v != floor(v))
+        return 0;
+    return (d->open_min ? v > d->min : v >= d->min) && v <= d->max;
+}
+
+/* The field of parameter d in p: every non-REAL parameter is an int (the
+   method enum has int's representation). */
+static void store(getme_params *p, const getme_param_info *d, double v)
+{
+    char *f = (char *)p + d->offset;
+    if (d->type == GETME_PARAM_REAL) {
+        memcpy(f, &v, sizeof v);
+    } else {
+        int i = (int)v;
+        memcpy(f, &i, sizeof i);
+    }
+}
+
+static double load(const getme_params *p, const getme_param_info *d)
+{
+    const char *f = (const char *)p + d->offset;
+    if (d->type == GETME_PARAM_REAL) {
+        double v;
+        memcpy(&v, f, sizeof v);
+        return v;
+    }
+    int i;
+    memcpy(&i, f, sizeof i);
+    return i;
+}
+
 void getme_params_init(getme_params *p)
 {
     static const double rmean[] = {1.0, 0.25, 0.0625, 0.0};
     static const double rmin[] = {0.5, 0.25, 0.1, 0.01, 0.0};
     memset(p, 0, sizeof *p);
-    p->method = GETME_METHOD_ADAPTIVE;
-    p->max_iter = 1000;
-    p->tol = 1e-4;
-    p->sigma = 1.5;
+    for (int i = 0; i < NUM_PARAMS; i++)
+        store(p, &PARAMS[i], PARAMS[i].default_value);
     p->num_relax_mean = 4;
     memcpy(p->relax_mean, rmean, sizeof rmean);
     p->num_relax_min = 5;
     memcpy(p->relax_min, rmin, sizeof rmin);
-    p->max_no_min_improve = 5;
-    p->min_tol = 1e-5;
-    p->threshold_fraction = DEFAULT_THRESHOLD_FRACTION;
-    p->keep_best = 1;
-    p->finish = 1;
-    p->finish_fraction = 0.001;
-    p->finish_max_passes = 100;
-    p->corner_guard = 1;
-    p->corner_floor = 0.0;
-    p->num_threads = 0;
-    p->renumber = 1;
-    p->untangle = 1;
 }
 
 size_t getme_params_sizeof(void) { return sizeof(getme_params); }
 
-static int is_int(double v) { return isfinite(v) && v == floor(v); }
-
 getme_status getme_params_set(getme_params *p, const char *name, double v)
 {
-    if (!p || !name || isnan(v))
+    const getme_param_info *d = getme_param_find(name);
+    if (!p || !d || !in_range(d, v))
         return GETME_ERR_ARGUMENT;
-    if (!strcmp(name, "method")) {
-        if (v != 0.0 && v != 1.0)
-            return GETME_ERR_ARGUMENT;
-        p->method = v == 0.0 ? GETME_METHOD_ADAPTIVE : GETME_METHOD_SMART_LAPLACE;
-    } else if (!strcmp(name, "max_iter")) {
-        if (!is_int(v) || v < 0 || v > 1e9)
-            return GETME_ERR_ARGUMENT;
-        p->max_iter = (int)v;
-    } else if (!strcmp(name, "tol")) {
-        if (!(v >= 0.0) || !isfinite(v))
-            return GETME_ERR_ARGUMENT;
-        p->tol = v;
-    } else if (!strcmp(name, "sigma")) {
-        if (!(v > 0.0) || !isfinite(v))
-            return GETME_ERR_ARGUMENT;
-        p->sigma = v;
-    } else if (!strcmp(name, "max_no_min_improve")) {
-        if (!is_int(v) || v < 1 || v > 1e6)
-            return GETME_ERR_ARGUMENT;
-        p->max_no_min_improve = (int)v;
-    } else if (!strcmp(name, "min_tol")) {
-        if (!(v >= 0.0) || !isfinite(v))
-            return GETME_ERR_ARGUMENT;
-        p->min_tol = v;
-    } else if (!strcmp(name, "threshold_fraction")) {
-        if (!(v >= 0.0 && v <= 1.0))
-            return GETME_ERR_ARGUMENT;
-        p->threshold_fraction = v;
-    } else if (!strcmp(name, "keep_best")) {
-        if (v != 0.0 && v != 1.0)
-            return GETME_ERR_ARGUMENT;
-        p->keep_best = (int)v;
-    } else if (!strcmp(name, "finish")) {
-        if (v != 0.0 && v != 1.0)
-            return GETME_ERR_ARGUMENT;
-        p->finish = (int)v;
-    } else if (!strcmp(name, "finish_fraction")) {
-        if (!(v >= 0.0 && v <= 1.0))
-            return GETME_ERR_ARGUMENT;
-        p->finish_fraction = v;
-    } else if (!strcmp(name, "finish_max_passes")) {
-        if (!is_int(v) || v < 0 || v > 1e6)
-            return GETME_ERR_ARGUMENT;
-        p->finish_max_passes = (int)v;
-    } else if (!strcmp(name, "corner_guard")) {
-        if (v != 0.0 && v != 1.0)
-            return GETME_ERR_ARGUMENT;
-        p->corner_guard = (int)v;
-    } else if (!strcmp(name, "corner_floor")) {
-        if (!(v >= -1.0 && v <= 1.0))
-            return GETME_ERR_ARGUMENT;
-        p->corner_floor = v;
-    } else if (!strcmp(name, "num_threads")) {
-        if (!is_int(v) || v < 0 || v > 4096)
-            return GETME_ERR_ARGUMENT;
-        p->num_threads = (int)v;
-    } else if (!strcmp(name, "renumber")) {
-        if (v != 0.0 && v != 1.0)
-            return GETME_ERR_ARGUMENT;
-        p->renumber = (int)v;
-    } else if (!strcmp(name, "untangle")) {
-        if (v != 0.0 && v != 1.0)
-            return GETME_ERR_ARGUMENT;
-        p->untangle = (int)v;
-    } else {
+    store(p, d, v);
+    return GETME_OK;
+}
+
+getme_status getme_params_get(const getme_params *p, const char *name,
+                              double *value)
+{
+    const getme_param_info *d = getme_param_find(name);
+    if (!p || !d || !value)
         return GETME_ERR_ARGUMENT;
-    }
+    *value = load(p, d);
     return GETME_OK;
 }
 
@@ -147,33 +178,30 @@ getme_status getme_params_set_relax(getme_params *p, getme_stage stage, int n,
     return GETME_OK;
 }
 
-/* Check a parameter set as a whole (callers may fill the struct directly).
-   Returns NULL if it is usable, else what is wrong. */
-const char *getme__params_problem(const getme_params *p)
+static const char *relax_problem(const getme_params *p);
+
+/* Check a parameter set as a whole (callers may fill the struct directly):
+   0 if it is usable, else -1 with what is wrong in buf. */
+int getme__params_problem(const getme_params *p, char *buf, size_t size)
 {
-    if (p->method != GETME_METHOD_ADAPTIVE &&
-        p->method != GETME_METHOD_SMART_LAPLACE)
-        return "unknown method";
-    if (p->max_iter < 0)
-        return "max_iter must be >= 0";
-    if (!(p->tol >= 0.0) || !isfinite(p->tol))
-        return "tol must be finite and >= 0";
-    if (!(p->sigma > 0.0) || !isfinite(p->sigma))
-        return "sigma must be finite and > 0";
-    if (p->max_no_min_improve < 1)
-        return "max_no_min_improve must be >= 1";
-    if (!(p->min_tol >= 0.0) || !isfinite(p->min_tol))
-        return "min_tol must be finite and >= 0";
-    if (!(p->threshold_fraction >= 0.0 && p->threshold_fraction <= 1.0))
-        return "threshold_fraction must be in [0, 1]";
-    if (p->num_threads < 0)
-        return "num_threads must be >= 0";
-    if (!(p->finish_fraction >= 0.0 && p->finish_fraction <= 1.0))
-        return "finish_fraction must be in [0, 1]";
-    if (p->finish_max_passes < 0)
-        return "finish_max_passes must be >= 0";
-    if (!(p->corner_floor >= -1.0 && p->corner_floor <= 1.0))
-        return "corner_floor must be in [-1, 1]";
+    for (int i = 0; i < NUM_PARAMS; i++) {
+        const getme_param_info *d = &PARAMS[i];
+        if (!in_range(d, load(p, d))) {
+            snprintf(buf, size, "%s = %g is out of its range %c%g, %g]",
+                     d->name, load(p, d), d->open_min ? '(' : '[', d->min,
+                     d->max);
+            return -1;
+        }
+    }
+    const char *problem = relax_problem(p);
+    if (problem)
+        snprintf(buf, size, "%s", problem);
+    return problem ? -1 : 0;
+}
+
+/* The relaxation tables' rules (getme_params_set_relax), or NULL. */
+static const char *relax_problem(const getme_params *p)
+{
     const double *tab[2] = {p->relax_mean, p->relax_min};
     int num[2] = {p->num_relax_mean, p->num_relax_min};
     for (int s = 0; s < 2; s++) {

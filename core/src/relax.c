@@ -32,7 +32,8 @@ static inline double trial_quality(const getme_run *run, int32_t e)
     int t = getme__ws_type(ws, e);
     getme__ws_gather(ws, run->xnew, t, e, x);
     double q = getme__quality(t, x);
-    if (!run->guard || !getme__has_corners(t) || !(q > 0.0))
+    if (!run->guard || !getme__has_corners(t) || !(q > 0.0) ||
+        q >= run->guard_skip_q[t])
         return q;
     double sj = getme__corner_sj(t, x);
     if (sj >= run->corner_floor)

@@ -191,8 +191,8 @@ getme_status getme__start(getme_mesh *mesh, const getme_params **params,
     mesh->error[0] = '\0';
     if (mesh->num_elements == 0)
         return getme__fail(mesh, GETME_ERR_STATE, "the mesh has no elements");
-    const char *problem = getme__params_problem(*params);
-    if (problem)
+    char problem[160];
+    if (getme__params_problem(*params, problem, sizeof problem))
         return getme__fail(mesh, GETME_ERR_ARGUMENT, "parameters: %s", problem);
     int nt = (*params)->num_threads > 0 ? (*params)->num_threads
                                         : omp_get_max_threads();

@@ -53,6 +53,13 @@ typedef struct getme_run {
        min(its old value, corner_floor) like an invalid element. */
     int guard;
     double corner_floor; /* max(params.corner_floor, the input's worst)   */
+    /* Per type, a mean ratio from which on the worst corner is provably
+       above corner_floor, so the guard need not compute it: a hex's corner
+       mean ratios q_k are <= 1 and average to q, so min q_k >= 8q - 7, and
+       a corner's scaled Jacobian is >= q_k^(3/2) (AM-GM on its edge
+       lengths); a quad's >= q_k with min q_k >= 4q - 3.  Prisms and
+       pyramids (other targets W) are always checked: 2 never skips. */
+    double guard_skip_q[GETME_NUM_TYPES];
 } getme_run;
 
 /* The start of getme_smooth() and getme_mesh_untangle(): params NULL ->

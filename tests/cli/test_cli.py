@@ -202,12 +202,22 @@ def errors_case():
     run("smooth", expect=2)
     run("smooth", missing, expect=2)
     run("smooth", "a.msh", "-o", "b.msh", "--threads", "zero", expect=2)
-    run("smooth", "a.msh", "-o", "b.msh", "--param", "sigma=-1", expect=2)
+    p = run("smooth", "a.msh", "-o", "b.msh", "--param", "sigma=-1", expect=2)
+    check("sigma takes a number > 0" in p.stderr, "range named: " + p.stderr.strip())
+    p = run("smooth", "a.msh", "-o", "b.msh", "--param", "finish=0.5", expect=2)
+    check("finish takes an integer [0, 1]" in p.stderr, "integer range named: " + p.stderr.strip())
+    p = run("smooth", "a.msh", "-o", "b.msh", "--param", "sigm=1", expect=2)
+    check("unknown parameter 'sigm'" in p.stderr, "unknown parameter named")
     run("frobnicate", expect=2)
     p = run("--help")
     check("smooth" in p.stdout and "exit codes" in p.stdout, "--help answers")
     p = run("smooth", "--help")
     check("--fix" in p.stdout, "smooth --help lists options")
+    # the parameter list comes from the library's table: every name, with
+    # its default
+    table = [ln.split()[0] for ln in p.stdout.split("parameters (--param")[1].splitlines()[1:] if ln.strip()]
+    check(table[:3] == ["method", "max_iter", "tol"] and "finish" in table and
+          "corner_guard" in table and "untangle" in table, f"--help parameter table: {table}")
     garbage = os.path.join(WORK, "garbage.msh")
     open(garbage, "w").write("$MeshFormat\nthis is not a mesh\n")
     p = subprocess.run([GETME, "smooth", garbage, "-o", garbage + "-out.msh"], capture_output=True, text=True)

@@ -132,6 +132,49 @@ static void check_errors(void)
     r[2] = 0;
     CHECK(getme_params_set_relax(&p, GETME_STAGE_MIN, 3, r) == GETME_OK);
     CHECK_EQ_INT(p.num_relax_min, 3);
+
+    /* The parameter table: every entry round-trips through set/get, its
+       default is what getme_params_init sets, and its range is enforced. */
+    getme_params d;
+    getme_params_init(&d);
+    CHECK(getme_param_count() >= 16);
+    CHECK(getme_param_at(-1) == NULL && getme_param_at(getme_param_count()) == NULL);
+    for (int i = 0; i < getme_param_count(); i++) {
+        const getme_param_info *info = getme_param_at(i);
+        double v = -99;
+        CHECK(getme_param_find(info->name) == info);
+        CHECK(getme_params_get(&d, info->name, &v) == GETME_OK);
+        CHECK(v == info->default_value);
+        CHECK(info->help && info->help[0]);
+        getme_params q = d;
+        double top = isfinite(info->max) ? info->max : 1e300;
+        CHECK(getme_params_set(&q, info->name, top) == GETME_OK);
+        CHECK(getme_params_get(&q, info->name, &v) == GETME_OK && v == top);
+        CHECK(isfinite(info->max) ||
+              getme_params_set(&q, info->name, INFINITY) == GETME_ERR_ARGUMENT);
+        CHECK(getme_params_set(&q, info->name, info->min - 1) == GETME_ERR_ARGUMENT);
+        CHECK(getme_params_set(&q, info->name, NAN) == GETME_ERR_ARGUMENT);
+        if (info->type != GETME_PARAM_REAL)
+            CHECK(getme_params_set(&q, info->name, info->min + 0.5) == GETME_ERR_ARGUMENT);
+    }
+    CHECK(d.max_iter == 1000 && d.sigma == 1.5 && d.threshold_fraction == 0.005 &&
+          d.finish == 1 && d.corner_guard == 1 && d.untangle == 1 &&
+          d.method == GETME_METHOD_ADAPTIVE && d.min_tol == 1e-5);
+    CHECK(getme_params_set(&d, "sigma", 0.0) == GETME_ERR_ARGUMENT); /* open */
+    CHECK(getme_params_set(&d, "method", 1) == GETME_OK &&
+          d.method == GETME_METHOD_SMART_LAPLACE);
+    CHECK(getme_param_find("nonsense") == NULL);
+    /* A struct filled by hand is checked against the same table. */
+    getme_mesh *mm = NULL;
+    double tet[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    int32_t c4[4] = {0, 1, 2, 3};
+    CHECK(getme_mesh_create(&mm, 3, 4, tet) == GETME_OK);
+    CHECK(getme_mesh_add_elements(mm, GETME_TET, 1, c4, NULL) == GETME_OK);
+    getme_params_init(&d);
+    d.finish_fraction = 2.0;
+    CHECK(getme_smooth(mm, &d, NULL) == GETME_ERR_ARGUMENT);
+    CHECK(strstr(getme_mesh_error(mm), "finish_fraction = 2 is out of its range [0, 1]") != NULL);
+    getme_mesh_free(mm);
 }
 
 /* A mesh with no free node is left alone. */

@@ -13,9 +13,10 @@ gives mean-ratio statistics of that model or of numpy arrays, plus the
 dihedral angles, scaled Jacobian, Gmsh's gamma and SICN per element type;
 getme.element_measure() one of them for one element.
 """
-from ._lib import GetmeError, version
+from ._lib import GetmeError, parameters, version
 from .quality import element_measure, quality
 from . import gmsh
 
-__all__ = ["GetmeError", "element_measure", "gmsh", "quality", "version"]
+__all__ = ["GetmeError", "element_measure", "gmsh", "parameters", "quality",
+           "version"]
 __version__ = version()

@@ -71,6 +71,16 @@ class MeasureStats(ctypes.Structure):
                 ("histogram", c_int64 * HIST_BINS)]
 
 
+class ParamInfo(ctypes.Structure):
+    """getme_param_info from getme.h: one entry of the parameter table."""
+    _fields_ = [("name", c_char_p), ("type", c_int), ("default_value", c_double),
+                ("min", c_double), ("max", c_double), ("open_min", c_int),
+                ("offset", c_size_t), ("help", c_char_p)]
+
+
+PARAM_TYPES = ("real", "int", "bool", "enum")
+
+
 def _sig(lib, name, restype, *argtypes):
     f = getattr(lib, name)
     f.restype = restype
@@ -78,6 +88,8 @@ def _sig(lib, name, restype, *argtypes):
 
 
 _sig(core, "getme_version", c_char_p)
+_sig(core, "getme_param_count", c_int)
+_sig(core, "getme_param_at", POINTER(ParamInfo), c_int)
 _sig(core, "getme_status_string", c_char_p, c_int)
 _sig(core, "getme_mesh_create", c_int, POINTER(c_void_p), c_int, c_int32,
      POINTER(c_double))
@@ -145,51 +157,29 @@ def measure_dict(get):
     return out
 
 
-MAX_RELAX = 16
-
-
-class Params(ctypes.Structure):
-    """getme_params from getme.h (checked against getme_params_sizeof)."""
-    _fields_ = [("method", c_int), ("max_iter", c_int), ("tol", c_double),
-                ("sigma", c_double), ("num_relax_mean", c_int),
-                ("relax_mean", c_double * MAX_RELAX),
-                ("num_relax_min", c_int),
-                ("relax_min", c_double * MAX_RELAX),
-                ("max_no_min_improve", c_int), ("min_tol", c_double),
-                ("threshold_fraction", c_double), ("keep_best", c_int),
-                ("finish", c_int), ("finish_fraction", c_double),
-                ("finish_max_passes", c_int), ("corner_guard", c_int),
-                ("corner_floor", c_double),
-                ("num_threads", c_int), ("renumber", c_int),
-                ("untangle", c_int),
-                ("progress", c_void_p), ("progress_data", c_void_p)]
-
-
-_sig(core, "getme_params_init", None, POINTER(Params))
-_sig(core, "getme_params_sizeof", c_size_t)
-
-
-def defaults():
-    """The library's default parameters (getme_params_init): the one table
-    every entry point (CLI, Python, GUI) starts from."""
-    if ctypes.sizeof(Params) != core.getme_params_sizeof():
-        raise GetmeError("getme_params layout differs from this module's")
-    p = Params()
-    core.getme_params_init(ctypes.byref(p))
-    return {"method": "getme" if p.method == 0 else "laplace",
-            "max_iter": p.max_iter, "tol": p.tol, "sigma": p.sigma,
-            "max_no_min_improve": p.max_no_min_improve, "min_tol": p.min_tol,
-            "threshold_fraction": p.threshold_fraction,
-            "keep_best": p.keep_best, "finish": p.finish,
-            "finish_fraction": p.finish_fraction,
-            "finish_max_passes": p.finish_max_passes,
-            "corner_guard": p.corner_guard, "corner_floor": p.corner_floor,
-            "renumber": p.renumber, "untangle": p.untangle}
-
-
 def version():
     return core.getme_version().decode()
 
 
 def status_text(status):
     return core.getme_status_string(status).decode()
+
+
+def parameters():
+    """libgetme's parameter table (getme_param_at): one dict per numeric
+    parameter with name, type ("real", "int", "bool", "enum"), default, min,
+    max, open_min and help.  The one definition the CLI, the Gmsh options
+    and the GUI also use."""
+    out = []
+    for i in range(core.getme_param_count()):
+        p = core.getme_param_at(i).contents
+        out.append({"name": p.name.decode(), "type": PARAM_TYPES[p.type],
+                    "default": p.default_value, "min": p.min, "max": p.max,
+                    "open_min": bool(p.open_min), "help": p.help.decode()})
+    return out
+
+
+def defaults():
+    """{name: default} of libgetme's parameter table (getme_params_init's
+    values): what every entry point (CLI, Python, GUI) starts from."""
+    return {p["name"]: p["default"] for p in parameters()}

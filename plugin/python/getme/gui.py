@@ -24,36 +24,38 @@ import sys
 import gmsh
 
 from . import gmsh as gg
-from . import _lib
 from ._lib import GetmeError
+from ._lib import parameters as getme_parameters
 
 P = "GETMe adaptive/"
 
 
+def _from_table(label, name, step, lo=None, hi=None):
+    """A panel number whose default, range and help come from libgetme's
+    parameter table (getme.parameters()), so the GUI cannot drift from the
+    CLI and the library.  lo/hi narrow the slider's range only."""
+    p = next(p for p in getme_parameters() if p["name"] == name)
+    return {"type": "number", "name": P + label, "values": [p["default"]],
+            "min": p["min"] if lo is None else lo,
+            "max": p["max"] if hi is None else hi, "step": step,
+            "help": p["help"]}
+
+
 def parameters():
-    d = _lib.defaults()  # the library's defaults, as the CLI's
     groups = ["%s" % gmsh.model.getPhysicalName(d, t) or "%d:%d" % (d, t)
               for d, t in gmsh.model.getPhysicalGroups()]
     return [
-        {"type": "string", "name": P + "0Method", "values": [d["method"]],
+        {"type": "string", "name": P + "0Method", "values": ["getme"],
          "choices": ["getme", "laplace"],
          "help": "GETMe adaptive or smart Laplace (baseline)"},
-        {"type": "number", "name": P + "1Sigma", "values": [d["sigma"]],
-         "min": 0.05, "max": 3, "step": 0.05},
-        {"type": "number", "name": P + "2Max iterations",
-         "values": [d["max_iter"]],
-         "min": 1, "max": 100000, "step": 1},
-        {"type": "number", "name": P + "3Threshold fraction",
-         "values": [d["threshold_fraction"]], "min": 0.0001, "max": 1,
-         "step": 0.001},
+        _from_table("1Sigma", "sigma", 0.05, lo=0.05, hi=3),
+        _from_table("2Max iterations", "max_iter", 1, lo=1, hi=100000),
+        _from_table("3Threshold fraction", "threshold_fraction", 0.001,
+                    lo=0.0001),
         {"type": "string", "name": P + "4Fixed groups", "values": [""],
          "help": "comma-separated physical group names or dim:tag; "
                  "available: " + (", ".join(groups) or "none")},
-        {"type": "number", "name": P + "6Finishing step", "values": [1],
-         "choices": [0, 1],
-         "help": "after the q*min stage, raise the worst elements by local "
-                 "max-min moves of their free nodes (0: the paper's method "
-                 "alone)"},
+        dict(_from_table("6Finishing step", "finish", 1), choices=[0, 1]),
         {"type": "number", "name": P + "7Gmsh swaps first", "values": [0],
          "choices": [0, 1],
          "help": "when some worst tets have no free node, run Gmsh's own "
