@@ -73,10 +73,17 @@ int cli_distort(int argc, char **argv)
     }
     if (rounds < 0)
         rounds = target > 0.0 ? 100 : 1;
-    int st;
-    getme_doc *doc = cli_open(input, NULL, 0, &st);
+    cli_paths paths = {input, output, NULL, "", ""};
+    int st = cli_check_paths(&paths);
+    if (st)
+        return st;
+    getme_doc *doc = cli_open(input, NULL, 0, &st, &log);
     if (!doc)
         return st;
+    if ((st = cli_check_read_files(&paths, doc)) != 0) {
+        getme_doc_close(doc);
+        return st;
+    }
     getme_mesh *mesh = getme_doc_mesh(doc);
     getme_quality_stats s;
     cli_print_stats(&log, "Quality before", &doc->stats);
@@ -88,7 +95,10 @@ int cli_distort(int argc, char **argv)
     }
     getme_mesh_quality_stats(mesh, -1, &s);
     cli_print_stats(&log, "Quality after ", &s);
-    st = getme_doc_write(doc, output);
+    cli_guard guard = {0};
+    cli_write_guard(&guard, 1);
+    st = getme_doc_write(doc, paths.out);
+    cli_write_guard(&guard, 0);
     if (st != (int)GETME_IO_OK)
         cli_error("%s", getme_doc_error(doc));
     else

@@ -1,15 +1,15 @@
 /*
  * cmd_gmsh.c -- `getme gmsh`: mesh a .geo / .step / .brep with Gmsh (or
  * open a .msh), smooth it with GETMe adaptive through the Gmsh plugin, and
- * write the result, all in one process with Gmsh's own terminal output on.
+ * write the result, all in one process with Gmsh's own terminal output on
+ * for reading and meshing.
  *
  *   getme gmsh model.geo|model.step|model.msh [-2|-3] [-clmax X] [-clmin X]
- *              [-o out.msh] [-format msh22|msh41] [-bin] [--method getme|
- *              laplace] [--fix GROUP]... [--threads N] [--sigma S]
- *              [--max-iter N] [--threshold-fraction F] [--free-interfaces]
- *              [--topology] [--no-untangle] [--allow-invalid] [--quiet]
+ *              [-o out.msh] [-format msh22|msh41] [-bin] [smooth options]
  *
- * Exit codes as the rest of the getme command (cli.h).
+ * The smooth options are `getme smooth`'s, parsed by the same code
+ * (smooth_opts.c), and the smoothing logs the same lines.  Exit codes as
+ * the rest of the getme command (cli.h).
  */
 #include "cli.h"
 #include "getme_gmsh.h"
@@ -32,42 +32,21 @@ static const char GMSH_HELP[] =
     "                        .vtk, .unv, ...), chosen by its extension\n"
     "  -format msh22|msh41   MSH version of the output (default 4.1)\n"
     "  -bin                  binary MSH\n"
-    "  --method getme|laplace   GETMe adaptive (default) or smart Laplace\n"
-    "  --fix GROUP[,GROUP]   keep the nodes of physical groups (names or dim:tag)\n"
-    "                        fixed; repeatable\n"
-    "  --free-interfaces     do not fix faces between physical groups (nodes on\n"
-    "                        Gmsh interface surfaces stay fixed regardless)\n"
     "  --topology            when some of the worst tets have no free node (no\n"
     "                        node move can fix them), run Gmsh's optimize(\"\")\n"
     "                        (edge/face swaps) first, then GETMe adaptive\n"
-    "  --no-untangle         refuse a mesh with inverted elements (exit 6)\n"
-    "                        instead of untangling it first\n"
-    "  --allow-invalid       if untangling leaves inverted elements, still\n"
-    "                        write the partly untangled mesh (exit code 8)\n"
-    "  --threads N           OpenMP threads (0: default)\n"
-    "  --sigma S, --max-iter N, --threshold-fraction F   GETMe parameters\n"
-    "  --quiet               only errors\n";
+    "smooth options (as getme smooth; --fix also takes GROUP,GROUP,...):\n";
+
+static const char GMSH_HELP_TAIL[] =
+    "  --sigma S, --threshold-fraction F   short for --param sigma=S ...\n";
 
 typedef struct gmsh_args {
     const char *input, *output;
     int dim;
     double clmax, clmin, msh_version;
-    int binary, quiet, allow_invalid;
-    getme_gmsh_options *opt;
+    int binary, topology;
+    cli_smooth_opts o;
 } gmsh_args;
-
-static int set_param(gmsh_args *a, const char *name, const char *opt,
-                     const char *value)
-{
-    double v;
-    if (cli_parse_double(opt, value, &v) != 0)
-        return -1;
-    if (getme_gmsh_options_set(a->opt, name, v) != GETME_OK) {
-        cli_error("%s: %s", opt, getme_gmsh_options_error(a->opt));
-        return -1;
-    }
-    return 0;
-}
 
 static int parse_format(gmsh_args *a, const char *v)
 {
@@ -83,103 +62,63 @@ static int parse_format(gmsh_args *a, const char *v)
     return 0;
 }
 
-static int takes_value(const char *o)
-{
-    static const char *const names[] = {
-        "-o", "-clmax", "-clmin", "-format", "--method", "--fix", "--threads",
-        "--sigma", "--max-iter", "--threshold-fraction"};
-    for (size_t i = 0; i < sizeof names / sizeof *names; i++)
-        if (!strcmp(o, names[i]))
-            return 1;
-    return 0;
-}
-
-/* --fix takes one name or a comma-separated list ("clamp,bolt holes"). */
-static int add_fixed_groups(gmsh_args *a, const char *list)
-{
-    char name[256];
-    while (*list) {
-        size_t n = strcspn(list, ",");
-        while (n && *list == ' ') {
-            list++;
-            n--;
-        }
-        snprintf(name, sizeof name, "%.*s", (int)(n < 255 ? n : 255), list);
-        for (size_t k = strlen(name); k && name[k - 1] == ' ';)
-            name[--k] = 0;
-        if (name[0] &&
-            getme_gmsh_options_add_fixed_group(a->opt, name) != GETME_OK) {
-            cli_error("out of memory");
-            return -1;
-        }
-        list += n + (list[n] == ',');
-    }
-    return 0;
-}
-
-/* One option at argv[*i]; advances *i past its value.  0 ok, -1 error. */
+/* One Gmsh option at argv[*i]; advances *i past its value.  0 ok, -1
+   error. */
 static int parse_one(gmsh_args *a, int argc, char **argv, int *i)
 {
     const char *o = argv[*i], *v = *i + 1 < argc ? argv[*i + 1] : NULL;
-    int takes = 1, rc = 0;
+    double x;
     if (!strcmp(o, "-2") || !strcmp(o, "-3")) {
         a->dim = o[1] - '0';
-        takes = 0;
-    } else if (!strcmp(o, "-bin")) {
-        a->binary = 1;
-        takes = 0;
-    } else if (!strcmp(o, "--quiet") || !strcmp(o, "-q")) {
-        a->quiet = 1;
-        takes = 0;
-    } else if (!strcmp(o, "--free-interfaces")) {
-        getme_gmsh_options_set(a->opt, "fix_interfaces", 0);
-        takes = 0;
-    } else if (!strcmp(o, "--no-untangle")) {
-        getme_gmsh_options_set(a->opt, "untangle", 0);
-        takes = 0;
-    } else if (!strcmp(o, "--topology")) {
-        getme_gmsh_options_set(a->opt, "topology", 1);
-        takes = 0;
-    } else if (!strcmp(o, "--allow-invalid")) {
-        getme_gmsh_options_set(a->opt, "allow_invalid", 1);
-        a->allow_invalid = 1;
-        takes = 0;
-    } else if (!takes_value(o)) {
+        return 0;
+    }
+    if (!strcmp(o, "-bin") || !strcmp(o, "--topology")) {
+        *(o[1] == 'b' ? &a->binary : &a->topology) = 1;
+        return 0;
+    }
+    static const char *const with_value[] = {
+        "-o", "-clmax", "-clmin", "-format", "--sigma", "--threshold-fraction"};
+    int known = 0;
+    for (size_t k = 0; k < sizeof with_value / sizeof *with_value; k++)
+        known |= !strcmp(o, with_value[k]);
+    if (!known) {
         cli_error("unknown option '%s' (see getme gmsh --help)", o);
         return -1;
-    } else if (!v) {
+    }
+    if (!v) {
         cli_error("option %s needs a value (see getme gmsh --help)", o);
         return -1;
-    } else if (!strcmp(o, "-o"))
+    }
+    ++*i;
+    if (!strcmp(o, "-o"))
         a->output = v;
     else if (!strcmp(o, "-clmax"))
-        rc = cli_parse_double(o, v, &a->clmax);
+        return cli_parse_double(o, v, &a->clmax);
     else if (!strcmp(o, "-clmin"))
-        rc = cli_parse_double(o, v, &a->clmin);
+        return cli_parse_double(o, v, &a->clmin);
     else if (!strcmp(o, "-format"))
-        rc = parse_format(a, v);
-    else if (!strcmp(o, "--method")) {
-        if (getme_gmsh_options_set_method(a->opt, v) != GETME_OK) {
-            cli_error("--method: %s", getme_gmsh_options_error(a->opt));
-            rc = -1;
+        return parse_format(a, v);
+    else { /* --sigma, --threshold-fraction (getme.geo uses them) */
+        if (cli_parse_double(o, v, &x) != 0)
+            return -1;
+        if (getme_params_set(&a->o.params,
+                             o[2] == 's' ? "sigma" : "threshold_fraction",
+                             x) != GETME_OK) {
+            cli_error("%s %s: value out of range", o, v);
+            return -1;
         }
-    } else if (!strcmp(o, "--fix"))
-        rc = add_fixed_groups(a, v);
-    else if (!strcmp(o, "--threads"))
-        rc = set_param(a, "num_threads", o, v);
-    else if (!strcmp(o, "--sigma"))
-        rc = set_param(a, "sigma", o, v);
-    else if (!strcmp(o, "--max-iter"))
-        rc = set_param(a, "max_iter", o, v);
-    else if (!strcmp(o, "--threshold-fraction"))
-        rc = set_param(a, "threshold_fraction", o, v);
-    *i += takes;
-    return rc;
+    }
+    return 0;
 }
 
 static int parse_args(gmsh_args *a, int argc, char **argv)
 {
     for (int i = 1; i < argc; i++) {
+        int r = cli_smooth_option(&a->o, argc, argv, &i);
+        if (r < 0)
+            return -1;
+        if (r > 0)
+            continue;
         if (argv[i][0] == '-' && argv[i][1] != 0) {
             if (parse_one(a, argc, argv, &i) != 0)
                 return -1;
@@ -285,31 +224,173 @@ static int exit_code(getme_status st, const getme_gmsh_report *rep)
     }
 }
 
-/* Gmsh picks the writer from the extension: the temporary file keeps it. */
-static int write_output(const gmsh_args *a, const char *out)
+/* Gmsh's INP writer puts the name it was given into *Heading: give the
+   output's name, not the temporary file's.  Copies src to dst with that
+   line replaced; 0 or -1. */
+static int fix_heading(const char *src, const char *dst, const char *tmp_name,
+                       const char *out)
 {
-    char tmp[4096], tmp_ext[4200];
+    FILE *in = fopen(src, "rb"), *f = fopen(dst, "wb");
+    char line[8192];
+    int rc = in && f ? 0 : -1, n = 0;
+    while (rc == 0 && fgets(line, sizeof line, in)) {
+        size_t len = strlen(line);
+        if (n++ < 4 && line[0] == ' ' && len > 1 &&
+            strncmp(line + 1, tmp_name, strlen(tmp_name)) == 0 &&
+            (line[1 + strlen(tmp_name)] == '\n' ||
+             line[1 + strlen(tmp_name)] == '\r'))
+            rc = fprintf(f, " %s%s", out, line + 1 + strlen(tmp_name)) < 0;
+        else
+            rc = fwrite(line, 1, len, f) != len;
+    }
+    if (in)
+        fclose(in);
+    if (f && fclose(f) != 0)
+        rc = -1;
+    return rc;
+}
+
+/* Gmsh picks the writer from the extension: the temporary file keeps it. */
+static int write_output(const gmsh_args *a, const char *out, const char *name)
+{
+    char tmp[4096], tmp_ext[4200], tmp2[4096];
     const char *dot = strrchr(out, '.'), *slash = strrchr(out, '/');
     const char *ext = dot && (!slash || dot > slash) ? dot : ".msh";
     if (getme_io_tmp_path(out, tmp, sizeof tmp) != 0) {
-        cli_error("cannot create a temporary file next to '%s'", out);
+        cli_error("cannot create a temporary file next to '%s': %s", out,
+                  strerror(errno));
         return GETME_IO_ERR_WRITE;
     }
     snprintf(tmp_ext, sizeof tmp_ext, "%s%s", tmp, ext);
     remove(tmp);
     set_number("Mesh.MshFileVersion", a->msh_version);
     set_number("Mesh.Binary", a->binary);
+    cli_info(&a->o.log, "Writing '%s'...", name);
+    set_number("General.Terminal", 0); /* it would name the temporary file */
     int ierr = 0;
     gmshWrite(tmp_ext, &ierr);
+    set_number("General.Terminal", a->o.log.quiet ? 0 : 1);
     FILE *f = ierr ? NULL : fopen(tmp_ext, "rb");
     if (f)
         fclose(f);
-    if (!f || getme_io_commit(tmp_ext, out) != 0) {
+    const char *final = tmp_ext;
+    if (f && has_ext(out, ".inp")) {
+        if (getme_io_tmp_path(out, tmp2, sizeof tmp2) != 0 ||
+            fix_heading(tmp_ext, tmp2, tmp_ext, name) != 0) {
+            remove(tmp2);
+            f = NULL;
+        } else
+            final = tmp2;
         remove(tmp_ext);
+    }
+    if (!f || getme_io_commit(final, out) != 0) {
+        remove(final);
         cli_error("cannot write '%s'", out);
         return GETME_IO_ERR_WRITE;
     }
     return 0;
+}
+
+/* --fix GROUP,GROUP,... */
+static int add_fixed_groups(getme_gmsh_options *opt, const char *list)
+{
+    char name[256];
+    while (*list) {
+        size_t n = strcspn(list, ",");
+        while (n && *list == ' ') {
+            list++;
+            n--;
+        }
+        snprintf(name, sizeof name, "%.*s", (int)(n < 255 ? n : 255), list);
+        for (size_t k = strlen(name); k && name[k - 1] == ' ';)
+            name[--k] = 0;
+        if (name[0] && getme_gmsh_options_add_fixed_group(opt, name) != GETME_OK)
+            return -1;
+        list += n + (list[n] == ',');
+    }
+    return 0;
+}
+
+/* What getme_gmsh_optimize smooths: element counts per type of dim. */
+static void count_model(int dim, const getme_gmsh_report *rep,
+                        cli_mesh_counts *c)
+{
+    static const int gmsh_type[GETME_NUM_TYPES] = {4, 5, 6, 7, 2, 3};
+    memset(c, 0, sizeof *c);
+    c->nodes = rep->num_nodes;
+    c->fixed = rep->num_fixed;
+    for (int t = 0; t < GETME_NUM_TYPES; t++) {
+        size_t *tags = NULL, *nodes = NULL, nt = 0, nn = 0;
+        int ierr = 0;
+        if ((t < 4) != (dim == 3))
+            continue;
+        gmshModelMeshGetElementsByType(gmsh_type[t], &tags, &nt, &nodes, &nn,
+                                       -1, 0, 1, &ierr);
+        c->elements[t] = ierr ? 0 : (int32_t)nt;
+        gmshFree(tags);
+        gmshFree(nodes);
+    }
+}
+
+typedef struct gmsh_result {
+    getme_quality_stats before;
+    getme_gmsh_report rep;
+    cli_mesh_counts counts;
+    cli_measures mbefore, mafter;
+} gmsh_result;
+
+static int smooth_model(gmsh_args *a, gmsh_result *res)
+{
+    cli_smooth_opts *so = &a->o;
+    getme_gmsh_options *opt = getme_gmsh_options_new();
+    char msg[600];
+    int rc = 0;
+    if (!opt) {
+        cli_error("out of memory");
+        return GETME_IO_ERR_INTERNAL;
+    }
+    getme_gmsh_options_set(opt, "log", 0);
+    getme_gmsh_options_set(opt, "fix_interfaces", !so->free_interfaces);
+    getme_gmsh_options_set(opt, "allow_invalid", so->allow_invalid);
+    getme_gmsh_options_set(opt, "topology", a->topology);
+    for (int i = 0; i < so->num_fix && rc == 0; i++)
+        rc = add_fixed_groups(opt, so->fix[i]);
+    if (rc == 0 && so->num_free &&
+        getme_gmsh_check_groups(so->free_sets, so->num_free, "free", msg,
+                                sizeof msg) != GETME_OK) {
+        cli_error("'%s': %s", a->input, msg);
+        getme_gmsh_options_free(opt);
+        return GETME_IO_ERR_USAGE;
+    }
+    getme_gmsh_report *rep = &res->rep;
+    memset(rep, 0, sizeof *rep);
+    getme_status st = rc == 0 ? getme_gmsh_quality(NULL, 0, opt, rep)
+                              : GETME_ERR_NOMEM;
+    if (st == GETME_OK) {
+        res->before = rep->before;
+        memcpy(res->mbefore.stats, rep->measures_before,
+               sizeof res->mbefore.stats);
+        cli_print_stats(&so->log, "Quality before", &res->before);
+        cli_print_measures(&so->log, "Measures before", &res->mbefore);
+        cli_smooth_begin(so, getme_gmsh_options_params(opt));
+        st = getme_gmsh_optimize(0, NULL, 0, opt, rep);
+        if (rep->untangle.num_invalid_before)
+            cli_untangle_warning(&so->log, &rep->untangle);
+        if (st == GETME_OK) {
+            cli_smooth_done(so, &rep->result);
+            cli_print_stats(&so->log, "Quality after ", &rep->after);
+            memcpy(res->mafter.stats, rep->measures_after,
+                   sizeof res->mafter.stats);
+            cli_print_measures(&so->log, "Measures after ", &res->mafter);
+            count_model(rep->dim, rep, &res->counts);
+        }
+    }
+    if (st != GETME_OK) {
+        cli_error("%s", rep->message[0] ? rep->message : getme_status_string(st));
+        rc = exit_code(st, rep);
+    }
+    getme_gmsh_options_free(opt);
+    return rc;
 }
 
 static int run(gmsh_args *a)
@@ -321,33 +402,46 @@ static int run(gmsh_args *a)
         default_output(a->input, has_ext(a->input, ".msh") ? "-smooth.msh"
                                                            : ".msh",
                        out, sizeof out);
-    if (getme_io_same_file(a->input, out)) {
-        cli_error("the output '%s' is the input: getme never overwrites its "
-                  "input",
-                  out);
+    /* any format Gmsh writes: no extension check, the rest as smooth */
+    cli_paths paths = {NULL, out, a->o.report, "", ""};
+    int rc = cli_check_paths(&paths);
+    if (rc)
+        return rc;
+    if (cli_same_file(a->input, paths.out) ||
+        (a->o.report && cli_same_file(a->input, paths.rep))) {
+        cli_error("%s: refusing to overwrite the input; choose another "
+                  "file", cli_same_file(a->input, paths.out) ? out
+                                                            : a->o.report);
         return GETME_IO_ERR_USAGE;
     }
     int ierr = 0;
     gmshInitialize(0, NULL, 0, &ierr);
-    set_number("General.Terminal", a->quiet ? 0 : 1);
-    getme_gmsh_options_set(a->opt, "log", a->quiet ? 0 : 2);
-    int rc = open_and_mesh(a);
-    if (rc == 0) {
-        getme_gmsh_report rep;
-        getme_status st = getme_gmsh_optimize(0, NULL, 0, a->opt, &rep);
-        if (st != GETME_OK && a->quiet)
-            cli_error("%s", rep.message);
-        rc = exit_code(st, &rep);
-    }
-    if (rc == 0 || (rc == GETME_IO_ERR_TANGLED && a->allow_invalid)) {
-        int wrc = write_output(a, out);
+    set_number("General.Terminal", a->o.log.quiet ? 0 : 1);
+    rc = open_and_mesh(a);
+    gmsh_result res;
+    if (rc == 0)
+        rc = smooth_model(a, &res);
+    cli_guard guard = {0};
+    cli_write_guard(&guard, 1);
+    if (rc == 0 ||
+        (rc == GETME_IO_ERR_TANGLED && a->o.allow_invalid)) {
+        /* --allow-invalid: the partly untangled mesh, exit code kept */
+        int wrc = write_output(a, paths.out, out);
         rc = rc ? rc : wrc;
     }
-    if (rc == 0 && !a->quiet) {
-        char line[4200];
-        snprintf(line, sizeof line, "Wrote '%s'", out);
-        gmshLoggerWrite(line, "info", &ierr);
+    if (rc == 0 && a->o.report &&
+        cli_write_report(paths.rep, a->input, out, &a->o.params, &res.counts,
+                         &res.before, &res.rep.after, &res.rep.result,
+                         &a->o.history, "gmsh",
+                         &(cli_report_extra){NULL, NULL, NULL, &res.mbefore,
+                                             &res.mafter}) != 0) {
+        cli_error("%s: cannot write the report: %s", a->o.report,
+                  strerror(errno));
+        rc = GETME_IO_ERR_WRITE;
     }
+    cli_write_guard(&guard, 0);
+    if (rc == 0)
+        cli_info(&a->o.log, "Done writing '%s'", out);
     gmshFinalize(&ierr);
     return rc;
 }
@@ -357,17 +451,19 @@ int getme_cli_gmsh(int argc, char **argv)
     for (int i = 1; i < argc; i++)
         if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
             fputs(GMSH_HELP, stdout);
+            fputs(CLI_SMOOTH_OPTIONS_HELP, stdout);
+            fputs(GMSH_HELP_TAIL, stdout);
+            cli_print_params(stdout);
             return 0;
         }
     gmsh_args a;
     memset(&a, 0, sizeof a);
     a.msh_version = 4.1;
-    a.opt = getme_gmsh_options_new();
-    if (!a.opt) {
+    if (cli_smooth_opts_init(&a.o, argc) != 0) {
         cli_error("out of memory");
         return GETME_IO_ERR_INTERNAL;
     }
     int rc = parse_args(&a, argc, argv) != 0 ? GETME_IO_ERR_USAGE : run(&a);
-    getme_gmsh_options_free(a.opt);
+    cli_smooth_opts_free(&a.o);
     return rc;
 }

@@ -28,9 +28,11 @@ static void print_type(const cli_log *log, getme_mesh *mesh, int type)
         return;
     const char *name = type < 0 ? "all elements"
                                 : getme_type_name((getme_elem_type)type);
-    cli_info(log, "%s: %lld, q*min %.4f, qmin %.4f, qmean %.4f, qmax %.4f, "
+    char qs[64];
+    cli_info(log, "%s: %lld, q*min %s, qmin %.4f, qmean %.4f, qmax %.4f, "
                   "%lld invalid",
-             name, (long long)s.num_elements, s.q_min_star, s.q_min, s.q_mean,
+             name, (long long)s.num_elements,
+             cli_q_min_star(&s, qs, sizeof qs), s.q_min, s.q_mean,
              s.q_max, (long long)s.num_invalid);
     for (int b = 0; b < GETME_HIST_BINS; b++)
         cli_info(log, "  %.2f < quality < %.2f : %9lld elements",
@@ -83,7 +85,7 @@ int cli_quality(int argc, char **argv)
         return EXIT_USAGE;
     }
     int st;
-    getme_doc *doc = cli_open(input, &opts, 1, &st);
+    getme_doc *doc = cli_open(input, &opts, 1, &st, &log);
     if (!doc)
         return st;
     getme_mesh *mesh = getme_doc_mesh(doc);

@@ -3,11 +3,12 @@
  */
 #include "cli.h"
 
+#include <errno.h>
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
-static const char SMOOTH_HELP[] =
+static const char SMOOTH_HELP_HEAD[] =
     "usage: getme smooth IN -o OUT [options]\n"
     "\n"
     "Smooth the mesh in IN by moving free nodes and write the same file with\n"
@@ -19,26 +20,13 @@ static const char SMOOTH_HELP[] =
     "CGNS BC patches, plus the sets named with --fix.\n"
     "\n"
     "options:\n"
-    "  -o, --output FILE      output file (required)\n"
-    "  --method getme|laplace GETMe adaptive (default) or smart Laplace\n"
-    "  --threads N            OpenMP threads (default: all cores); the result\n"
-    "                         is bit-identical for any N\n"
-    "  --max-iter N           iteration limit over both stages (default 1000)\n"
-    "  --fix NAME             also fix a named set: Gmsh physical group name\n"
-    "                         (or DIM:TAG), INP NSET/ELSET, CGNS BC/family\n"
-    "                         (repeatable)\n"
-    "  --free NAME            do not fix this CGNS BC/family (repeatable)\n"
-    "  --free-interfaces      let nodes on region interfaces move\n"
-    "  --param NAME=VALUE     any smoothing parameter (repeatable; the table\n"
-    "                         below)\n"
+    "  -o, --output FILE      output file (required; the input's format and\n"
+    "                         extension; a regular file or a new one)\n"
     "  --worst N              list the N worst elements after smoothing and\n"
     "                         why each stays bad (default 10; printed with -v,\n"
-    "                         always in --report)\n"
-    "  --report FILE.json     write before/after statistics, iterations,\n"
-    "                         the worst elements and the per-iteration\n"
-    "                         history as JSON\n"
-    "  -q, --quiet            print errors only\n"
-    "  -v, --verbose          print the quality histograms\n"
+    "                         always in --report)\n";
+
+static const char SMOOTH_HELP_TAIL[] =
     "\n"
     "An input with invalid elements is untangled first (free nodes near them\n"
     "move until every element is valid, docs/untangle.md), with a warning\n"
@@ -46,167 +34,44 @@ static const char SMOOTH_HELP[] =
     "\n"
     "exit codes: 0 ok, 1 internal error, 2 usage, 3 cannot read input,\n"
     "4 malformed input, 5 unsupported content, 6 invalid elements in input\n"
-    "(--no-untangle), 7 cannot write output, 8 invalid elements that could not\n"
-    "be untangled (named by their ids in the file; no output unless\n"
-    "--allow-invalid)\n";
+    "(--no-untangle) or degenerate ones (a node twice), 7 cannot write output,\n"
+    "8 invalid elements that could not be untangled (named by their ids in\n"
+    "the file; no output unless --allow-invalid)\n";
 
 typedef struct smooth_args {
-    const char *input, *output, *report;
-    const char **fix, **free_sets;
-    int num_fix, num_free, free_interfaces, allow_invalid;
+    const char *input, *output;
     long worst;
-    getme_params params;
-    cli_log log;
+    cli_smooth_opts o;
 } smooth_args;
-
-typedef struct progress_state {
-    const cli_log *log;
-    cli_history *history;
-} progress_state;
-
-static int on_progress(const getme_progress *p, void *data)
-{
-    progress_state *ps = data;
-    cli_history *h = ps->history;
-    if (h->count == h->cap) {
-        int cap = h->cap ? 2 * h->cap : 64;
-        getme_progress *items = realloc(h->items, (size_t)cap * sizeof *items);
-        if (items) {
-            h->items = items;
-            h->cap = cap;
-        }
-    }
-    if (h->count < h->cap)
-        h->items[h->count++] = *p;
-    const char *stage = p->stage == GETME_STAGE_MEAN  ? "qmean stage"
-                        : p->stage == GETME_STAGE_MIN ? "q*min stage"
-                                                      : "smart Laplace";
-    if (p->stage == GETME_STAGE_FINISH)
-        cli_info(ps->log, "Finishing pass %d: q*min %.4f, qmean %.4f, %d "
-                          "elements below %.4f worked on, %d raised (%.2f s)",
-                 p->iteration, p->q_min_star, p->q_mean,
-                 (int)p->num_transformed, p->threshold, (int)p->num_relaxed,
-                 p->elapsed);
-    else if (p->stage == GETME_STAGE_MIN)
-        cli_info(ps->log, "It %4d (%s, cycle %d, q_t %.4f): q*min %.4f, "
-                          "qmean %.4f, %d transformed, %d relaxed (%.2f s)",
-                 p->iteration, stage, p->cycle, p->threshold, p->q_min_star,
-                 p->q_mean, (int)p->num_transformed, (int)p->num_relaxed,
-                 p->elapsed);
-    else
-        cli_info(ps->log, "It %4d (%s): q*min %.4f, qmean %.4f, %d relaxed "
-                          "(%.2f s)",
-                 p->iteration, stage, p->q_min_star, p->q_mean,
-                 (int)p->num_relaxed, p->elapsed);
-    return 0;
-}
-
-/* name=value for --param. */
-static int set_param(getme_params *p, const char *arg)
-{
-    const char *eq = strchr(arg, '=');
-    char name[64];
-    double v;
-    if (!eq || eq == arg || (size_t)(eq - arg) >= sizeof name) {
-        cli_error("--param expects NAME=VALUE, got '%s'", arg);
-        return -1;
-    }
-    memcpy(name, arg, (size_t)(eq - arg));
-    name[eq - arg] = '\0';
-    if (cli_parse_double("--param", eq + 1, &v) != 0)
-        return -1;
-    const getme_param_info *info = getme_param_find(name);
-    if (!info) {
-        cli_error("--param %s: unknown parameter '%s' (getme smooth --help "
-                  "lists them)", arg, name);
-        return -1;
-    }
-    if (getme_params_set(p, name, v) != GETME_OK) {
-        char range[64];
-        cli_param_range(info, range, sizeof range);
-        cli_error("--param %s: %s takes %s %s", arg, name,
-                  info->type == GETME_PARAM_REAL ? "a number" : "an integer",
-                  range);
-        return -1;
-    }
-    return 0;
-}
-
-/* Takes the value of an option: "--opt VALUE". */
-static const char *value(int argc, char **argv, int *i)
-{
-    if (*i + 1 >= argc) {
-        cli_error("%s needs a value (see getme smooth --help)", argv[*i]);
-        return NULL;
-    }
-    return argv[++*i];
-}
 
 static int parse(int argc, char **argv, smooth_args *a)
 {
-    getme_params_init(&a->params);
     a->worst = 10;
-    a->fix = calloc((size_t)argc, sizeof *a->fix);
-    a->free_sets = calloc((size_t)argc, sizeof *a->free_sets);
-    if (!a->fix || !a->free_sets)
+    if (cli_smooth_opts_init(&a->o, argc) != 0)
         return 1;
     for (int i = 1; i < argc; i++) {
-        const char *o = argv[i], *v;
-        long n;
+        const char *o = argv[i];
+        int r = cli_smooth_option(&a->o, argc, argv, &i);
+        if (r < 0)
+            return EXIT_USAGE;
+        if (r > 0)
+            continue;
         if (!strcmp(o, "-h") || !strcmp(o, "--help")) {
-            fputs(SMOOTH_HELP, stdout);
+            fputs(SMOOTH_HELP_HEAD, stdout);
+            fputs(CLI_SMOOTH_OPTIONS_HELP, stdout);
+            fputs(SMOOTH_HELP_TAIL, stdout);
             cli_print_params(stdout);
             return -1;
-        } else if (!strcmp(o, "-o") || !strcmp(o, "--output")) {
-            if (!(a->output = value(argc, argv, &i)))
-                return EXIT_USAGE;
-        } else if (!strcmp(o, "--method")) {
-            if (!(v = value(argc, argv, &i)))
-                return EXIT_USAGE;
-            if (!strcmp(v, "getme") || !strcmp(v, "adaptive"))
-                a->params.method = GETME_METHOD_ADAPTIVE;
-            else if (!strcmp(v, "laplace"))
-                a->params.method = GETME_METHOD_SMART_LAPLACE;
-            else {
-                cli_error("--method expects getme or laplace, got '%s'", v);
+        } else if (!strcmp(o, "-o") || !strcmp(o, "--output") ||
+                   !strcmp(o, "--worst")) {
+            if (i + 1 >= argc) {
+                cli_error("%s needs a value (see getme smooth --help)", o);
                 return EXIT_USAGE;
             }
-        } else if (!strcmp(o, "--threads")) {
-            if (!(v = value(argc, argv, &i)) ||
-                cli_parse_int(o, v, 1, 4096, &n) != 0)
+            if (o[2] != 'w')
+                a->output = argv[++i];
+            else if (cli_parse_int(o, argv[++i], 0, 1000000, &a->worst) != 0)
                 return EXIT_USAGE;
-            a->params.num_threads = (int)n;
-        } else if (!strcmp(o, "--max-iter")) {
-            if (!(v = value(argc, argv, &i)) ||
-                cli_parse_int(o, v, 0, 1000000000, &n) != 0)
-                return EXIT_USAGE;
-            a->params.max_iter = (int)n;
-        } else if (!strcmp(o, "--fix")) {
-            if (!(a->fix[a->num_fix++] = value(argc, argv, &i)))
-                return EXIT_USAGE;
-        } else if (!strcmp(o, "--free")) {
-            if (!(a->free_sets[a->num_free++] = value(argc, argv, &i)))
-                return EXIT_USAGE;
-        } else if (!strcmp(o, "--free-interfaces")) {
-            a->free_interfaces = 1;
-        } else if (!strcmp(o, "--no-untangle")) {
-            a->params.untangle = 0;
-        } else if (!strcmp(o, "--allow-invalid")) {
-            a->allow_invalid = 1;
-        } else if (!strcmp(o, "--param")) {
-            if (!(v = value(argc, argv, &i)) || set_param(&a->params, v) != 0)
-                return EXIT_USAGE;
-        } else if (!strcmp(o, "--worst")) {
-            if (!(v = value(argc, argv, &i)) ||
-                cli_parse_int(o, v, 0, 1000000, &a->worst) != 0)
-                return EXIT_USAGE;
-        } else if (!strcmp(o, "--report")) {
-            if (!(a->report = value(argc, argv, &i)))
-                return EXIT_USAGE;
-        } else if (!strcmp(o, "-q") || !strcmp(o, "--quiet")) {
-            a->log.quiet = 1;
-        } else if (!strcmp(o, "-v") || !strcmp(o, "--verbose")) {
-            a->log.verbose = 1;
         } else if (o[0] == '-' && o[1]) {
             cli_error("unknown option '%s' (see getme smooth --help)", o);
             return EXIT_USAGE;
@@ -225,16 +90,17 @@ static int parse(int argc, char **argv, smooth_args *a)
     return 0;
 }
 
-static int write_output(const smooth_args *a, getme_doc *doc,
-                        const char *what)
+/* Writing the output (termination signals held). */
+static int write_output(const smooth_args *a, const cli_paths *paths,
+                        getme_doc *doc, const char *what)
 {
-    cli_info(&a->log, "Writing %s'%s'...", what, a->output);
-    getme_io_status ios = getme_doc_write(doc, a->output);
+    cli_info(&a->o.log, "Writing %s'%s'...", what, a->output);
+    getme_io_status ios = getme_doc_write(doc, paths->out);
     if (ios != GETME_IO_OK) {
         cli_error("%s", getme_doc_error(doc));
         return ios;
     }
-    cli_info(&a->log, "Done writing '%s'", a->output);
+    cli_info(&a->o.log, "Done writing '%s'", a->output);
     return 0;
 }
 
@@ -245,25 +111,20 @@ static int write_output(const smooth_args *a, getme_doc *doc,
 /* Untangle an input with invalid elements: one warning line with the
    counts; the elements that stay invalid named by their file ids.
    Returns 0, GETME_IO_ERR_TANGLED or GETME_IO_ERR_INTERNAL. */
-static int untangle(const smooth_args *a, getme_doc *doc,
-                    getme_untangle_result *ur)
+static int untangle(smooth_args *a, getme_doc *doc, getme_untangle_result *ur)
 {
     getme_mesh *mesh = getme_doc_mesh(doc);
-    cli_info(&a->log, "Untangling (%d thread%s)...", a->params.num_threads,
-             a->params.num_threads == 1 ? "" : "s");
-    getme_status st = getme_mesh_untangle(mesh, &a->params, ur);
+    cli_smooth_threads(&a->o);
+    int threads = a->o.params.num_threads;
+    cli_info(&a->o.log, "Untangling (%d thread%s)...", threads,
+             threads == 1 ? "" : "s");
+    getme_status st = getme_mesh_untangle(mesh, &a->o.params, ur);
     if (st != GETME_OK && st != GETME_ERR_INVALID_MESH) {
         cli_error("%s: %s", a->input, getme_mesh_error(mesh));
         return GETME_IO_ERR_INTERNAL;
     }
-    long long before = (long long)ur->num_invalid_before,
-              after = (long long)ur->num_invalid_after;
-    cli_warning(&a->log, "%lld invalid (inverted or degenerate) element%s in "
-                         "the input, %lld remain%s after untangling (%d "
-                         "sweep%s, %d nodes moved, %.3f s)",
-                before, before == 1 ? "" : "s", after,
-                after == 1 ? "s" : "", ur->sweeps, ur->sweeps == 1 ? "" : "s",
-                (int)ur->num_moved, ur->seconds);
+    cli_untangle_warning(&a->o.log, ur);
+    long long after = (long long)ur->num_invalid_after;
     if (after == 0)
         return 0;
     int32_t ne = getme_mesh_num_elements(mesh);
@@ -282,35 +143,33 @@ static int untangle(const smooth_args *a, getme_doc *doc,
               "fixed): %s%s; %s",
               a->input, after, after == 1 ? "" : "s",
               (long long)ur->num_stuck, list, after > named ? ", ..." : "",
-              a->allow_invalid ? "writing the partly untangled mesh as asked"
-                               : "no output written (--allow-invalid writes "
-                                 "the partly untangled mesh)");
+              a->o.allow_invalid ? "writing the partly untangled mesh as asked"
+                                 : "no output written (--allow-invalid writes "
+                                   "the partly untangled mesh)");
     return GETME_IO_ERR_TANGLED;
 }
 
 static int run(smooth_args *a)
 {
-    const cli_log *log = &a->log;
+    cli_smooth_opts *so = &a->o;
+    const cli_log *log = &so->log;
     getme_doc_options opts;
-    getme_doc_options_init(&opts);
-    opts.fix = a->fix;
-    opts.num_fix = a->num_fix;
-    opts.free_sets = a->free_sets;
-    opts.num_free = a->num_free;
-    opts.fix_interfaces = !a->free_interfaces;
-    opts.verbose = log->verbose;
+    cli_smooth_doc_options(so, &opts);
 
-    if (getme_io_same_file(a->input, a->output)) {
-        cli_error("%s: refusing to overwrite the input; choose another output "
-                  "file", a->output);
-        return EXIT_USAGE;
-    }
+    cli_paths paths = {a->input, a->output, so->report, "", ""};
+    int code = cli_check_paths(&paths);
+    if (code)
+        return code;
     double t0 = omp_get_wtime();
     cli_info(log, "Reading '%s'...", a->input);
-    int code;
-    getme_doc *doc = cli_open(a->input, &opts, a->params.untangle, &code);
+    getme_doc *doc = cli_open(a->input, &opts, so->params.untangle, &code,
+                              log);
     if (!doc)
         return code;
+    if ((code = cli_check_read_files(&paths, doc)) != 0) {
+        getme_doc_close(doc);
+        return code;
+    }
     getme_mesh *mesh = getme_doc_mesh(doc);
     char desc[256];
     cli_describe_mesh(mesh, desc, sizeof desc);
@@ -323,35 +182,22 @@ static int run(smooth_args *a)
     cli_print_stats(log, "Quality before", &before);
     cli_measures mbefore, mafter;
     cli_measures_log(log, mesh, "Measures before", &mbefore);
-
-    cli_history history = {0};
     cli_worst_list worst = {0}, worst_free = {0};
-    progress_state ps = {log, &history};
-    a->params.progress = on_progress;
-    a->params.progress_data = &ps;
-    /* Gmsh's initialisation sets OpenMP's global thread count to 1, so
-       "default" must be decided here: OMP_NUM_THREADS if set, else every
-       core. */
-    if (!a->params.num_threads) {
-        const char *env = getenv("OMP_NUM_THREADS");
-        int n = env ? atoi(env) : 0;
-        a->params.num_threads = n > 0 ? n : omp_get_num_procs();
-    }
+    cli_guard guard = {0};
     getme_untangle_result ur;
     memset(&ur, 0, sizeof ur);
     code = 0;
     if (before.num_invalid > 0 && (code = untangle(a, doc, &ur)) != 0) {
-        if (code == GETME_IO_ERR_TANGLED && a->allow_invalid)
-            write_output(a, doc, "partly untangled, not smoothed, ");
+        if (code == GETME_IO_ERR_TANGLED && so->allow_invalid) {
+            cli_write_guard(&guard, 1);
+            write_output(a, &paths, doc, "partly untangled, not smoothed, ");
+            cli_write_guard(&guard, 0);
+        }
         goto out;
     }
-    int threads = a->params.num_threads;
-    cli_info(log, "Optimizing mesh (%s, %d thread%s)...",
-             a->params.method == GETME_METHOD_ADAPTIVE ? "GETMe adaptive"
-                                                       : "smart Laplace",
-             threads, threads == 1 ? "" : "s");
+    cli_smooth_begin(so, NULL);
     getme_result res;
-    getme_status st = getme_smooth(mesh, &a->params, &res);
+    getme_status st = getme_smooth(mesh, &so->params, &res);
     res.num_invalid_initial = ur.num_invalid_before;
     res.untangle_sweeps = ur.sweeps;
     res.untangle_seconds = ur.seconds;
@@ -361,10 +207,7 @@ static int run(smooth_args *a)
                                             : GETME_IO_ERR_INTERNAL;
         goto out;
     }
-    cli_info(log, "Done optimizing mesh (Wall %.3fs): %d + %d iterations "
-                  "(%d q*min cycles)",
-             res.seconds, res.iterations_mean, res.iterations_min,
-             res.cycles_min);
+    cli_smooth_done(so, &res);
     getme_mesh_quality_stats(mesh, -1, &after);
     cli_print_stats(log, "Quality after ", &after);
     cli_measures_log(log, mesh, "Measures after ", &mafter);
@@ -378,30 +221,46 @@ static int run(smooth_args *a)
         code = GETME_IO_ERR_INTERNAL;
         goto out;
     }
-    if (after.q_min < after.q_min_star)
+    int fixed_worst = after.num_free > 0 && after.q_min < after.q_min_star;
+    if (fixed_worst)
         cli_warning(log, "qmin %.4f is below q*min %.4f: the worst elements "
                          "have no free node, no node move can fix them "
                          "(see --worst, -v)",
                     after.q_min, after.q_min_star);
     if (log->verbose) {
         cli_print_worst(log, doc, &worst, "");
-        if (after.q_min < after.q_min_star)
+        if (fixed_worst)
             cli_print_worst(log, doc, &worst_free, " with a free node");
     }
 
-    if ((code = write_output(a, doc, "")) != 0)
-        goto out;
-    if (a->report &&
-        cli_write_report(a->report, a->input, a->output, &a->params, mesh,
-                         &before, &after, &res, &history, doc, &worst,
-                         &worst_free, &mbefore, &mafter) != 0) {
-        cli_error("%s: cannot write the report", a->report);
-        code = GETME_IO_ERR_WRITE;
+    cli_write_guard(&guard, 1);
+    cli_file_stamp report_was;
+    cli_stamp(paths.rep, &report_was);
+    if ((code = write_output(a, &paths, doc, "")) != 0) {
+        /* the message is printed */
+    } else if (so->report && cli_replaced(paths.rep, &report_was)) {
+        /* the report names a file the output wrote (an INP include copy) */
+        cli_error("report %s: it is a file the output just wrote; not "
+                  "replacing it (choose another report file)", so->report);
+        code = EXIT_USAGE;
+    } else {
+        cli_mesh_counts counts;
+        cli_count_mesh(mesh, &counts);
+        cli_report_extra extra = {doc, &worst, &worst_free, &mbefore,
+                                  &mafter};
+        if (so->report &&
+            cli_write_report(paths.rep, a->input, a->output, &so->params,
+                             &counts, &before, &after, &res, &so->history,
+                             doc->format->name, &extra) != 0) {
+            cli_error("%s: cannot write the report: %s", so->report,
+                      strerror(errno));
+            code = GETME_IO_ERR_WRITE;
+        }
     }
+    cli_write_guard(&guard, 0);
 out:
     free(worst.items);
     free(worst_free.items);
-    free(history.items);
     getme_doc_close(doc);
     return code;
 }
@@ -415,7 +274,6 @@ int cli_smooth(int argc, char **argv)
         code = run(&a);
     else if (code < 0)
         code = 0; /* --help */
-    free(a.fix);
-    free(a.free_sets);
+    cli_smooth_opts_free(&a.o);
     return code;
 }

@@ -47,12 +47,23 @@ void cli_error(const char *fmt, ...)
     va_end(ap);
 }
 
+const char *cli_q_min_star(const getme_quality_stats *s, char *buf,
+                           size_t size)
+{
+    if (s->num_free == 0)
+        snprintf(buf, size, "- (no element has a free node)");
+    else
+        snprintf(buf, size, "%.4f", s->q_min_star);
+    return buf;
+}
+
 void cli_print_stats(const cli_log *log, const char *title,
                      const getme_quality_stats *s)
 {
-    cli_info(log, "%s: q*min %.4f, qmin %.4f, qmean %.4f, %lld elements "
+    char qs[64];
+    cli_info(log, "%s: q*min %s, qmin %.4f, qmean %.4f, %lld elements "
                   "(%lld with q <= 0.4, %lld with q < 0.1, %lld invalid)",
-             title, s->q_min_star, s->q_min, s->q_mean,
+             title, cli_q_min_star(s, qs, sizeof qs), s->q_min, s->q_mean,
              (long long)s->num_elements, (long long)s->num_below_04,
              (long long)s->num_below_01, (long long)s->num_invalid);
     if (log && !log->verbose)
@@ -108,13 +119,21 @@ void cli_describe_mesh(getme_mesh *mesh, char *buf, size_t size)
 }
 
 getme_doc *cli_open(const char *path, const getme_doc_options *opts,
-                    int allow_invalid, int *code)
+                    int allow_invalid, int *code, const cli_log *log)
 {
     getme_doc *doc = NULL;
     getme_io_status st = getme_doc_open(&doc, path, opts);
     *code = st;
-    if (st == GETME_IO_OK || (allow_invalid && st == GETME_IO_ERR_INVALID))
+    /* allow_invalid: inverted elements found in a complete mesh (to be
+       untangled or reported on); not elements an adapter refused as
+       degenerate (a node twice), which no node move repairs */
+    if (st == GETME_IO_OK ||
+        (allow_invalid && st == GETME_IO_ERR_INVALID && doc->mesh &&
+         doc->stats.num_invalid > 0)) {
+        if (doc->warning[0])
+            cli_warning(log, "%s", doc->warning);
         return doc;
+    }
     cli_error("%s", getme_doc_error(doc));
     getme_doc_close(doc);
     return NULL;

@@ -25,11 +25,15 @@ static void json_string(FILE *f, const char *s)
 
 static void json_stats(FILE *f, const getme_quality_stats *s)
 {
-    fprintf(f, "{\"elements\": %lld, \"invalid\": %lld, \"q_min_star\": %.17g, "
+    /* q*min is undefined (null) when no element has a free node */
+    char qs[32] = "null";
+    if (s->num_free > 0)
+        snprintf(qs, sizeof qs, "%.17g", s->q_min_star);
+    fprintf(f, "{\"elements\": %lld, \"invalid\": %lld, \"q_min_star\": %s, "
                "\"q_min\": %.17g, \"q_mean\": %.17g, \"q_max\": %.17g, "
                "\"below_0_4\": %lld, \"below_0_1\": %lld, \"histogram\": [",
             (long long)s->num_elements, (long long)s->num_invalid,
-            s->q_min_star, s->q_min, s->q_mean, s->q_max,
+            qs, s->q_min, s->q_mean, s->q_max,
             (long long)s->num_below_04, (long long)s->num_below_01);
     for (int b = 0; b < GETME_HIST_BINS; b++)
         fprintf(f, "%s%lld", b ? ", " : "", (long long)s->histogram[b]);
@@ -47,18 +51,31 @@ static const char *stop_name(getme_stop_reason r)
     return "unknown";
 }
 
+void cli_count_mesh(getme_mesh *mesh, cli_mesh_counts *c)
+{
+    c->nodes = getme_mesh_num_nodes(mesh);
+    c->fixed = getme_mesh_num_fixed(mesh);
+    for (int t = 0; t < GETME_NUM_TYPES; t++)
+        c->elements[t] =
+            getme_mesh_num_elements_of_type(mesh, (getme_elem_type)t);
+}
+
 int cli_write_report(const char *path, const char *input, const char *output,
-                     const getme_params *p, getme_mesh *mesh,
+                     const getme_params *p, const cli_mesh_counts *mesh,
                      const getme_quality_stats *before,
                      const getme_quality_stats *after, const getme_result *r,
-                     const cli_history *h, const getme_doc *doc,
-                     const cli_worst_list *worst,
-                     const cli_worst_list *worst_free,
-                     const cli_measures *mb, const cli_measures *ma)
+                     const cli_history *h, const char *format_name,
+                     const cli_report_extra *x)
 {
-    FILE *f = fopen(path, "w");
-    if (!f)
+    /* Through a temporary file next to it and a rename, like the mesh. */
+    char tmp[4200];
+    if (getme_io_tmp_path(path, tmp, sizeof tmp) != 0)
         return -1;
+    FILE *f = fopen(tmp, "w");
+    if (!f) {
+        remove(tmp);
+        return -1;
+    }
     fputs("{\n  \"getme_version\": ", f);
     json_string(f, getme_version());
     fputs(",\n  \"input\": ", f);
@@ -66,7 +83,7 @@ int cli_write_report(const char *path, const char *input, const char *output,
     fputs(",\n  \"output\": ", f);
     json_string(f, output);
     fputs(",\n  \"format\": ", f);
-    json_string(f, doc->format->name);
+    json_string(f, format_name);
     fprintf(f, ",\n  \"method\": \"%s\",\n",
             p->method == GETME_METHOD_ADAPTIVE ? "getme" : "laplace");
     fprintf(f, "  \"params\": {\"max_iter\": %d, \"tol\": %.17g, \"sigma\": %.17g, "
@@ -79,10 +96,10 @@ int cli_write_report(const char *path, const char *input, const char *output,
             p->finish_fraction, p->finish_max_passes, p->corner_guard,
             p->corner_floor, p->num_threads, p->renumber);
     fprintf(f, "  \"nodes\": %d,\n  \"fixed_nodes\": %d,\n  \"elements\": {",
-            (int)getme_mesh_num_nodes(mesh), (int)getme_mesh_num_fixed(mesh));
+            (int)mesh->nodes, (int)mesh->fixed);
     int first = 1;
     for (int t = 0; t < GETME_NUM_TYPES; t++) {
-        int32_t n = getme_mesh_num_elements_of_type(mesh, (getme_elem_type)t);
+        int32_t n = mesh->elements[t];
         if (!n)
             continue;
         fprintf(f, "%s\"%s\": %d", first ? "" : ", ",
@@ -93,11 +110,13 @@ int cli_write_report(const char *path, const char *input, const char *output,
     json_stats(f, before);
     fputs(",\n  \"after\": ", f);
     json_stats(f, after);
-    fputs(",\n  \"measures\": {\"before\": ", f);
-    cli_json_measures(f, mb);
-    fputs(",\n    \"after\": ", f);
-    cli_json_measures(f, ma);
-    fputc('}', f);
+    if (x && x->measures_before && x->measures_after) {
+        fputs(",\n  \"measures\": {\"before\": ", f);
+        cli_json_measures(f, x->measures_before);
+        fputs(",\n    \"after\": ", f);
+        cli_json_measures(f, x->measures_after);
+        fputc('}', f);
+    }
     fprintf(f, ",\n  \"iterations\": {\"total\": %d, \"mean_stage\": %d, "
                "\"min_stage\": %d, \"min_cycles\": %d, \"finish_passes\": %d, "
                "\"finish_improved\": %d},\n",
@@ -109,11 +128,13 @@ int cli_write_report(const char *path, const char *input, const char *output,
             r->untangle_seconds);
     fprintf(f, "  \"corner_sj\": {\"before\": %.17g, \"after\": %.17g},\n",
             r->corner_sj_initial, r->corner_sj);
-    fputs("  \"worst_elements\": ", f);
-    cli_json_worst(f, doc, worst);
-    fputs(",\n  \"worst_free_elements\": ", f);
-    cli_json_worst(f, doc, worst_free);
-    fputs(",\n", f);
+    if (x && x->doc && x->worst && x->worst_free) {
+        fputs("  \"worst_elements\": ", f);
+        cli_json_worst(f, x->doc, x->worst);
+        fputs(",\n  \"worst_free_elements\": ", f);
+        cli_json_worst(f, x->doc, x->worst_free);
+        fputs(",\n", f);
+    }
     fprintf(f, "  \"seconds\": %.6f,\n  \"stop_reason\": \"%s\",\n",
             r->seconds, stop_name(r->stop_reason));
     fputs("  \"history\": [", f);
@@ -127,5 +148,10 @@ int cli_write_report(const char *path, const char *input, const char *output,
                 (int)e->num_relaxed, e->elapsed);
     }
     fputs("\n  ]\n}\n", f);
-    return fclose(f) == 0 ? 0 : -1;
+    int bad = ferror(f);
+    if (fclose(f) != 0 || bad) {
+        remove(tmp);
+        return -1;
+    }
+    return getme_io_commit(tmp, path);
 }

@@ -192,4 +192,6 @@ const getme_format getme_format_cgns = {
     cgns_open,
     cgns_write_doc,
     cgns_close,
+    ".cgns .cgn",
+    NULL,
 };

@@ -344,9 +344,11 @@ static getme_io_status add_block(const zone_ctx *c, const cgns_section *sec,
             for (int b = a + 1; b < nv; b++)
                 if (e[a] == e[b]) {
                     free(regions);
-                    return getme_doc_fail(c->doc, GETME_IO_ERR_PARSE,
-                                          "%s: %s/%s: element %ld uses node "
-                                          "%ld twice", c->doc->path, c->path,
+                    return getme_doc_fail(c->doc, GETME_IO_ERR_INVALID,
+                                          "%s: %s/%s: element %ld is "
+                                          "degenerate: node %ld appears "
+                                          "twice; getme smooths valid meshes "
+                                          "only", c->doc->path, c->path,
                                           sec->name, (long)numbers[i],
                                           (long)e[a]);
                 }

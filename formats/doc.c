@@ -2,7 +2,7 @@
  * doc.c -- the format-independent side of the adapters: choosing an
  * adapter, checking the mesh it built, temp-file-and-rename writing.
  */
-#define _POSIX_C_SOURCE 200809L
+#define _XOPEN_SOURCE 700
 #include "getme_formats.h"
 
 #include <errno.h>
@@ -11,7 +11,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <dirent.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -61,6 +63,11 @@ const char *getme_doc_error(const getme_doc *doc)
 }
 
 const char *getme_doc_info(const getme_doc *doc) { return doc ? doc->info : ""; }
+
+const char *getme_doc_warning(const getme_doc *doc)
+{
+    return doc ? doc->warning : "";
+}
 
 getme_mesh *getme_doc_mesh(getme_doc *doc) { return doc ? doc->mesh : NULL; }
 
@@ -143,11 +150,61 @@ getme_io_status getme_doc_write(getme_doc *doc, const char *out_path)
 {
     if (!doc || !doc->format || !doc->mesh)
         return GETME_IO_ERR_INTERNAL;
-    if (getme_io_same_file(doc->path, out_path))
-        return getme_doc_fail(doc, GETME_IO_ERR_USAGE,
-                              "%s: refusing to overwrite the input; choose "
-                              "another output file", out_path);
-    return doc->format->write(doc, out_path);
+    char target[4096], msg[sizeof doc->error];
+    getme_io_status st =
+        getme_io_output_path(out_path, target, sizeof target, msg, sizeof msg);
+    if (st != GETME_IO_OK)
+        return getme_doc_fail(doc, st, "%s", msg);
+    for (size_t i = 0; i < getme_doc_num_files(doc); i++)
+        if (getme_io_same_file(getme_doc_file(doc, i), target))
+            return getme_doc_fail(doc, GETME_IO_ERR_USAGE,
+                                  "%s: refusing to overwrite the input%s%s; "
+                                  "choose another output file", out_path,
+                                  i ? " file " : "", i ? getme_doc_file(doc, i) : "");
+    return doc->format->write(doc, target);
+}
+
+size_t getme_doc_num_files(const getme_doc *doc)
+{
+    if (!doc || !doc->path)
+        return 0;
+    size_t n = 1;
+    if (doc->format && doc->format->file && doc->impl)
+        while (doc->format->file(doc, n))
+            n++;
+    return n;
+}
+
+const char *getme_doc_file(const getme_doc *doc, size_t i)
+{
+    if (!doc || !doc->path)
+        return NULL;
+    if (i == 0)
+        return doc->path;
+    return doc->format && doc->format->file && doc->impl
+               ? doc->format->file(doc, i)
+               : NULL;
+}
+
+int getme_format_has_extension(const getme_format *format, const char *path)
+{
+    if (!format || !format->extensions || !path)
+        return 0;
+    const char *base = strrchr(path, '/');
+    base = base ? base + 1 : path;
+    const char *dot = strrchr(base, '.');
+    if (!dot || dot == base)
+        return 0;
+    size_t n = strlen(dot);
+    for (const char *e = format->extensions; *e;) {
+        size_t m = strcspn(e, " ");
+        if (m == n && strncasecmp(e, dot, n) == 0)
+            return 1;
+        e += m;
+        while (*e == ' ')
+            e++;
+    }
+    return 0;
 }
 
 void getme_doc_close(getme_doc *doc)
@@ -162,22 +219,81 @@ void getme_doc_close(getme_doc *doc)
     free(doc);
 }
 
+void getme_io_dirname(const char *path, char *buf, size_t size)
+{
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        snprintf(buf, size, ".");
+    else
+        snprintf(buf, size, "%.*s", slash == path ? 1 : (int)(slash - path),
+                 path);
+}
+
+/* "<dir>/.<base>.getme-tmp.<pid>.<n>" (the Gmsh path appends ".msh"). */
+static const char TMP_TAG[] = ".getme-tmp.";
+
+/* A temporary file of ours for base (".<base>.getme-tmp.<pid>.<n>[.ext]")
+   whose process is gone: left by a process that was killed (SIGKILL, power
+   loss) while writing.  Returns its pid, or 0 if name is not such a file. */
+static long stale_tmp(const char *name, const char *base, size_t blen)
+{
+    size_t tlen = sizeof TMP_TAG - 1;
+    if (name[0] != '.' || strncmp(name + 1, base, blen) != 0 ||
+        strncmp(name + 1 + blen, TMP_TAG, tlen) != 0)
+        return 0;
+    const char *p = name + 1 + blen + tlen;
+    char *end;
+    errno = 0;
+    long pid = strtol(p, &end, 10);
+    if (errno || end == p || *end != '.' || pid <= 0 || pid == (long)getpid())
+        return 0;
+    p = end + 1;
+    strtoul(p, &end, 10);
+    if (end == p || (*end && *end != '.'))
+        return 0;
+    if (kill((pid_t)pid, 0) == 0 || errno != ESRCH)
+        return 0; /* alive (or not ours to judge) */
+    return pid;
+}
+
+/* Remove the temporary files a killed getme left next to out_path. */
+static void remove_stale_tmps(const char *out_path, const char *base)
+{
+    char dir[4096], path[4096 + 256];
+    getme_io_dirname(out_path, dir, sizeof dir);
+    DIR *d = opendir(dir);
+    if (!d)
+        return;
+    size_t blen = strlen(base);
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL)
+        if (stale_tmp(e->d_name, base, blen) &&
+            snprintf(path, sizeof path, "%s/%s", dir, e->d_name) <
+                (int)sizeof path)
+            unlink(path);
+    closedir(d);
+}
+
 int getme_io_tmp_path(const char *out_path, char *buf, size_t size)
 {
     /* Same directory as the output, so rename() is atomic and never crosses
-       file systems; hidden.  O_EXCL makes the name ours even with concurrent
-       writers; mode 0666 lets the umask decide the output's permissions as
-       for any new file (mkstemp would leave 0600).  The empty file is
-       overwritten by the adapter (or removed by getme_io_commit). */
+       file systems; hidden, and named ".<output name>.getme-tmp.<pid>.<n>"
+       so that one left by a killed process is recognisable (the next write
+       of the same output removes those whose process is gone).  O_EXCL
+       makes the name ours even with concurrent writers; mode 0666 lets the
+       umask decide the output's permissions as for any new file (mkstemp
+       would leave 0600).  The empty file is overwritten by the adapter (or
+       removed by getme_io_commit). */
     const char *slash = strrchr(out_path, '/');
     int dirlen = slash ? (int)(slash - out_path) + 1 : 0;
     const char *base = slash ? slash + 1 : out_path;
+    remove_stale_tmps(out_path, base);
     struct timespec ts;
     clock_gettime(CLOCK_REALTIME, &ts);
     for (unsigned attempt = 0; attempt < 100; attempt++) {
         unsigned long tag = (unsigned long)ts.tv_nsec + attempt * 7919ul;
-        int len = snprintf(buf, size, "%.*s.%s.tmp.%ld.%lu", dirlen, out_path,
-                           base, (long)getpid(), tag);
+        int len = snprintf(buf, size, "%.*s.%s%s%ld.%lu", dirlen, out_path,
+                           base, TMP_TAG, (long)getpid(), tag);
         if (len < 0 || (size_t)len >= size)
             return -1;
         int fd = open(buf, O_WRONLY | O_CREAT | O_EXCL, 0666);
@@ -193,12 +309,81 @@ int getme_io_tmp_path(const char *out_path, char *buf, size_t size)
 
 int getme_io_commit(const char *tmp, const char *out)
 {
+    /* Never replace anything but a regular file: a device, a FIFO, a
+       directory or a symbolic link named as an output stays as it is. */
+    struct stat sb;
+    if (lstat(out, &sb) == 0 && !S_ISREG(sb.st_mode)) {
+        remove(tmp);
+        errno = EEXIST;
+        return -1;
+    }
     if (rename(tmp, out) == 0)
         return 0;
     int saved = errno;
     remove(tmp);
     errno = saved;
     return -1;
+}
+
+static const char *kind_of(mode_t m)
+{
+    return S_ISCHR(m)    ? "a character device"
+           : S_ISBLK(m)  ? "a block device"
+           : S_ISFIFO(m) ? "a FIFO"
+           : S_ISSOCK(m) ? "a socket"
+           : S_ISDIR(m)  ? "a directory"
+                         : "not a regular file";
+}
+
+getme_io_status getme_io_output_path(const char *out_path, char *buf,
+                                     size_t size, char *msg, size_t msg_size)
+{
+    struct stat sb;
+    if (!out_path || !*out_path) {
+        snprintf(msg, msg_size, "empty output file name");
+        return GETME_IO_ERR_USAGE;
+    }
+    if (snprintf(buf, size, "%s", out_path) >= (int)size) {
+        snprintf(msg, msg_size, "%s: path too long", out_path);
+        return GETME_IO_ERR_USAGE;
+    }
+    if (lstat(out_path, &sb) == 0 && S_ISLNK(sb.st_mode)) {
+        /* A symbolic link is followed: the file it points to is written
+           (through a temporary file next to it), the link stays. */
+        char *real = realpath(out_path, NULL);
+        if (!real) {
+            snprintf(msg, msg_size,
+                     "%s: a symbolic link to a missing file; give the "
+                     "path of the file to write", out_path);
+            return GETME_IO_ERR_USAGE;
+        }
+        int len = snprintf(buf, size, "%s", real);
+        free(real);
+        if (len >= (int)size) {
+            snprintf(msg, msg_size, "%s: path too long", out_path);
+            return GETME_IO_ERR_USAGE;
+        }
+    }
+    if (stat(buf, &sb) == 0 && !S_ISREG(sb.st_mode)) {
+        snprintf(msg, msg_size,
+                 "%s: is %s; getme writes regular files only (it writes a "
+                 "temporary file and renames it)",
+                 out_path, kind_of(sb.st_mode));
+        return GETME_IO_ERR_USAGE;
+    }
+    char dir[4096];
+    getme_io_dirname(buf, dir, sizeof dir);
+    if (stat(dir, &sb) != 0 || !S_ISDIR(sb.st_mode) ||
+        access(dir, W_OK | X_OK) != 0) {
+        int e = errno;
+        snprintf(msg, msg_size,
+                 "%s: cannot create a temporary file next to it: %s",
+                 out_path, strerror(stat(dir, &sb) == 0 && !S_ISDIR(sb.st_mode)
+                                        ? ENOTDIR
+                                        : e));
+        return GETME_IO_ERR_WRITE;
+    }
+    return GETME_IO_OK;
 }
 
 int getme_io_same_file(const char *a, const char *b)

@@ -492,7 +492,10 @@ static void list_sets(const inp_deck *d, char *buf, size_t sz)
 }
 
 /* Fix the sets called name: "Set", or "Part.Set" / "Instance.Set". */
-static getme_io_status fix_named(builder *b, const char *name)
+/* The sets called name: their nodes are fixed (fix = 1) or only looked up
+   (--free: nothing is fixed by name in a deck, but an unknown name is
+   still an error). */
+static getme_io_status fix_named(builder *b, const char *name, int fix)
 {
     inp_deck *d = b->d;
     int found = 0;
@@ -523,6 +526,8 @@ static getme_io_status fix_named(builder *b, const char *name)
         if (!match)
             continue;
         found = 1;
+        if (!fix)
+            continue;
         st = for_each_member(b, (int32_t)s,
                              set->kind == INP_SET_NODE ? fix_node : fix_elem,
                              NULL, 0);
@@ -533,9 +538,10 @@ static getme_io_status fix_named(builder *b, const char *name)
         char avail[700];
         list_sets(d, avail, sizeof avail);
         return getme_doc_fail(b->doc, GETME_IO_ERR_USAGE,
-                              "%s: no node or element set named '%s' "
+                              "%s: no node or element set named '%s' to %s "
                               "(available: %s)",
-                              inp_file_name(d, 0), name, avail);
+                              inp_file_name(d, 0), name, fix ? "fix" : "free",
+                              avail);
     }
     return GETME_IO_OK;
 }
@@ -549,7 +555,12 @@ static getme_io_status fix_nodes(builder *b, const getme_doc_options *opts,
         return getme_doc_fail(b->doc, GETME_IO_ERR_INTERNAL, "out of memory");
     fix_other_elements(b);
     for (int i = 0; i < opts->num_fix; i++) {
-        getme_io_status st = fix_named(b, opts->fix[i]);
+        getme_io_status st = fix_named(b, opts->fix[i], 1);
+        if (st)
+            return st;
+    }
+    for (int i = 0; i < opts->num_free; i++) {
+        getme_io_status st = fix_named(b, opts->free_sets[i], 0);
         if (st)
             return st;
     }
@@ -577,6 +588,25 @@ static getme_io_status add_blocks(builder *b, getme_mesh *mesh)
         const inp_elem_block *eb = &d->eblocks[k];
         if (eb->kind != b->smooth || eb->count == 0)
             continue;
+        int nv = getme_type_num_nodes((getme_elem_type)eb->gtype);
+        for (int32_t e = 0; e < eb->count && !st; e++) {
+            const int32_t *c = d->conn + eb->conn_beg + (size_t)e * nv;
+            for (int i = 1; i < nv && !st; i++)
+                for (int j = 0; j < i && !st; j++)
+                    if (c[i] == c[j]) {
+                        char w[600];
+                        st = getme_doc_fail(
+                            b->doc, GETME_IO_ERR_INVALID,
+                            "%s: element %lld is degenerate: node %lld "
+                            "appears twice; getme smooths valid meshes only",
+                            where(d, eb->file, d->elem_line[eb->first + e], w,
+                                  sizeof w),
+                            (long long)d->elem_id[eb->first + e],
+                            (long long)d->node_id[c[i]]);
+                    }
+        }
+        if (st)
+            break;
         getme_status gs = getme_mesh_add_elements(
             mesh, (getme_elem_type)eb->gtype, eb->count, d->conn + eb->conn_beg,
             region + b->sfirst[k]);

@@ -54,6 +54,13 @@ static getme_io_status inp_write_doc(getme_doc *doc, const char *out_path)
     return inp_write(doc, doc->impl, out_path);
 }
 
+/* Included files: occurrences 1.. of the deck (one may be included twice). */
+static const char *inp_included(const getme_doc *doc, size_t i)
+{
+    const inp_doc *st = doc->impl;
+    return st && i < st->nfiles ? st->files[i].path : NULL;
+}
+
 static void inp_close(getme_doc *doc)
 {
     inp_doc_free(doc->impl);
@@ -67,4 +74,6 @@ const getme_format getme_format_inp = {
     inp_open,
     inp_write_doc,
     inp_close,
+    ".inp",
+    inp_included,
 };

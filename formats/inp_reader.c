@@ -43,6 +43,12 @@ typedef struct reader {
     int32_t elset_name;
     int pending;           /* node ids read so far of an open element, -1 */
     int64_t count_pos;     /* OTHER elements: where their node count goes  */
+    /* elements with more node ids on their line than their type has
+       (CalculiX ignores them): how many, the first one */
+    int64_t extra;
+    int extra_file;
+    uint32_t extra_line;
+    int32_t extra_elem;
     int depth;
     dev_t dev[INP_MAX_DEPTH + 1];
     ino_t ino[INP_MAX_DEPTH + 1];
@@ -343,10 +349,18 @@ static getme_io_status element_line(reader *rd, const char *text, size_t len)
             return fail(rd, GETME_IO_ERR_PARSE,
                         "element %d: node number 0",
                         d->elem_id[d->nelems - 1]);
-        if (rd->nv && rd->pending == rd->nv)
-            return fail(rd, GETME_IO_ERR_PARSE,
-                        "element %d of type %s has more than %d nodes",
-                        d->elem_id[d->nelems - 1], rd->type, rd->nv);
+        if (rd->nv && rd->pending == rd->nv) {
+            /* As CalculiX: an element line with more node ids than the
+               type has (decks of ccx's own test suite do this) gives the
+               first ones; the rest of the line is ignored (and written
+               back as it was), with a warning. */
+            if (rd->extra++ == 0) {
+                rd->extra_file = rd->file;
+                rd->extra_line = rd->line;
+                rd->extra_elem = d->elem_id[d->nelems - 1];
+            }
+            break;
+        }
         if (push_conn(d, (int32_t)id))
             return nomem(rd);
         rd->pending++;
@@ -912,6 +926,14 @@ getme_io_status inp_read(inp_deck *d, const char *path, getme_doc *doc)
         st = nomem(rd);
     if (!st)
         st = read_file(rd, path, -1);
+    if (!st && rd->extra)
+        snprintf(doc->warning, sizeof doc->warning,
+                 "%s:%u: element %d has more node ids than its type needs: "
+                 "the extra ids are ignored, as CalculiX does (%lld element%s "
+                 "like this)",
+                 inp_file_name(d, rd->extra_file), rd->extra_line,
+                 (int)rd->extra_elem, (long long)rd->extra,
+                 rd->extra == 1 ? "" : "s");
     free(rd);
     return st;
 }

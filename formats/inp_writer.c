@@ -6,8 +6,10 @@
  * lines change:
  *  - a *NODE data line whose node moved: the coordinate fields get the new
  *    values, everything else on the line (node number, spacing, extra
- *    fields) stays; a node that did not move keeps its original text, so
- *    fixed nodes stay bit-identical;
+ *    fields) stays; a node that did not move, or moved by no more than
+ *    1e-12 times the bounding-box diagonal (a rounding step, see
+ *    keep_tolerance), keeps its original text, so fixed nodes stay
+ *    bit-identical and unmoved nodes do not show up in a diff;
  *  - an *INCLUDE line: its INPUT= value names the written copy of the
  *    included file, "<output stem>.<included file name>" next to the
  *    output (a "-2", "-3"... before the extension if two included files
@@ -19,6 +21,7 @@
 #include "inp_internal.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -36,6 +39,7 @@ typedef struct writer {
     char (*out)[PATH_BUF]; /* final name per file occurrence        */
     char (*tmp)[PATH_BUF]; /* temporary name per file occurrence    */
     int32_t moved;         /* node lines rewritten                  */
+    double keep_tol;       /* moves up to this keep the line (below) */
 } writer;
 
 static const char *base_name(const char *p)
@@ -78,6 +82,16 @@ static getme_io_status name_outputs(writer *w, const char *out_path)
                 break;
         }
     }
+    /* Never replace anything but a regular file (the deck's own name was
+       checked by getme_doc_write). */
+    for (size_t i = 1; i < st->nfiles; i++) {
+        struct stat sb;
+        if (lstat(w->out[i], &sb) == 0 && !S_ISREG(sb.st_mode))
+            return getme_doc_fail(w->doc, GETME_IO_ERR_USAGE,
+                                  "output '%s' (the copy of included '%s') "
+                                  "exists and is not a regular file",
+                                  w->out[i], st->files[i].path);
+    }
     /* Never overwrite any file of the input deck. */
     for (size_t i = 0; i < st->nfiles; i++)
         for (size_t j = 0; j < st->nfiles; j++)
@@ -89,8 +103,6 @@ static getme_io_status name_outputs(writer *w, const char *out_path)
 }
 
 /* ---- one node line ---------------------------------------------------------- */
-
-static int same_bits(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
 
 static int put(FILE *out, const char *s, size_t n)
 {
@@ -121,8 +133,10 @@ static int node_line(writer *w, FILE *out, const inp_lines *in, int32_t node)
     for (int k = 0; k < 3; k++) {
         if (k < ncoord && inp_parse_real(&f[k + 1], &old[k]))
             return 1;
-        moved |= !same_bits(old[k], x[k]);
+        moved |= !(fabs(x[k] - old[k]) <= w->keep_tol);
     }
+    /* A node that moved by no more than keep_tol in every coordinate keeps
+       its line, so it is back exactly where the deck had it. */
     if (!moved)
         return put(out, in->text, in->len);
     w->moved++;
@@ -130,8 +144,8 @@ static int node_line(writer *w, FILE *out, const inp_lines *in, int32_t node)
        coordinate that kept its value keeps its text. */
     const char *cur = in->text;
     for (int k = 0; k < ncoord; k++) {
-        if (same_bits(old[k], x[k]))
-            continue;
+        if (fabs(x[k] - old[k]) <= w->keep_tol)
+            continue; /* this coordinate keeps its text */
         if (put(out, cur, (size_t)(f[k + 1].s - cur)) || put_real(out, x[k]))
             return -1;
         cur = f[k + 1].s + f[k + 1].n;
@@ -139,7 +153,7 @@ static int node_line(writer *w, FILE *out, const inp_lines *in, int32_t node)
     /* Coordinates the line left out (0 in Abaqus) that are not 0 now. */
     int need = ncoord;
     for (int k = ncoord; k < 3; k++)
-        if (!same_bits(x[k], 0.0))
+        if (!(fabs(x[k]) <= w->keep_tol))
             need = k + 1;
     if (need > ncoord && put(out, cur, (size_t)(end - cur)))
         return -1;
@@ -308,6 +322,30 @@ static getme_io_status write_all(writer *w, const char *out_path)
     return GETME_IO_OK;
 }
 
+/* Smoothing can move a node that is already where it belongs by a
+   rounding step (0.75 -> 0.75000000000000011 on a perfect hex grid); such
+   moves are not worth a changed line in the user's diff.  Nodes that move
+   by at most INP_KEEP_REL times the mesh's bounding-box diagonal (in each
+   coordinate) keep their original text. */
+#define INP_KEEP_REL 1e-12
+
+static double keep_tolerance(const double *xyz, int32_t n)
+{
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    for (int32_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) {
+            double v = xyz[3 * (size_t)i + k];
+            if (i == 0 || v < lo[k])
+                lo[k] = v;
+            if (i == 0 || v > hi[k])
+                hi[k] = v;
+        }
+    double d2 = 0;
+    for (int k = 0; k < 3; k++)
+        d2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+    return INP_KEEP_REL * sqrt(d2);
+}
+
 getme_io_status inp_write(getme_doc *doc, const inp_doc *st,
                           const char *out_path)
 {
@@ -322,6 +360,7 @@ getme_io_status inp_write(getme_doc *doc, const inp_doc *st,
     w.st = st;
     w.xyz = getme_mesh_coords(doc->mesh);
     w.dim = getme_mesh_dim(doc->mesh);
+    w.keep_tol = keep_tolerance(w.xyz, st->nnodes);
     w.out = malloc(st->nfiles * sizeof *w.out);
     w.tmp = malloc(st->nfiles * sizeof *w.tmp);
     getme_io_status s = w.out && w.tmp

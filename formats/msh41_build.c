@@ -504,14 +504,19 @@ static void describe_groups(const msh41_reader *r, char *buf, size_t size)
 
 static getme_io_status check_fix_names(msh41_reader *r)
 {
-    for (int w = 0; r->opts && w < r->opts->num_fix; w++) {
+    int nfix = r->opts ? r->opts->num_fix : 0;
+    int nfree = r->opts ? r->opts->num_free : 0;
+    for (int w = 0; w < nfix + nfree; w++) {
         if (r->fix_found && r->fix_found[w])
             continue;
         char known[300];
         describe_groups(r, known, sizeof known);
         return getme_doc_fail(r->doc, GETME_IO_ERR_USAGE,
-                              "'%s': Unknown physical group '%s' to fix (%s)",
-                              r->doc->path, r->opts->fix[w], known);
+                              "'%s': Unknown physical group '%s' to %s (%s)",
+                              r->doc->path,
+                              w < nfix ? r->opts->fix[w]
+                                       : r->opts->free_sets[w - nfix],
+                              w < nfix ? "fix" : "free", known);
     }
     return GETME_IO_OK;
 }
@@ -536,9 +541,10 @@ static void describe(msh41_reader *r, size_t num_entities)
     int len = dot ? (int)(dot - base) : (int)strlen(base);
     getme_mesh *m = r->doc->mesh;
     snprintf(r->doc->info, sizeof r->doc->info,
-             "MSH 4.1 %s, model '%.*s': %zu %s%s, %ld elements, %ld nodes "
+             "MSH %s %s, model '%.*s': %zu %s%s, %ld elements, %ld nodes "
              "(%ld fixed)",
-             r->binary ? "binary" : "ASCII", len, base, num_entities,
+             r->v22 ? "2.2" : "4.1", r->binary ? "binary" : "ASCII", len,
+             base, num_entities,
              r->top_dim == 3 ? "volume" : "surface",
              num_entities > 1 ? "s" : "", (long)getme_mesh_num_elements(m),
              (long)getme_mesh_num_nodes(m), (long)getme_mesh_num_fixed(m));

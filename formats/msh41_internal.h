@@ -1,7 +1,7 @@
 /*
  * msh41_internal.h -- the native MSH 4.1 path of the MSH adapter (private).
  *
- * msh_format.c tries this path first for MSH 4.1 files: it reads the file
+ * msh_format.c tries this path first for MSH 4.1 and 2.2 files: it reads the file
  * in one streaming pass without creating a Gmsh model (msh41_reader.c,
  * msh41_build.c), and writes by copying the input with new coordinates in
  * $Nodes (msh41_writer.c).  Files it does not handle (parametric nodes,
@@ -88,6 +88,7 @@ typedef struct msh41_doc {
     int64_t nodes_offset;   /* first byte after the "$Nodes" line      */
     int64_t size, mtime_ns; /* identity of the input when it was read  */
     uint64_t dev, ino;
+    int v22;                /* MSH 2.2 (else 4.1)                        */
     msh41_nodemap map;      /* node tag -> mesh node, -1 if not in it   */
 } msh41_doc;
 
@@ -164,6 +165,15 @@ typedef struct msh41_reader {
     msh41_eblock *eb;
     size_t neb, cap_eb;
     int top_dim;
+    /* MSH 2.2: no $Entities and no node blocks; both are derived from the
+       elements' (physical, elementary) tags as Gmsh's MSH 2 reader does */
+    int v22;
+    uint8_t *ndim;            /* per node: lowest dimension of an element
+                                 using it (4: none) ...                    */
+    int *netag;               /* ... and the lowest elementary tag there   */
+    int (*ent22)[3];          /* (dim, elementary, physical) seen         */
+    size_t nent22, cap_ent22;
+    size_t cap_cur;           /* room in the last element block            */
 } msh41_reader;
 
 /* Error at the current position: "'file', line N: ..." (ASCII) or

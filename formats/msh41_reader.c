@@ -16,6 +16,7 @@
 #include "msh41_internal.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -299,8 +300,9 @@ static getme_io_status read_format(msh41_reader *r)
         (file_type != 0 && file_type != 1))
         return line_fail(r, GETME_IO_ERR_PARSE,
                          "bad $MeshFormat header (want \"4.1 0|1 8\")");
-    if (version != 4.1)
-        return msh41_decline(r, "not MSH 4.1");
+    if (version != 4.1 && version != 2.2)
+        return msh41_decline(r, "not MSH 4.1 or 2.2");
+    r->v22 = version == 2.2;
     r->binary = file_type == 1;
     if (r->binary && data_size != 8)
         return msh41_fail(r, GETME_IO_ERR_UNSUPPORTED,
@@ -485,16 +487,20 @@ const char *msh41_group_name(const msh41_reader *r, int dim, int tag)
 static getme_io_status prepare_groups(msh41_reader *r)
 {
     int nfix = r->opts ? r->opts->num_fix : 0;
-    if (r->groups_ready || nfix == 0) {
+    int nfree = r->opts ? r->opts->num_free : 0;
+    if (r->groups_ready || nfix + nfree == 0) {
         r->groups_ready = 1;
         return GETME_IO_OK;
     }
     r->groups_ready = 1;
-    r->fix_found = calloc((size_t)nfix, sizeof *r->fix_found);
+    /* --fix words first, then --free words (only looked up: no physical
+       group is fixed by default, but an unknown name is an error) */
+    r->fix_found = calloc((size_t)(nfix + nfree), sizeof *r->fix_found);
     if (!r->fix_found)
         return oom(r);
-    for (int w = 0; w < nfix; w++) {
-        const char *word = r->opts->fix[w];
+    for (int w = 0; w < nfix + nfree; w++) {
+        const char *word = w < nfix ? r->opts->fix[w]
+                                    : r->opts->free_sets[w - nfix];
         int dim, tag, used = 0;
         int by_tag = sscanf(word, "%d:%d%n", &dim, &tag, &used) == 2 &&
                      word[used] == 0;
@@ -507,7 +513,7 @@ static getme_io_status prepare_groups(msh41_reader *r)
                 int match = by_tag ? (e->dim == dim && p == tag)
                                    : (name && strcmp(name, word) == 0);
                 if (match) {
-                    e->fix = 1;
+                    e->fix |= w < nfix;
                     r->fix_found[w]++;
                 }
             }
@@ -554,8 +560,22 @@ static getme_io_status read_node_tags(msh41_reader *r, uint64_t *tags,
 
 /* Coordinates of one block.  ASCII: one node per line, which the writer
    relies on (anything else is declined). */
+static getme_io_status not_finite(msh41_reader *r, uint64_t tag,
+                                  const double *x)
+{
+    return msh41_fail(r, GETME_IO_ERR_PARSE,
+                      "node %llu has a coordinate that is not a finite "
+                      "number (%g %g %g)",
+                      (unsigned long long)tag, x[0], x[1], x[2]);
+}
+
+static int finite3(const double *x)
+{
+    return isfinite(x[0]) && isfinite(x[1]) && isfinite(x[2]);
+}
+
 static getme_io_status read_node_coords(msh41_reader *r, double *xyz,
-                                        size_t n)
+                                        const uint64_t *tags, size_t n)
 {
     if (r->binary) {
         if (msh41_in_read(&r->in, xyz, 3 * n * 8))
@@ -564,12 +584,17 @@ static getme_io_status read_node_coords(msh41_reader *r, double *xyz,
             uint64_t bits = le64((const unsigned char *)&xyz[i]);
             memcpy(&xyz[i], &bits, sizeof bits);
         }
+        for (size_t i = 0; i < n; i++)
+            if (!finite3(xyz + 3 * i))
+                return not_finite(r, tags[i], xyz + 3 * i);
         return GETME_IO_OK;
     }
     getme_io_status st = GETME_IO_OK;
     for (size_t i = 0; i < n && st == GETME_IO_OK; i++) {
         for (int k = 0; k < 3 && st == GETME_IO_OK; k++)
             st = read_double(r, &xyz[3 * i + k]);
+        if (st == GETME_IO_OK && !finite3(xyz + 3 * i))
+            st = not_finite(r, tags[i], xyz + 3 * i);
         if (st == GETME_IO_OK && !msh41_in_eol(&r->in))
             st = msh41_decline(r, "node coordinates not one node per line");
     }
@@ -605,7 +630,8 @@ static getme_io_status read_node_block(msh41_reader *r, size_t *filled)
     b->count = (size_t)count;
     st = read_node_tags(r, r->tags + b->first, b->count);
     if (st == GETME_IO_OK)
-        st = read_node_coords(r, r->xyz + 3 * b->first, b->count);
+        st = read_node_coords(r, r->xyz + 3 * b->first, r->tags + b->first,
+                              b->count);
     /* A point's group fixes the point's node (Gmsh: mesh_vertices[0]). */
     const msh41_entity *e = msh41_find_entity(r, b->dim, b->tag);
     if (st == GETME_IO_OK && b->dim == 0 && e && e->fix && b->count)
@@ -706,6 +732,14 @@ static getme_io_status take_element(msh41_reader *r, msh41_eblock *b,
                                     int fix)
 {
     for (int k = 0; k < nv; k++) {
+        for (int j = 0; b && b->conn && j < k; j++)
+            if (rec[1 + j] == rec[1 + k])
+                return msh41_fail(r, GETME_IO_ERR_INVALID,
+                                  "element %llu is degenerate: node %llu "
+                                  "appears twice; getme smooths valid meshes "
+                                  "only",
+                                  (unsigned long long)rec[0],
+                                  (unsigned long long)rec[1 + k]);
         int32_t idx = msh41_map_find(&r->map, rec[1 + k]);
         if (idx < 0)
             return msh41_fail(r, GETME_IO_ERR_PARSE,
@@ -764,6 +798,16 @@ static getme_io_status read_ascii_elements(msh41_reader *r, msh41_eblock *b,
     return st;
 }
 
+/* As Gmsh's reader: an element block needs its entity, from $Entities or
+   created by a $Nodes block of the same dimension and tag. */
+static int node_block_entity(const msh41_reader *r, int dim, int tag)
+{
+    for (size_t i = 0; i < r->nnb; i++)
+        if (r->nb[i].dim == dim && r->nb[i].tag == tag)
+            return 1;
+    return 0;
+}
+
 static getme_io_status read_element_block(msh41_reader *r)
 {
     int dim = 0, tag = 0, type = 0;
@@ -786,6 +830,11 @@ static getme_io_status read_element_block(msh41_reader *r)
         return msh41_fail(r, GETME_IO_ERR_PARSE,
                           "bad element block dimension %d", dim);
     const msh41_entity *e = msh41_find_entity(r, dim, tag);
+    if (!e && !node_block_entity(r, dim, tag))
+        return msh41_fail(r, GETME_IO_ERR_PARSE,
+                          "element block of entity %d (dimension %d): no "
+                          "such entity in $Entities or $Nodes",
+                          tag, dim);
     msh41_eblock *b = NULL;
     if (dim >= 2 && dim >= r->top_dim && count > 0)
         st = new_eblock(r, dim, tag, type, count, nv, &b);
@@ -796,16 +845,24 @@ static getme_io_status read_element_block(msh41_reader *r)
                      : read_ascii_elements(r, b, count, nv, fix);
 }
 
-static getme_io_status read_elements(msh41_reader *r)
+/* Entering $Elements (both versions): after $Nodes, only once. */
+static getme_io_status elements_begin(msh41_reader *r)
 {
-    uint64_t nblocks = 0, n, lo, hi;
     r->section = "Elements";
     if (!r->have_nodes)
         return msh41_fail(r, GETME_IO_ERR_PARSE, "$Elements before $Nodes");
     if (r->have_elements)
         return msh41_decline(r, "several $Elements sections");
     r->have_elements = 1;
-    getme_io_status st = read_count(r, &nblocks, "number of element blocks", 8);
+    return GETME_IO_OK;
+}
+
+static getme_io_status read_elements(msh41_reader *r)
+{
+    uint64_t nblocks = 0, n, lo, hi;
+    getme_io_status st = elements_begin(r);
+    if (st == GETME_IO_OK)
+        st = read_count(r, &nblocks, "number of element blocks", 8);
     if (st == GETME_IO_OK)
         st = read_count(r, &n, "number of elements", 8);
     if (st == GETME_IO_OK)
@@ -819,18 +876,408 @@ static getme_io_status read_elements(msh41_reader *r)
     return st;
 }
 
+/* ---- MSH 2.2 ------------------------------------------------------------
+ * $Nodes: a count line, then "tag x y z" per line (binary: int32 tag and
+ * three doubles per node).  $Elements: a count line, then per element
+ * "tag type ntags physical elementary nodes..." (binary: blocks of
+ * int32 "type count ntags", then per element int32 tag, tags, nodes).
+ * Entities are what the elements' (dimension, elementary tag) name, their
+ * physical groups the physical tags of their elements; a node belongs to
+ * the entity of lowest dimension (then lowest tag) among the elements
+ * using it, and inside an entity nodes go by tag: Gmsh's MSH 2 reader. */
+
+/* The count line of a 2.2 section (text even in binary files). */
+static getme_io_status read_count22(msh41_reader *r, uint64_t *n,
+                                    const char *what, uint64_t min_bytes)
+{
+    int save = r->binary;
+    r->binary = 0;
+    getme_io_status st = read_count(r, n, what, min_bytes);
+    r->binary = save;
+    if (st == GETME_IO_OK && save && !msh41_in_eol(&r->in))
+        st = msh41_fail(r, GETME_IO_ERR_PARSE, "bad %s line in $%s", what,
+                        r->section);
+    return st;
+}
+
+static getme_io_status read_nodes22(msh41_reader *r)
+{
+    uint64_t n = 0;
+    r->section = "Nodes";
+    if (r->have_nodes)
+        return msh41_decline(r, "several $Nodes sections");
+    r->have_nodes = 1;
+    r->nodes_offset = msh41_in_offset(&r->in);
+    getme_io_status st = read_count22(r, &n, "number of nodes", 8);
+    if (st == GETME_IO_OK)
+        st = alloc_nodes(r, 0, n);
+    r->nnodes = st == GETME_IO_OK ? (size_t)n : 0;
+    if (st == GETME_IO_OK) {
+        r->ndim = malloc(r->nnodes ? r->nnodes : 1);
+        r->netag = malloc((r->nnodes ? r->nnodes : 1) * sizeof *r->netag);
+        if (!r->ndim || !r->netag)
+            st = oom(r);
+        else
+            memset(r->ndim, 4, r->nnodes);
+    }
+    for (size_t i = 0; i < r->nnodes && st == GETME_IO_OK; i++) {
+        double *x = r->xyz + 3 * i;
+        if (r->binary) {
+            int tag = 0;
+            st = read_int(r, &tag, "node tag");
+            if (st == GETME_IO_OK && tag <= 0)
+                st = msh41_fail(r, GETME_IO_ERR_PARSE, "bad node tag %d", tag);
+            r->tags[i] = (uint64_t)(tag > 0 ? tag : 0);
+        } else {
+            st = read_u64(r, &r->tags[i], "node tag");
+        }
+        for (int k = 0; k < 3 && st == GETME_IO_OK; k++)
+            st = read_double(r, &x[k]);
+        if (st == GETME_IO_OK && !finite3(x))
+            st = not_finite(r, r->tags[i], x);
+        if (st == GETME_IO_OK && !r->binary && !msh41_in_eol(&r->in))
+            st = msh41_decline(r, "node coordinates not one node per line");
+    }
+    if (st == GETME_IO_OK)
+        st = expect_end(r);
+    if (st == GETME_IO_OK)
+        st = msh41_map_build(r, &r->map, r->tags, r->nnodes);
+    return st;
+}
+
+static int type_dim(int msh_type)
+{
+    const type_info *t = find_type(msh_type);
+    if (!t)
+        return -1;
+    const char *f = t->family;
+    return !strcmp(f, "point") ? 0 : !strcmp(f, "line") ? 1
+           : !strcmp(f, "triangle") || !strcmp(f, "quadrilateral") ? 2 : 3;
+}
+
+/* Does (dim, physical) belong to a group a --fix (or --free) word names?
+   Counts the matches per word for check_fix_names. */
+static int fix_group22(msh41_reader *r, int dim, int phys)
+{
+    int nfix = r->opts ? r->opts->num_fix : 0;
+    int nfree = r->opts ? r->opts->num_free : 0, fix = 0;
+    for (int w = 0; phys && w < nfix + nfree; w++) {
+        const char *word = w < nfix ? r->opts->fix[w]
+                                    : r->opts->free_sets[w - nfix];
+        int d, t, used = 0;
+        int match;
+        if (sscanf(word, "%d:%d%n", &d, &t, &used) == 2 && word[used] == 0)
+            match = d == dim && t == phys;
+        else {
+            const char *name = msh41_group_name(r, dim, phys);
+            match = name && strcmp(name, word) == 0;
+        }
+        if (match) {
+            r->fix_found[w]++;
+            fix |= w < nfix;
+        }
+    }
+    return fix;
+}
+
+/* The element block an element of (tag, type) of the top dimension goes
+   to: the last one if it is the same (entity, type), else a new one. */
+static getme_io_status block22(msh41_reader *r, int dim, int etag, int type,
+                               int nv, msh41_eblock **out)
+{
+    msh41_eblock *b = r->neb ? &r->eb[r->neb - 1] : NULL;
+    if (!b || dim > r->top_dim || b->tag != etag || b->type != type) {
+        getme_io_status st = new_eblock(r, dim, etag, type, 1, nv, &b);
+        if (st != GETME_IO_OK)
+            return st;
+        b->count = 0; /* room for 1, grown below */
+        r->cap_cur = 1;
+    }
+    if (b->conn && (size_t)b->count == r->cap_cur) {
+        size_t cap = r->cap_cur ? 2 * r->cap_cur : 64;
+        int32_t *c = realloc(b->conn, cap * (size_t)nv * sizeof *c);
+        if (c)
+            b->conn = c;
+        int64_t *ids = realloc(b->ids, cap * sizeof *ids);
+        if (ids)
+            b->ids = ids;
+        if (!c || !ids)
+            return oom(r);
+        r->cap_cur = cap;
+    }
+    if (b->count == INT32_MAX)
+        return msh41_fail(r, GETME_IO_ERR_UNSUPPORTED,
+                          "More than 2^31-1 elements are not supported");
+    *out = b;
+    return GETME_IO_OK;
+}
+
+/* One element: rec = tag + nv node tags; tags = physical, elementary. */
+static getme_io_status element22(msh41_reader *r, int type, int ntags,
+                                 const int *tags, const uint64_t *rec)
+{
+    int order = 0, nv = msh41_type_nodes(type, &order), dim = type_dim(type);
+    if (nv == 0 || dim < 0)
+        return msh41_decline(r, "an element type this reader does not know");
+    if (ntags > 2)
+        return msh41_decline(r, "partitioned mesh (element with more than "
+                                "2 tags)");
+    if (ntags < 2 || tags[1] <= 0)
+        return msh41_decline(r, "element without an elementary tag");
+    int phys = tags[0] > 0 ? tags[0] : 0, etag = tags[1];
+    if (!r->nent22 || r->ent22[r->nent22 - 1][0] != dim ||
+        r->ent22[r->nent22 - 1][1] != etag ||
+        r->ent22[r->nent22 - 1][2] != phys) {
+        if (r->nent22 == r->cap_ent22) {
+            size_t cap = r->cap_ent22 ? 2 * r->cap_ent22 : 64;
+            int(*e)[3] = realloc(r->ent22, cap * sizeof *e);
+            if (!e)
+                return oom(r);
+            r->ent22 = e;
+            r->cap_ent22 = cap;
+        }
+        r->ent22[r->nent22][0] = dim;
+        r->ent22[r->nent22][1] = etag;
+        r->ent22[r->nent22++][2] = phys;
+    }
+    msh41_eblock *b = NULL;
+    getme_io_status st = GETME_IO_OK;
+    if (dim >= 2 && dim >= r->top_dim)
+        st = block22(r, dim, etag, type, nv, &b);
+    if (st == GETME_IO_OK)
+        st = take_element(r, b, b ? (size_t)b->count : 0, rec, nv,
+                          fix_group22(r, dim, phys));
+    if (st != GETME_IO_OK)
+        return st;
+    if (b)
+        b->count++;
+    for (int k = 0; k < nv; k++) { /* nodes exist: take_element checked */
+        int32_t i = msh41_map_find(&r->map, rec[1 + k]);
+        if (dim < r->ndim[i] || (dim == r->ndim[i] && etag < r->netag[i])) {
+            r->ndim[i] = (uint8_t)dim;
+            r->netag[i] = etag;
+        }
+    }
+    return GETME_IO_OK;
+}
+
+enum { MAX_TAGS22 = 64, MAX_NODES22 = 128 };
+
+static getme_io_status ascii_element22(msh41_reader *r)
+{
+    uint64_t rec[1 + MAX_NODES22];
+    int type = 0, ntags = 0, tags[MAX_TAGS22];
+    getme_io_status st = read_u64(r, &rec[0], "element tag");
+    if (st == GETME_IO_OK)
+        st = read_int(r, &type, "element type");
+    if (st == GETME_IO_OK)
+        st = read_int(r, &ntags, "number of tags");
+    if (st == GETME_IO_OK && (ntags < 0 || ntags > MAX_TAGS22))
+        st = msh41_fail(r, GETME_IO_ERR_PARSE, "bad number of tags %d", ntags);
+    for (int k = 0; k < ntags && st == GETME_IO_OK; k++)
+        st = read_int(r, &tags[k], "element tag");
+    int nv = msh41_type_nodes(type, NULL);
+    if (st == GETME_IO_OK && (nv == 0 || nv > MAX_NODES22))
+        return msh41_decline(r, "an element type this reader does not know");
+    for (int k = 0; k < nv && st == GETME_IO_OK; k++)
+        st = read_u64(r, &rec[1 + k], "node tag");
+    if (st == GETME_IO_OK && !msh41_in_eol(&r->in))
+        st = msh41_decline(r, "elements not one per line");
+    return st == GETME_IO_OK ? element22(r, type, ntags, tags, rec) : st;
+}
+
+static getme_io_status binary_block22(msh41_reader *r, uint64_t *left)
+{
+    int head[3], vals[1 + MAX_TAGS22 + MAX_NODES22];
+    getme_io_status st = GETME_IO_OK;
+    for (int k = 0; k < 3 && st == GETME_IO_OK; k++)
+        st = read_int(r, &head[k], "element block header");
+    if (st != GETME_IO_OK)
+        return st;
+    int type = head[0], nv = msh41_type_nodes(type, NULL), ntags = head[2];
+    if (nv == 0 || nv > MAX_NODES22)
+        return msh41_decline(r, "an element type this reader does not know");
+    if (head[1] < 0 || (uint64_t)head[1] > *left || ntags < 0 ||
+        ntags > MAX_TAGS22)
+        return msh41_fail(r, GETME_IO_ERR_PARSE,
+                          "bad element block header (type %d, %d elements, "
+                          "%d tags)",
+                          type, head[1], ntags);
+    *left -= (uint64_t)head[1];
+    for (int e = 0; e < head[1] && st == GETME_IO_OK; e++) {
+        for (int k = 0; k < 1 + ntags + nv && st == GETME_IO_OK; k++)
+            st = read_int(r, &vals[k], "element data");
+        uint64_t rec[1 + MAX_NODES22];
+        for (int k = 0; k <= nv && st == GETME_IO_OK; k++) {
+            int v = vals[k == 0 ? 0 : ntags + k];
+            if (v <= 0)
+                return msh41_fail(r, GETME_IO_ERR_PARSE,
+                                  "bad %s %d in $Elements",
+                                  k ? "node tag" : "element tag", v);
+            rec[k] = (uint64_t)v;
+        }
+        if (st == GETME_IO_OK)
+            st = element22(r, type, ntags, vals + 1, rec);
+    }
+    return st;
+}
+
+static getme_io_status read_elements22(msh41_reader *r)
+{
+    uint64_t n = 0;
+    getme_io_status st = elements_begin(r);
+    if (st != GETME_IO_OK)
+        return st;
+    int nw = r->opts ? r->opts->num_fix + r->opts->num_free : 0;
+    if (nw && !r->fix_found &&
+        !(r->fix_found = calloc((size_t)nw, sizeof *r->fix_found)))
+        return oom(r);
+    st = read_count22(r, &n, "number of elements", 8);
+    if (r->binary)
+        for (uint64_t left = n; st == GETME_IO_OK && left > 0;)
+            st = binary_block22(r, &left);
+    else
+        for (uint64_t i = 0; st == GETME_IO_OK && i < n; i++)
+            st = ascii_element22(r);
+    if (st == GETME_IO_OK)
+        st = expect_end(r);
+    return st;
+}
+
+static int cmp_triple(const void *a, const void *b)
+{
+    const int *x = a, *y = b;
+    for (int k = 0; k < 3; k++)
+        if (x[k] != y[k])
+            return x[k] < y[k] ? -1 : 1;
+    return 0;
+}
+
+/* $Entities as the elements define them. */
+static getme_io_status entities22(msh41_reader *r)
+{
+    qsort(r->ent22, r->nent22, sizeof *r->ent22, cmp_triple);
+    r->ents = malloc((r->nent22 ? r->nent22 : 1) * sizeof *r->ents);
+    r->phys = malloc((r->nent22 ? r->nent22 : 1) * sizeof *r->phys);
+    if (!r->ents || !r->phys)
+        return oom(r);
+    for (size_t i = 0; i < r->nent22; i++) {
+        const int *t = r->ent22[i];
+        if (i && !cmp_triple(t, r->ent22[i - 1]))
+            continue;
+        msh41_entity *e = r->nents ? &r->ents[r->nents - 1] : NULL;
+        if (!e || e->dim != t[0] || e->tag != t[1]) {
+            e = &r->ents[r->nents++];
+            memset(e, 0, sizeof *e);
+            e->dim = t[0];
+            e->tag = t[1];
+            e->phys_first = r->nphys;
+        }
+        if (t[2]) {
+            r->phys[r->nphys++] = t[2];
+            e->phys_count++;
+        }
+    }
+    return GETME_IO_OK;
+}
+
+/* Node order by (dimension, entity, tag), one node block per entity. */
+static const msh41_reader *order_reader;
+
+static int cmp_node22(const void *a, const void *b)
+{
+    const msh41_reader *r = order_reader;
+    size_t i = *(const size_t *)a, j = *(const size_t *)b;
+    if (r->ndim[i] != r->ndim[j])
+        return r->ndim[i] < r->ndim[j] ? -1 : 1;
+    int ti = r->ndim[i] < 4 ? r->netag[i] : 0;
+    int tj = r->ndim[j] < 4 ? r->netag[j] : 0;
+    if (ti != tj)
+        return ti < tj ? -1 : 1;
+    return (r->tags[i] > r->tags[j]) - (r->tags[i] < r->tags[j]);
+}
+
+static getme_io_status nodes22(msh41_reader *r)
+{
+    size_t n = r->nnodes;
+    size_t *order = malloc((n ? n : 1) * sizeof *order);
+    int32_t *pos = malloc((n ? n : 1) * sizeof *pos);
+    uint64_t *tags = malloc((n ? n : 1) * sizeof *tags);
+    double *xyz = malloc((n ? n : 1) * 3 * sizeof *xyz);
+    uint8_t *flag = malloc(n ? n : 1);
+    msh41_nblock *nb = malloc((n ? n : 1) * sizeof *nb);
+    getme_io_status st =
+        order && pos && tags && xyz && flag && nb ? GETME_IO_OK : oom(r);
+    if (st == GETME_IO_OK) {
+        for (size_t i = 0; i < n; i++)
+            order[i] = i;
+        order_reader = r; /* qsort has no context argument in C11 */
+        qsort(order, n, sizeof *order, cmp_node22);
+        size_t nnb = 0;
+        for (size_t k = 0; k < n; k++) {
+            size_t i = order[k];
+            pos[i] = (int32_t)k;
+            tags[k] = r->tags[i];
+            memcpy(xyz + 3 * k, r->xyz + 3 * i, 3 * sizeof *xyz);
+            flag[k] = r->flag[i];
+            int dim = r->ndim[i], tag = dim < 4 ? r->netag[i] : 0;
+            if (!nnb || nb[nnb - 1].dim != dim || nb[nnb - 1].tag != tag)
+                nb[nnb++] = (msh41_nblock){dim, tag, k, 0};
+            nb[nnb - 1].count++;
+        }
+        for (size_t b = 0; b < r->neb; b++)
+            for (size_t k = 0; r->eb[b].conn &&
+                               k < (size_t)r->eb[b].count *
+                                       (size_t)msh41_type_nodes(r->eb[b].type,
+                                                                NULL);
+                 k++)
+                r->eb[b].conn[k] = pos[r->eb[b].conn[k]];
+        free(r->tags);
+        free(r->xyz);
+        free(r->flag);
+        free(r->nb);
+        r->tags = tags;
+        r->xyz = xyz;
+        r->flag = flag;
+        r->nb = nb;
+        r->nnb = nnb;
+        tags = NULL;
+        xyz = NULL;
+        flag = NULL;
+        nb = NULL;
+        msh41_map_free(&r->map);
+        st = msh41_map_build(r, &r->map, r->tags, n);
+    }
+    free(order);
+    free(pos);
+    free(tags);
+    free(xyz);
+    free(flag);
+    free(nb);
+    return st;
+}
+
+/* After the file: entities and node blocks, as MSH 4.1 would have them. */
+static getme_io_status finish22(msh41_reader *r)
+{
+    if (!r->have_nodes || !r->have_elements)
+        return GETME_IO_OK; /* msh41_build says there is no mesh */
+    getme_io_status st = entities22(r);
+    return st == GETME_IO_OK ? nodes22(r) : st;
+}
+
 /* ---- the file ----------------------------------------------------------- */
 
 static getme_io_status read_section(msh41_reader *r, const char *name)
 {
     if (strcmp(name, "PhysicalNames") == 0)
         return read_physical_names(r);
-    if (strcmp(name, "Entities") == 0)
+    if (strcmp(name, "Entities") == 0 && !r->v22)
         return read_entities(r);
     if (strcmp(name, "Nodes") == 0)
-        return read_nodes(r);
+        return r->v22 ? read_nodes22(r) : read_nodes(r);
     if (strcmp(name, "Elements") == 0)
-        return read_elements(r);
+        return r->v22 ? read_elements22(r) : read_elements(r);
     if (strcmp(name, "PartitionedEntities") == 0)
         return msh41_decline(r, "partitioned mesh");
     if (strcmp(name, "MeshFormat") == 0) {
@@ -866,6 +1313,9 @@ static void reader_free(msh41_reader *r)
     msh41_map_free(&r->map);
     drop_blocks(r);
     free(r->eb);
+    free(r->ndim);
+    free(r->netag);
+    free(r->ent22);
 }
 
 static void remember_identity(msh41_doc *m, FILE *f)
@@ -911,9 +1361,12 @@ getme_io_status msh41_open(getme_doc *doc, const getme_doc_options *opts,
     remember_identity(m, r.in.f);
     r.file_size = m->size > 0 ? m->size : 1;
     getme_io_status st = read_file(&r);
+    if (st == GETME_IO_OK && r.v22)
+        st = finish22(&r);
     if (st == GETME_IO_OK)
         st = msh41_build(&r, m);
     m->binary = r.binary;
+    m->v22 = r.v22;
     m->nodes_offset = r.nodes_offset;
     reader_free(&r);
     if (st == MSH41_DECLINED) {

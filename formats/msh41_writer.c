@@ -1,6 +1,7 @@
 /*
- * msh41_writer.c -- write a natively read MSH 4.1 file back: a byte-for-byte
- * copy of the input in which only node coordinates in $Nodes change.
+ * msh41_writer.c -- write a natively read MSH 4.1 or 2.2 file back: a
+ * byte-for-byte copy of the input in which only node coordinates in $Nodes
+ * change (MSH 2.2: "tag x y z" lines, or int32 tag + 3 doubles records).
  *
  * The input is streamed through msh41_input with its echo on (every byte
  * read is copied to the temporary output); inside $Nodes the echo is
@@ -144,7 +145,9 @@ static int format_double(double v, char *buf, size_t size)
     return n;
 }
 
-/* One coordinate line (read raw, echo off): rewritten if the node moved. */
+/* One node's line (read raw, echo off): "x y z" (MSH 4.1, tag given) or
+   "tag x y z" (MSH 2.2, tag == 0: read from the line, its text kept);
+   the coordinates are rewritten if the node moved. */
 static int ascii_coord_line(writer *w, uint64_t tag)
 {
     char line[8192], *p = line, *end;
@@ -158,6 +161,13 @@ static int ascii_coord_line(writer *w, uint64_t tag)
             break;
     }
     line[n] = 0;
+    if (tag == 0) {
+        errno = 0;
+        tag = strtoull(line, &p, 10);
+        if (p == line || errno || tag == 0)
+            return -1;
+    }
+    size_t prefix = (size_t)(p - line); /* the tag's text, kept */
     double old[3];
     for (int k = 0; k < 3; k++, p = end) {
         old[k] = strtod(p, &end);
@@ -173,7 +183,9 @@ static int ascii_coord_line(writer *w, uint64_t tag)
     char num[3][40];
     for (int k = 0; k < 3; k++)
         format_double(x[k], num[k], sizeof num[k]);
-    return fprintf(w->out, "%s %s %s%s", num[0], num[1], num[2], eol) < 0
+    return fwrite(line, 1, prefix, w->out) != prefix ||
+                   fprintf(w->out, "%s%s %s %s%s", prefix ? " " : "", num[0],
+                           num[1], num[2], eol) < 0
                ? -1
                : 0;
 }
@@ -204,6 +216,45 @@ static int ascii_block(writer *w)
     return rc;
 }
 
+/* ---- MSH 2.2: one node per record ---------------------------------------- */
+
+/* Binary: int32 tag + 3 doubles per node, patched in place. */
+static int bin_node22(writer *w)
+{
+    unsigned char rec[28];
+    if (msh41_in_read(&w->in, rec, sizeof rec))
+        return -1;
+    uint32_t t = (uint32_t)rec[0] | (uint32_t)rec[1] << 8 |
+                 (uint32_t)rec[2] << 16 | (uint32_t)rec[3] << 24;
+    double old[3];
+    for (int k = 0; k < 3; k++) {
+        uint64_t bits = le64(rec + 4 + 8 * k);
+        memcpy(&old[k], &bits, sizeof bits);
+    }
+    const double *x = moved(w, t, old);
+    for (int k = 0; x && k < 3; k++) {
+        uint64_t bits;
+        memcpy(&bits, &x[k], sizeof bits);
+        put_le64(rec + 4 + 8 * k, bits);
+    }
+    return fwrite(rec, 1, sizeof rec, w->out) == sizeof rec ? 0 : -1;
+}
+
+/* The count line, then the nodes (echo off while they are patched). */
+static int nodes22(writer *w)
+{
+    uint64_t count;
+    if (ascii_u64(w, &count) || !msh41_in_eol(&w->in) ||
+        count > (uint64_t)w->m->size / 8)
+        return -1;
+    msh41_in_echo(&w->in, NULL);
+    int rc = 0;
+    for (uint64_t i = 0; rc == 0 && i < count; i++)
+        rc = w->m->binary ? bin_node22(w) : ascii_coord_line(w, 0);
+    msh41_in_echo(&w->in, w->out);
+    return rc;
+}
+
 /* ---- the file ----------------------------------------------------------- */
 
 /* Copy up to $Nodes, patch the node blocks, copy the rest. */
@@ -215,7 +266,9 @@ static int copy_file(writer *w)
         return -1;
     uint64_t nblocks = 0, skip;
     int rc = 0;
-    if (m->binary)
+    if (m->v22)
+        rc = nodes22(w);
+    else if (m->binary)
         rc = bin_u64(w, &nblocks) || bin_u64(w, &skip) || bin_u64(w, &skip) ||
              bin_u64(w, &skip);
     else

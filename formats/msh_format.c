@@ -2,15 +2,17 @@
  * msh_format.c -- the Gmsh MSH adapter (MSH 2.2 / 4.x, ASCII or binary).
  *
  * Two readers:
- *  - MSH 4.1 (ASCII or binary) is read natively by msh41_reader.c in one
- *    streaming pass, without a Gmsh model (a Gmsh model of a 4M-tet mesh
- *    costs about 1 GiB), and written by msh41_writer.c as a copy of the
- *    input with new coordinates in $Nodes.  Fixed nodes, regions and
- *    element order are those the Gmsh path gives for the same file.
- *  - Everything else (MSH 2.2 / 4.0, and the 4.1 files the native reader
- *    declines: parametric nodes, partitioned meshes, planar meshes outside
- *    a plane z = const, element types it does not know...) goes through
- *    Gmsh's own reader via the C API and libgetme_gmsh's model extraction.
+ *  - MSH 4.1 and 2.2 (ASCII or binary) are read natively by
+ *    msh41_reader.c in one streaming pass, without a Gmsh model (a Gmsh
+ *    model of a 4M-tet mesh costs about 1 GiB), and written by
+ *    msh41_writer.c as a copy of the input with new coordinates in $Nodes.
+ *    Fixed nodes, regions and element order are those the Gmsh path gives
+ *    for the same file.
+ *  - Everything else (MSH 4.0, and the files the native reader declines:
+ *    parametric nodes, partitioned meshes, planar meshes outside a plane
+ *    z = const, element types it does not know...) goes through Gmsh's own
+ *    reader via the C API and libgetme_gmsh's model extraction, after
+ *    check_msh_file refused what Gmsh's reader would accept damaged.
  * The environment variable GETME_MSH_READER=gmsh forces the Gmsh path,
  * GETME_MSH_READER=native forces the native one (a file it declines is then
  * an error); anything else, or unset, means "native if it can".  A
@@ -31,6 +33,7 @@
  * copying the input with new coordinates in $Nodes (see patch_msh2: Gmsh's
  * MSH 2 writer would renumber the nodes).
  */
+#define _POSIX_C_SOURCE 200809L /* getline */
 #include "getme_formats.h"
 #include "getme_gmsh.h"
 #include "msh41_internal.h"
@@ -39,6 +42,8 @@
 
 #include <ctype.h>
 #include <errno.h>
+#include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -148,6 +153,254 @@ static getme_io_status read_header(getme_doc *doc, msh_impl *impl)
                               "4.0 and 4.1 are)",
                               doc->path, impl->version);
     return GETME_IO_OK;
+}
+
+/* ---- files Gmsh's readers would take although they are damaged ----------
+ * Gmsh's MSH readers stop at the end of the file without complaint, so a
+ * truncated file is read as if it were whole (its last element wrong).
+ * Before Gmsh reads a file it is checked here:
+ *  - MSH 2.2 ASCII, line by line: every section is closed by its $End line,
+ *    $Nodes and $Elements hold the number of lines they declare, node lines
+ *    have 4 numbers with finite coordinates, element lines as many fields as
+ *    their type needs (tag, type, number of tags, tags, nodes);
+ *  - every other file (binary, MSH 4.0/4.1 given to Gmsh): its last line
+ *    is a closing "$End..." line.
+ * Errors name the file and the line (binary: the byte).
+ */
+typedef struct scan {
+    getme_doc *doc;
+    FILE *f;
+    char *line;
+    size_t cap;
+    long lineno;
+} scan;
+
+static int scan_line(scan *s)
+{
+    ssize_t n = getline(&s->line, &s->cap, s->f);
+    if (n < 0)
+        return -1;
+    while (n > 0 && (s->line[n - 1] == '\n' || s->line[n - 1] == '\r'))
+        s->line[--n] = 0;
+    s->lineno++;
+    return 0;
+}
+
+static getme_io_status scan_fail(scan *s, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+
+static getme_io_status scan_fail(scan *s, const char *fmt, ...)
+{
+    char msg[400];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    return getme_doc_fail(s->doc, GETME_IO_ERR_PARSE, "'%s', line %ld: %s",
+                          s->doc->path, s->lineno, msg);
+}
+
+static getme_io_status scan_eof(scan *s, const char *section)
+{
+    return getme_doc_fail(s->doc, GETME_IO_ERR_PARSE,
+                          "'%s', line %ld: the file ends inside $%s (no "
+                          "$End%s): truncated or damaged",
+                          s->doc->path, s->lineno, section, section);
+}
+
+/* Whitespace-separated fields of s->line as numbers, up to max. */
+static int fields(const char *line, double *v, int max, int *bad)
+{
+    int n = 0;
+    *bad = 0;
+    for (const char *p = line;;) {
+        while (*p == ' ' || *p == '\t')
+            p++;
+        if (!*p)
+            return n;
+        char *end;
+        double x = strtod(p, &end);
+        if (end == p || (*end && *end != ' ' && *end != '\t')) {
+            *bad = 1;
+            return n;
+        }
+        if (n < max)
+            v[n] = x;
+        n++;
+        p = end;
+    }
+}
+
+static getme_io_status scan_count(scan *s, const char *section, long *count)
+{
+    char *end;
+    if (scan_line(s) != 0)
+        return scan_eof(s, section);
+    *count = strtol(s->line, &end, 10);
+    while (*end == ' ' || *end == '\t')
+        end++;
+    if (end == s->line || *end || *count < 0)
+        return scan_fail(s, "bad number of entries '%s' in $%s", s->line,
+                         section);
+    return GETME_IO_OK;
+}
+
+/* Entry i of the n that $section declares: its line in s->line. */
+static getme_io_status scan_entry(scan *s, const char *section, long n)
+{
+    if (scan_line(s) != 0)
+        return scan_eof(s, section);
+    if (s->line[0] == '$')
+        return scan_fail(s, "$%s declares %ld entries, it has fewer",
+                         section, n);
+    return GETME_IO_OK;
+}
+
+/* The lines of $Nodes ("tag x y z") or $Elements ("tag type ntags tags...
+   nodes..."). */
+static getme_io_status scan_entries(scan *s, int nodes)
+{
+    const char *section = nodes ? "Nodes" : "Elements";
+    long n = 0;
+    getme_io_status st = scan_count(s, section, &n);
+    for (long i = 0; st == GETME_IO_OK && i < n; i++) {
+        double v[64];
+        int bad;
+        if ((st = scan_entry(s, section, n)) != GETME_IO_OK)
+            return st;
+        int nf = fields(s->line, v, 64, &bad);
+        if (nodes && (nf != 4 || bad))
+            return scan_fail(s, "bad node line '%s' (want: tag x y z)",
+                             s->line);
+        if (nodes && (!isfinite(v[1]) || !isfinite(v[2]) || !isfinite(v[3])))
+            return scan_fail(s, "node %ld has a coordinate that is not a "
+                                "finite number", (long)v[0]);
+        int nv = !nodes && nf >= 3 ? msh41_type_nodes((int)v[1], NULL) : 0;
+        if (!nodes && (bad || nf < 3 || v[2] < 0 ||
+                       (nv > 0 && nf != 3 + (int)v[2] + nv)))
+            return scan_fail(s, "bad element line '%s' (want: tag type "
+                                "number-of-tags tags... nodes...)",
+                             s->line);
+    }
+    return st;
+}
+
+/* The last line of the file (after trailing blanks) starts with "$End". */
+static getme_io_status check_last_line(getme_doc *doc, FILE *f, int binary)
+{
+    char tail[256];
+    if (fseek(f, 0, SEEK_END) != 0)
+        return GETME_IO_OK;
+    long size = ftell(f);
+    long from = size > (long)sizeof tail - 1 ? size - (long)sizeof tail + 1 : 0;
+    fseek(f, from, SEEK_SET);
+    size_t n = fread(tail, 1, (size_t)(size - from), f);
+    tail[n] = 0;
+    while (n > 0 && (tail[n - 1] == '\n' || tail[n - 1] == '\r' ||
+                     tail[n - 1] == ' ' || tail[n - 1] == '\t'))
+        tail[--n] = 0;
+    size_t start = n;
+    while (start > 0 && tail[start - 1] != '\n')
+        start--;
+    if (n > 0 && strncmp(tail + start, "$End", 4) == 0)
+        return GETME_IO_OK;
+    if (binary)
+        return getme_doc_fail(doc, GETME_IO_ERR_PARSE,
+                              "'%s': the file ends at byte %ld without a "
+                              "closing $End line: truncated or damaged",
+                              doc->path, size);
+    long lines = 1;
+    int c;
+    rewind(f);
+    while ((c = getc(f)) != EOF)
+        lines += c == '\n';
+    return getme_doc_fail(doc, GETME_IO_ERR_PARSE,
+                          "'%s', line %ld: the file ends without a closing "
+                          "$End line: truncated or damaged",
+                          doc->path, lines - (size > 0 && tail[0] == 0));
+}
+
+static getme_io_status check_msh_file(getme_doc *doc, const msh_impl *impl)
+{
+    scan s = {doc, fopen(doc->path, "rb"), NULL, 0, 0};
+    if (!s.f)
+        return getme_doc_fail(doc, GETME_IO_ERR_OPEN, "Cannot open '%s': %s",
+                              doc->path, strerror(errno));
+    getme_io_status st = GETME_IO_OK;
+    if (impl->binary || impl->version != 2.2) {
+        st = check_last_line(doc, s.f, impl->binary);
+        fclose(s.f);
+        return st;
+    }
+    char section[64] = "";
+    while (st == GETME_IO_OK && scan_line(&s) == 0) {
+        if (s.line[0] != '$')
+            continue; /* Gmsh ignores anything between sections */
+        snprintf(section, sizeof section, "%s", s.line + 1);
+        if (strncmp(section, "End", 3) == 0) {
+            st = scan_fail(&s, "%s without its section", s.line);
+            break;
+        }
+        if (strcmp(section, "Nodes") == 0 || strcmp(section, "Elements") == 0)
+            st = scan_entries(&s, section[0] == 'N');
+        /* up to the closing line */
+        while (st == GETME_IO_OK) {
+            if (scan_line(&s) != 0) {
+                st = scan_eof(&s, section);
+                break;
+            }
+            if (s.line[0] == '$' && strncmp(s.line + 1, "End", 3) == 0) {
+                if (strcmp(s.line + 4, section) != 0)
+                    st = scan_fail(&s, "%s closes $%s", s.line, section);
+                break;
+            }
+            if (strcmp(section, "Nodes") == 0 ||
+                strcmp(section, "Elements") == 0) {
+                st = scan_fail(&s, "$%s holds more entries than it declares",
+                               section);
+                break;
+            }
+        }
+    }
+    free(s.line);
+    fclose(s.f);
+    return st;
+}
+
+/* Gmsh's model: every node coordinate finite (files the scan above did not
+   read line by line). */
+static getme_io_status check_model_coords(getme_doc *doc)
+{
+    size_t *tags = NULL, nt = 0, nc = 0, np = 0;
+    double *xyz = NULL, *par = NULL;
+    int ierr = 0;
+    gmshModelMeshGetNodes(&tags, &nt, &xyz, &nc, &par, &np, -1, -1, 0, 0,
+                          &ierr);
+    getme_io_status st = GETME_IO_OK;
+    for (size_t i = 0; i < nt && 3 * i + 2 < nc && st == GETME_IO_OK; i++)
+        if (!isfinite(xyz[3 * i]) || !isfinite(xyz[3 * i + 1]) ||
+            !isfinite(xyz[3 * i + 2]))
+            st = getme_doc_fail(doc, GETME_IO_ERR_PARSE,
+                                "'%s': node %zu has a coordinate that is not "
+                                "a finite number",
+                                doc->path, tags[i]);
+    gmshFree(tags);
+    gmshFree(xyz);
+    gmshFree(par);
+    return st;
+}
+
+/* --free names must name physical groups ("name" or "dim:tag"), as --fix
+   names must (no group is fixed by default: nothing else happens). */
+static getme_io_status check_free_names(getme_doc *doc,
+                                        const getme_doc_options *opts)
+{
+    char msg[512];
+    if (!opts || opts->num_free == 0 ||
+        getme_gmsh_check_groups(opts->free_sets, opts->num_free, "free", msg,
+                                sizeof msg) == GETME_OK)
+        return GETME_IO_OK;
+    return getme_doc_fail(doc, GETME_IO_ERR_USAGE, "'%s': %s", doc->path, msg);
 }
 
 static int model_exists(const char *name)
@@ -302,18 +555,19 @@ static getme_io_status open_native(getme_doc *doc, msh_impl *impl,
     char why[160] = "";
     int eligible = 1;
     *done = 1;
-    if (impl->version != 4.1)
+    int native = impl->version == 4.1 || impl->version == 2.2;
+    if (!native)
         snprintf(why, sizeof why, "MSH %g", impl->version);
     getme_io_status st =
-        impl->version == 4.1
+        native
             ? msh41_open(doc, opts, &impl->native, &eligible, why, sizeof why)
             : GETME_IO_OK;
-    if (impl->version == 4.1 && eligible)
+    if (native && eligible)
         return st;
     if (choice == 'n')
         return getme_doc_fail(doc, GETME_IO_ERR_UNSUPPORTED,
-                              "'%s': the native MSH reader reads MSH 4.1 "
-                              "only, without %s (GETME_MSH_READER=native)",
+                              "'%s': the native MSH reader reads MSH 4.1 and "
+                              "2.2 only, without %s (GETME_MSH_READER=native)",
                               doc->path, why);
     *done = 0;
     return GETME_IO_OK;
@@ -335,9 +589,16 @@ static getme_io_status msh_open(getme_doc *doc, const getme_doc_options *opts)
         if (done)
             return st;
     }
+    st = check_msh_file(doc, impl);
+    if (st != GETME_IO_OK)
+        return st;
     saved_options saved;
     quiet_begin(&saved);
     st = open_model(doc, impl);
+    if (st == GETME_IO_OK)
+        st = check_model_coords(doc);
+    if (st == GETME_IO_OK)
+        st = check_free_names(doc, opts);
     if (st == GETME_IO_OK) {
         impl->save_all = needs_save_all();
         st = extract(doc, impl, opts);
@@ -570,7 +831,7 @@ static void msh_close(getme_doc *doc)
 
 const getme_format getme_format_msh = {
     "msh",
-    "Gmsh MSH 2.2/4.1, ASCII or binary (4.1 read natively, others via the "
+    "Gmsh MSH 2.2/4.1, ASCII or binary (2.2 and 4.1 read natively, others via the "
     "Gmsh SDK)",
     msh_probe,
-    msh_open, msh_write, msh_close};
+    msh_open, msh_write, msh_close, ".msh", NULL};

@@ -13,7 +13,8 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # Everything getme needs, from Debian 12's archive and nowhere else.
 PACKAGES="cmake make gcc libc6-dev libgmsh-dev gmsh python3-gmsh libcgns-dev cgns-convert \
 libhdf5-dev calculix-ccx python3 python3-numpy python3-meshio python3-h5py python3-matplotlib \
-xvfb xdotool x11-apps imagemagick time python3-netgen occt-misc gmsh-doc"
+xvfb xdotool x11-apps imagemagick time python3-netgen occt-misc gmsh-doc \
+calculix-ccx-test"
 
 missing=""
 for p in $PACKAGES; do

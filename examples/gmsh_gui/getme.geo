@@ -16,7 +16,7 @@ DefineConstant[
                  Name "GETMe adaptive/3Sigma"},
   getme_maxiter = {1000, Min 1, Max 100000, Step 1,
                    Name "GETMe adaptive/4Max iterations"},
-  getme_fraction = {0.01, Min 0.0001, Max 1, Step 0.001,
+  getme_fraction = {0.005, Min 0.0001, Max 1, Step 0.001,
                     Name "GETMe adaptive/5Threshold fraction"},
   getme_fix = {"", Name "GETMe adaptive/6Fixed groups (a,b,...)"},
   getme_exe = {"getme", Name "GETMe adaptive/9getme command"}

@@ -1,5 +1,5 @@
 // A planar plate with two holes, meshed with triangles: the GUI demo model
-// for GETMe adaptive (examples/gmsh_gui/README.md).
+// for GETMe adaptive (docs/gmsh.md, "The Gmsh GUI").
 SetFactory("OpenCASCADE");
 Rectangle(1) = {0, 0, 0, 4, 2};
 Disk(2) = {1.2, 1, 0, 0.45};

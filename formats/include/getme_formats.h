@@ -80,6 +80,12 @@ typedef struct getme_format {
     getme_io_status (*write)(getme_doc *doc, const char *out_path);
     /* Free doc->impl. */
     void (*close)(getme_doc *doc);
+    /* Extensions of the format, space-separated, with the dot (".inp"):
+       an output must end with one of them (getme_format_has_extension). */
+    const char *extensions;
+    /* The i-th file (i >= 1) the document was read from besides doc->path
+       (INP *INCLUDE files), NULL past the last; NULL if there are none. */
+    const char *(*file)(const getme_doc *doc, size_t i);
 } getme_format;
 
 struct getme_doc {
@@ -95,6 +101,8 @@ struct getme_doc {
                             check; callers need not compute them again)      */
     char info[1024];     /* one line the CLI may log: zones, sets, fixed...  */
     char error[1024];    /* the last error, one line                         */
+    char warning[1024];  /* input accepted with a caveat (the CLI prints it
+                            as a warning), one line; empty if none           */
 };
 
 /* The registered adapters, NULL-terminated. */
@@ -110,11 +118,21 @@ const getme_format *getme_format_for(const char *path);
  */
 getme_io_status getme_doc_open(getme_doc **doc, const char *path,
                                const getme_doc_options *opts);
+/* Write the document to out_path: refused (GETME_IO_ERR_USAGE) if out_path
+   is one of the files read (by device and inode) or is not a regular file
+   (see getme_io_output_path: a symbolic link is followed). */
 getme_io_status getme_doc_write(getme_doc *doc, const char *out_path);
+/* The files the document was read from: 0 is the input, then the files it
+   includes (INP *INCLUDE), in the order they were read. */
+size_t getme_doc_num_files(const getme_doc *doc);
+const char *getme_doc_file(const getme_doc *doc, size_t i);
+/* 1 if path ends with one of format's extensions (case-insensitive). */
+int getme_format_has_extension(const getme_format *format, const char *path);
 void getme_doc_close(getme_doc *doc);
 getme_mesh *getme_doc_mesh(getme_doc *doc);
 const char *getme_doc_error(const getme_doc *doc);
 const char *getme_doc_info(const getme_doc *doc);
+const char *getme_doc_warning(const getme_doc *doc);
 
 /* The id of mesh element e as written in the file (1-based position if
    the format has no ids). */
@@ -131,13 +149,26 @@ getme_io_status getme_doc_fail(getme_doc *doc, getme_io_status status,
 /* ---- helpers for adapters ----------------------------------------------- */
 
 /* Create an empty file with a unique name next to out_path
-   ("<dir>/.<name>.tmp.XXXXXX") and put its path into buf; the adapter
+   ("<dir>/.<name>.getme-tmp.<pid>.<n>") and put its path into buf; the adapter
    overwrites it.  Returns 0, or -1 (buf too small, directory not writable:
    errno tells). */
 int getme_io_tmp_path(const char *out_path, char *buf, size_t size);
 /* Rename tmp to out (same directory); on failure remove tmp. 0 or -1.
+   Refuses (errno EEXIST) when out exists and is not a regular file: a
+   device, FIFO, directory or symbolic link is never replaced.
    Adapters that fail after getme_io_tmp_path must remove(tmp) themselves. */
 int getme_io_commit(const char *tmp, const char *out);
+/* Where out_path may be written, checked before anything is read or
+   written: the path to write goes to buf (out_path itself, or for a
+   symbolic link the file it points to: the link is followed and stays).
+   GETME_IO_ERR_USAGE if out_path exists and is not a regular file
+   (character or block device, FIFO, socket, directory) or is a link to a
+   missing file; GETME_IO_ERR_WRITE if its directory is missing or not
+   writable.  msg gets the one-line reason, naming out_path. */
+getme_io_status getme_io_output_path(const char *out_path, char *buf,
+                                     size_t size, char *msg, size_t msg_size);
+/* The directory part of path ("." if none, "/" for "/x"), into buf. */
+void getme_io_dirname(const char *path, char *buf, size_t size);
 /* 1 if a and b name the same existing file (used to refuse -o == input). */
 int getme_io_same_file(const char *a, const char *b);
 

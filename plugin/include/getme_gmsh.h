@@ -187,6 +187,13 @@ GETME_GMSH_API getme_status getme_gmsh_optimize(
  * the measures into report->measures_before (and copies in ->after,
  * ->measures_after); nothing is smoothed, nothing is logged.
  */
+/* Each of names[0..n) names a physical group of the current model (its
+   name or "dim:tag"): GETME_OK, else GETME_ERR_ARGUMENT and "Unknown
+   physical group 'x' to <what> (the groups there are)" in msg. */
+GETME_GMSH_API getme_status getme_gmsh_check_groups(const char *const *names,
+                                                    int n, const char *what,
+                                                    char *msg, size_t size);
+
 GETME_GMSH_API getme_status getme_gmsh_quality(
     const int *dim_tags, size_t dim_tags_n, const getme_gmsh_options *options,
     getme_gmsh_report *report);

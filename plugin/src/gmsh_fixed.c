@@ -117,7 +117,8 @@ static int fix_one(const char *word, const int *dt, size_t n,
         int match = by_tag ? (dt[i] == dim && dt[i + 1] == tag)
                            : group_name_is(dt[i], dt[i + 1], word);
         if (match) {
-            fix_group_nodes(dt[i], dt[i + 1], local, fixed);
+            if (fixed)
+                fix_group_nodes(dt[i], dt[i + 1], local, fixed);
             found++;
         }
     }
@@ -142,6 +143,29 @@ getme_status gg_fix_groups(const getme_gmsh_options *opt,
         st = gg_fail(msg, GETME_ERR_ARGUMENT,
                      "Unknown physical group '%s' to fix (%s)", opt->fix[g],
                      known);
+    }
+    gmshFree(dt);
+    return st;
+}
+
+getme_status getme_gmsh_check_groups(const char *const *names, int n,
+                                     const char *what, char *msg, size_t size)
+{
+    int *dt = NULL;
+    size_t nd = 0;
+    list_groups(&dt, &nd);
+    getme_status st = GETME_OK;
+    if (msg && size)
+        msg[0] = 0;
+    for (int g = 0; g < n && st == GETME_OK; g++) {
+        if (fix_one(names[g], dt, nd, NULL, NULL))
+            continue;
+        char known[300];
+        describe_groups(dt, nd, known, sizeof known);
+        if (msg && size)
+            snprintf(msg, size, "Unknown physical group '%s' to %s (%s)",
+                     names[g], what ? what : "use", known);
+        st = GETME_ERR_ARGUMENT;
     }
     gmshFree(dt);
     return st;

@@ -209,6 +209,17 @@ static int entity_index(const getme_gmsh_model *m, int tag)
     return 0;
 }
 
+/* First element of a block that has a node twice, -1 if none. */
+static int32_t repeated_node(const int32_t *conn, int32_t count, int nv)
+{
+    for (int32_t e = 0; e < count; e++)
+        for (int i = 1; i < nv; i++)
+            for (int j = 0; j < i; j++)
+                if (conn[(size_t)e * nv + i] == conn[(size_t)e * nv + j])
+                    return e;
+    return -1;
+}
+
 static getme_status build_mesh(getme_gmsh_model *m, gg_read *r, gg_msg *msg)
 {
     getme_status st = getme_mesh_create(&m->mesh, m->dim, m->num_nodes,
@@ -225,6 +236,15 @@ static getme_status build_mesh(getme_gmsh_model *m, gg_read *r, gg_msg *msg)
         int32_t id = r->entity_region[entity_index(m, blk->tag)];
         for (int32_t i = 0; i < blk->count; i++)
             region[i] = id;
+        int32_t bad = repeated_node(r->conn[b], blk->count,
+                                    getme_type_num_nodes(blk->type));
+        if (bad >= 0) {
+            free(region);
+            return gg_fail(msg, GETME_ERR_INVALID_MESH,
+                           "element %zu is degenerate: a node appears twice "
+                           "in it; getme smooths valid meshes only",
+                           m->elem_tags[blk->first + bad]);
+        }
         st = getme_mesh_add_elements(m->mesh, (getme_elem_type)blk->type,
                                      blk->count, r->conn[b], region);
         free(region);

@@ -23,25 +23,11 @@ import numpy as np
 
 GETME, WORK, CASE = sys.argv[1], sys.argv[2], sys.argv[3]
 os.makedirs(WORK, exist_ok=True)
-failures = []
-passed = 0
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402
 
-
-def check(cond, what):
-    global passed
-    if cond:
-        passed += 1
-    else:
-        failures.append(what)
-        print("FAILED:", what, flush=True)
-
-
-def run(*args, expect=0):
-    p = subprocess.run([GETME, *args], capture_output=True, text=True)
-    if p.returncode != expect:
-        print(p.stdout[-3000:], p.stderr[-3000:])
-    check(p.returncode == expect, f"getme {' '.join(args)} -> {p.returncode}, want {expect}")
-    return p
+T = Checks(GETME)
+check, run = T.check, T.run
 
 
 # ---- independent mean ratio: bench/quality.py (numpy, DESIGN.md §2, written
@@ -234,9 +220,9 @@ def errors_case():
           "corner_guard" in table and "untangle" in table, f"--help parameter table: {table}")
     garbage = os.path.join(WORK, "garbage.msh")
     open(garbage, "w").write("$MeshFormat\nthis is not a mesh\n")
-    p = subprocess.run([GETME, "smooth", garbage, "-o", garbage + ".out"], capture_output=True, text=True)
+    p = subprocess.run([GETME, "smooth", garbage, "-o", garbage + "-out.msh"], capture_output=True, text=True)
     check(p.returncode in (4, 5), f"garbage input -> {p.returncode}, want 4 (malformed)")
-    check(not os.path.exists(garbage + ".out"), "no output for bad input")
+    check(not os.path.exists(garbage + "-out.msh"), "no output for bad input")
     # An inverted element: swap the last two nodes of one tet (MSH 2.2 text:
     # "tag type ntags tags... nodes").
     good = os.path.join(WORK, "inv-src.msh")
@@ -258,17 +244,17 @@ def errors_case():
     open(inv, "w").write("\n".join(lines))
     tags = [[int(victim[0])] * 6]
     digest = sha(inv)
-    if os.path.exists(inv + ".out"):  # written by an earlier run
-        os.remove(inv + ".out")
-    p = run("smooth", inv, "-o", inv + ".out", "--no-untangle", expect=6)
+    if os.path.exists(inv + "-out.msh"):  # written by an earlier run
+        os.remove(inv + "-out.msh")
+    p = run("smooth", inv, "-o", inv + "-out.msh", "--no-untangle", expect=6)
     check("invalid" in p.stderr and str(tags[0][5]) in p.stderr,
           "inverted element reported by its Gmsh tag")
-    check(sha(inv) == digest and not os.path.exists(inv + ".out"), "input untouched, no output")
+    check(sha(inv) == digest and not os.path.exists(inv + "-out.msh"), "input untouched, no output")
     # by default it is untangled first (issue #12), then smoothed
-    p = run("smooth", inv, "-o", inv + ".out")
+    p = run("smooth", inv, "-o", inv + "-out.msh")
     check("Warning : 1 invalid (inverted or degenerate) element in the input, 0 remain"
           in p.stdout, "untangling warning line")
-    check(sha(inv) == digest and os.path.exists(inv + ".out"), "input untouched, output written")
+    check(sha(inv) == digest and os.path.exists(inv + "-out.msh"), "input untouched, output written")
     run("quality", inv, expect=6)
     p = run("smooth", good, "-o", good, expect=2)
     check("overwrite" in p.stderr, "refuses to overwrite the input")
@@ -403,5 +389,4 @@ elif CASE == "untangle":
     untangle_case()
 else:
     mesh_case(CASE)
-print(f"{passed} passed, {len(failures)} failed")
-sys.exit(1 if failures else 0)
+sys.exit(T.summary())

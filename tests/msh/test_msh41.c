@@ -67,6 +67,16 @@ static const char ascii_seed[] =
     "3 2 4 1\n3 2 3 4 5\n$EndElements\n"
     "$Comments\nanything $End\n$EndComments\n";
 
+/* The same mesh as MSH 2.2: entities and groups from the element tags. */
+static const char ascii22_seed[] =
+    "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
+    "$PhysicalNames\n2\n3 7 \"a\"\n3 8 \"b\"\n$EndPhysicalNames\n"
+    "$Nodes\n5\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 1 1 1\n$EndNodes\n"
+    "$Elements\n3\n"
+    "1 2 2 0 1 1 2 3\n"
+    "2 4 2 7 1 1 2 3 4\n"
+    "3 4 2 8 2 2 3 4 5\n$EndElements\n";
+
 typedef struct bytes {
     unsigned char d[4096];
     size_t n;
@@ -172,6 +182,28 @@ static void binary_seed(bytes *b)
     b_str(b, "\n$EndNodeData\n");
 }
 
+/* ascii22_seed in binary: int32 records after text count lines. */
+static void binary22_seed(bytes *b)
+{
+    static const double x[15] = {0, 0, 0, 1, 0, 0, 0, 1, 0,
+                                 0, 0, 1, 1, 1, 1};
+    b->n = 0;
+    b_str(b, "$MeshFormat\n2.2 1 8\n");
+    b_int(b, 1);
+    b_str(b, "\n$EndMeshFormat\n$Nodes\n5\n");
+    for (int i = 0; i < 5; i++) {
+        b_int(b, i + 1);
+        b_raw(b, x + 3 * i, 24);
+    }
+    b_str(b, "\n$EndNodes\n$Elements\n3\n");
+    static const int32_t tri[] = {2, 1, 2, 1, 0, 1, 1, 2, 3};
+    static const int32_t tets[] = {4, 2, 2, 2, 7, 1, 1, 2, 3, 4,
+                                   3, 8, 2, 2, 3, 4, 5};
+    b_raw(b, tri, sizeof tri);
+    b_raw(b, tets, sizeof tets);
+    b_str(b, "\n$EndElements\n");
+}
+
 static getme_io_status open_file(getme_doc **doc, const char *name,
                                  int nfix, const char *const *fix)
 {
@@ -184,8 +216,9 @@ static getme_io_status open_file(getme_doc **doc, const char *name,
 
 /* ---- good files --------------------------------------------------------- */
 
+/* moved: the ASCII line node 5 gets ("x y z" in 4.1, "tag x y z" in 2.2) */
 static void check_seed(const char *name, const void *data, size_t n,
-                       int binary)
+                       int binary, const char *moved)
 {
     put_file(name, data, n);
     getme_doc *doc;
@@ -221,9 +254,9 @@ static void check_seed(const char *name, const void *data, size_t n,
             diff += ((const char *)data)[i] != out[i];
         CHECK(diff > 0 && diff <= 16);
     } else {
-        CHECK(strstr(out, "\n0.9 1 0.3333333333333333\n") != NULL);
+        CHECK(strstr(out, moved) != NULL);
         const char *tail = strstr(out, "$EndNodes");
-        CHECK(tail && strcmp(tail, strstr(ascii_seed, "$EndNodes")) == 0);
+        CHECK(tail && strcmp(tail, strstr((const char *)data, "$EndNodes")) == 0);
     }
     /* the output reads back with the new coordinates */
     CHECK_EQ_INT(open_file(&doc, "out.msh", 0, NULL), GETME_IO_OK);
@@ -388,13 +421,21 @@ static size_t mutate(char *buf, size_t n, size_t cap)
     return n;
 }
 
-static void fuzz(const bytes *bin, int iters)
+static void fuzz(const bytes *bin, const bytes *bin22, int iters)
 {
     static char buf[8192];
     int opened = 0, failed = 0;
     for (int it = 0; it < iters; it++) {
-        size_t n = it & 1 ? bin->n : strlen(ascii_seed);
-        memcpy(buf, it & 1 ? (const char *)bin->d : ascii_seed, n);
+        /* MSH 4.1 ASCII, 4.1 binary, 2.2 ASCII, 2.2 binary in turn */
+        const char *seed = it % 4 == 0   ? ascii_seed
+                           : it % 4 == 1 ? (const char *)bin->d
+                           : it % 4 == 2 ? ascii22_seed
+                                         : (const char *)bin22->d;
+        size_t n = it % 4 == 0   ? strlen(ascii_seed)
+                   : it % 4 == 1 ? bin->n
+                   : it % 4 == 2 ? strlen(ascii22_seed)
+                                 : bin22->n;
+        memcpy(buf, seed, n);
         n = mutate(buf, n, sizeof buf);
         put_file("fuzz.msh", buf, n);
         const char *fix[] = {it % 3 ? "a" : "3:8"};
@@ -428,14 +469,20 @@ int main(int argc, char **argv)
     snprintf(dir, sizeof dir, "msh41_test.%ld", (long)getpid());
     if (!mkdtemp(strcpy(dir, "/tmp/msh41_test.XXXXXX")))
         return 1;
-    static bytes bin;
+    static bytes bin, bin22;
     binary_seed(&bin);
-    check_seed("seed-ascii.msh", ascii_seed, strlen(ascii_seed), 0);
-    check_seed("seed-bin.msh", bin.d, bin.n, 1);
+    binary22_seed(&bin22);
+    static const char moved41[] = "\n0.9 1 0.3333333333333333\n";
+    static const char moved22[] = "\n5 0.9 1 0.3333333333333333\n";
+    check_seed("seed-ascii.msh", ascii_seed, strlen(ascii_seed), 0, moved41);
+    check_seed("seed-bin.msh", bin.d, bin.n, 1, NULL);
+    check_seed("seed-22a.msh", ascii22_seed, strlen(ascii22_seed), 0, moved22);
+    check_seed("seed-22b.msh", bin22.d, bin22.n, 1, NULL);
     check_errors(&bin);
-    fuzz(&bin, iters);
+    fuzz(&bin, &bin22, iters);
     static const char *const names[] = {
-        "seed-ascii.msh", "seed-bin.msh", "out.msh", "cut.msh", "cutb.msh",
+        "seed-ascii.msh", "seed-bin.msh", "seed-22a.msh", "seed-22b.msh",
+        "out.msh", "cut.msh", "cutb.msh",
         "fmt.msh", "missing.msh", "order2.msh", "fix.msh", "size4.msh",
         "param.msh", "fuzz.msh", "fuzz-out.msh"};
     for (size_t i = 0; i < sizeof names / sizeof *names; i++)

@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """
-test_msh_native.py GETME WORKDIR -- the native MSH 4.1 reader/writer
-against the Gmsh path (GETME_MSH_READER=gmsh) on Gmsh-generated meshes.
+test_msh_native.py GETME WORKDIR -- the native MSH 4.1 and 2.2
+reader/writer against the Gmsh path (GETME_MSH_READER=gmsh) on
+Gmsh-generated meshes.
 
 For each mesh (ASCII and binary): `getme smooth` once per reader; the two
 outputs must hold the same coordinates per node tag (bit for bit) and the
@@ -45,8 +46,8 @@ def start(name):
     gmsh.model.add(name)
 
 
-def write(name, binary):
-    gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+def write(name, binary, version=4.1):
+    gmsh.option.setNumber("Mesh.MshFileVersion", version)
     gmsh.option.setNumber("Mesh.Binary", 1 if binary else 0)
     gmsh.write(path(name))
 
@@ -274,7 +275,10 @@ def compare(name, top, extra=()):
                                                 logs["native"]))
     g, n = load(outs["gmsh"]), load(outs["native"])
     check(np.array_equal(g[0], n[0]), name + ": node tags differ")
-    if b"\n4.1 1 8\n" in open(src, "rb").read(40):
+    head = open(src, "rb").read(40)
+    # exact: binary 4.1, and MSH 2.2 (the Gmsh path patches $Nodes with
+    # %.17g)
+    if b"\n4.1 1 8\n" in head or b"\n2.2 " in head:
         check(g[1].tobytes() == n[1].tobytes(), name + ": coordinates differ")
     else:  # Gmsh's ASCII writer prints %.16g, which may not round-trip
         n16 = np.array([float("%.16g" % v) for v in n[1].ravel()])
@@ -292,7 +296,7 @@ def compare(name, top, extra=()):
     data_in, data_out = open(src, "rb").read(), open(outs["native"], "rb").read()
     check(split_nodes(data_in) == split_nodes(data_out),
           name + ": native output differs outside $Nodes")
-    if b"\n4.1 1 8\n" in data_in[:40]:
+    if b"\n4.1 1 8\n" in data_in[:40] or b"\n2.2 1 8\n" in data_in[:40]:
         check(len(data_in) == len(data_out), name + ": binary size changed")
     i = load(src)
     fixed = lower_dim_nodes(src, top)
@@ -372,14 +376,26 @@ def errors():
         check(rc == 2, "unknown --fix: exit %d (%s)" % (rc, reader))
         msgs.append([l for l in log.splitlines() if l.startswith("Error")])
     check(msgs[0] == msgs[1], "unknown --fix messages differ: %s" % msgs)
-    # forced native on a file it declines
+    # forced native on a file it declines (MSH 4.0 goes to Gmsh)
     gmsh.clear()
     gmsh.open(path("two-ascii.msh"))
-    gmsh.option.setNumber("Mesh.MshFileVersion", 2.2)
+    gmsh.option.setNumber("Mesh.MshFileVersion", 4.0)
     gmsh.option.setNumber("Mesh.Binary", 0)
-    gmsh.write(path("v22.msh"))
-    expect_error("v22.msh", 5, [r"native"])
-    check(run(["quality", path("v22.msh")])[0] == 0, "MSH 2.2 fallback")
+    gmsh.write(path("v40.msh"))
+    expect_error("v40.msh", 5, [r"native"])
+    check(run(["quality", path("v40.msh")])[0] == 0, "MSH 4.0 fallback")
+    # MSH 2.2 read natively: damage named with file and line / byte
+    corrupt("two-22a.msh", "trunc-22a.msh",
+            lambda d: d[:d.index(b"$Elements") + 3000])
+    expect_error("trunc-22a.msh", 4, [r"line \d+", r"end of file"])
+    corrupt("two-22b.msh", "trunc-22b.msh", lambda d: d[:len(d) - 100])
+    expect_error("trunc-22b.msh", 4, [r"byte \d+", r"end of file"])
+    corrupt("two-22a.msh", "nonode-22a.msh",
+            lambda d: d.replace(b"\n$Elements\n", b"\n$Elements\n", 1)[
+                :d.index(b"\n", d.index(b"$Elements") + 11) + 1] +
+            b"1 4 2 0 1 1 2 3 99999999\n" +
+            d[d.index(b"\n", d.index(b"\n", d.index(b"$Elements") + 11) + 1) + 1:])
+    expect_error("nonode-22a.msh", 4, [r"line \d+", r"node 99999999"])
 
 
 def main():
@@ -393,6 +409,8 @@ def main():
         gen()
         write(name + "-ascii.msh", False)
         write(name + "-bin.msh", True)
+        write(name + "-22a.msh", False, 2.2)
+        write(name + "-22b.msh", True, 2.2)
     second_order()
     write("order2.msh", False)
     gmsh.clear()
@@ -404,7 +422,7 @@ def main():
     corrupt("partial-ascii.msh", "nodedata-ascii.msh", lambda d: d)
     add_node_data("nodedata-ascii.msh")
     for name, _, top in cases:
-        for flavour in ("ascii", "bin"):
+        for flavour in ("ascii", "bin", "22a", "22b"):
             compare("%s-%s.msh" % (name, flavour), top)
     compare("sparse-ascii.msh", 3)
     compare("sparse-bin.msh", 3)
@@ -412,6 +430,8 @@ def main():
     compare("two-bin.msh", 3, ["--fix", "left"])
     compare("two-ascii.msh", 3, ["--fix", "3:12", "--free-interfaces"])
     compare("partial-bin.msh", 3, ["--fix", "third"])
+    compare("two-22b.msh", 3, ["--fix", "left"])
+    compare("two-22a.msh", 3, ["--fix", "3:12", "--free-interfaces"])
     errors()
     gmsh.finalize()
     print("test_msh_native: %d failures" % len(FAILED))

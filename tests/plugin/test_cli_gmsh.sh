@@ -8,25 +8,47 @@ PY=$2
 fail=0
 ok() { echo "ok: $*"; }
 bad() { echo "FAILED: $*"; fail=1; }
-cat > part.geo <<'GEO'
-SetFactory("OpenCASCADE");
-Box(1) = {0, 0, 0, 2, 1, 1};
-Cylinder(2) = {1, 0.5, -0.2, 0, 0, 1.4, 0.3};
-BooleanFragments{ Volume{1}; Delete; }{ Volume{2}; Delete; }
-Physical Volume("matrix") = {3};
-Physical Volume("insert") = {2};
-Physical Surface("clamp") = {1};
-GEO
+here=$(cd "$(dirname "$0")" && pwd)
+cp "$here/../../examples/part.geo" part.geo
 rm -f part.msh part22.msh
-"$G" gmsh part.geo -3 -clmax 0.15 --fix clamp -o part.msh > run.log 2>&1
+"$G" gmsh part.geo -3 -clmax 0.15 --fix clamp -o part.msh -v > run.log 2>&1
 rc=$?
 [ $rc -eq 0 ] && ok "exit 0" || bad "exit $rc"
-grep -q "^Info    : Optimizing mesh (GETMe adaptive)..." run.log && ok "start line" || bad "no start line"
+grep -q "^Info    : Optimizing mesh (GETMe adaptive, [0-9]* threads*)...$" run.log && ok "start line" || bad "no start line"
 grep -q "^Info    : 0.90 < quality < 1.00 : " run.log && ok "histogram" || bad "no histogram"
-grep -q "^Info    : Measures after (tet): dihedral .* deg, scaled Jacobian min .*, gamma min .*, SICN min " run.log \
+grep -q "^Info    : Measures after  *(tet): dihedral .* deg, scaled Jacobian min .*, gamma min .*, SICN min " run.log \
   && ok "measures line" || bad "no measures line"
 grep -q "^Info    : Done optimizing mesh (Wall " run.log && ok "done line" || bad "no done line"
 grep -q "^Info    : Done meshing 3D" run.log && ok "Gmsh's own meshing lines" || bad "no Gmsh lines"
+# the same log lines as getme smooth (one parser, one progress callback)
+"$G" smooth part.msh -o part-again.msh --fix clamp -v > smooth.log 2>&1
+for pat in "^Info    : Quality before: q\*min [0-9.]*, qmin" "^Info    : It    1 (qmean stage): q\*min" \
+           "^Info    : It  *[0-9]* (q\*min stage, cycle 1, q_t" "^Info    : Quality after : q\*min" \
+           "^Info    : Measures before (tet): dihedral" "^Info    : Measures after  (tet): dihedral"; do
+  grep -q "$pat" run.log && grep -q "$pat" smooth.log && ok "both log '$pat'" || bad "log line '$pat'"
+done
+grep -q "getme-tmp" run.log && bad "the temporary file's name in the log" || ok "no temporary name in the log"
+# smooth options: --param, --report, --method, --threads, --free-interfaces
+rm -f opts.json part-opts.msh
+"$G" gmsh part.msh -q -o part-opts.msh --param sigma=1.3 --param threshold_fraction=0.01 \
+  --report opts.json --threads 1 --method getme --free-interfaces; rc=$?
+[ $rc -eq 0 ] && "$PY" -c "
+import json; r = json.load(open('opts.json'))
+assert r['params']['sigma'] == 1.3 and r['params']['threshold_fraction'] == 0.01, r['params']
+assert r['params']['num_threads'] == 1 and r['elements']['tet'] > 100, r
+assert len(r['history']) == r['iterations']['total'] + r['iterations']['finish_passes'] > 0
+" && ok "gmsh --param/--report" || bad "gmsh --param/--report ($rc)"
+"$G" gmsh part.msh -q -o x.msh --param nonsense=1; rc=$?
+[ $rc -eq 2 ] && ok "gmsh bad --param: 2" || bad "gmsh bad --param: $rc"
+"$G" gmsh part.msh -q -o x.msh --free nope 2> err.log; rc=$?
+[ $rc -eq 2 ] && grep -q "Unknown physical group 'nope' to free" err.log && ok "gmsh unknown --free: 2" || bad "gmsh --free: $rc"
+"$G" gmsh part.msh -q -o x.msh --report part.msh; rc=$?
+[ $rc -eq 2 ] && ok "gmsh --report = input refused" || bad "gmsh --report input: $rc"
+# -o .inp: *Heading names the output, not the temporary file
+rm -f part.inp
+"$G" gmsh part.msh -q -o part.inp; rc=$?
+[ $rc -eq 0 ] && [ "$(sed -n 2p part.inp)" = " part.inp" ] && ok "*Heading names part.inp" || bad "*Heading: $(sed -n 2p part.inp) ($rc)"
+ls -a | grep -q getme-tmp && bad "temporary files left" || ok "no temporary files left"
 head -2 part.msh | grep -q "^4.1 0 8" && ok "MSH 4.1" || bad "not MSH 4.1"
 "$G" gmsh part.msh -q -format msh22 -bin -o part22.msh; rc=$?
 [ $rc -eq 0 ] && head -2 part22.msh | grep -q "^2.2 1 8" && ok "msh input -> MSH 2.2 binary" || bad "msh22 ($rc)"
@@ -55,7 +77,7 @@ gmsh.model.mesh.setNode(int(t[len(t) // 2]), (x.reshape(-1, 3)[len(t) // 2] + [0
 gmsh.write("tangled.msh")
 PYEOF
 "$G" gmsh tangled.msh -o untangled.msh > tangled.log 2>&1; rc=$?
-[ $rc -eq 0 ] && grep -q "^Warning : [0-9]* invalid (inverted or degenerate) elements, 0 remain after untangling" tangled.log \
+[ $rc -eq 0 ] && grep -q "^Warning : [0-9]* invalid (inverted or degenerate) elements* in the input, 0 remain after untangling" tangled.log \
   && ok "tangled input untangled: 0" || bad "tangled input: $rc"
 "$G" gmsh tangled.msh -q --no-untangle -o refused.msh 2> err.log; rc=$?
 [ $rc -eq 6 ] && [ ! -e refused.msh ] && ok "--no-untangle: 6" || bad "--no-untangle: $rc"
@@ -66,7 +88,6 @@ PYEOF
 "$G" gmsh part.geo --bogus 2> err.log; rc=$?; [ $rc -eq 2 ] && grep -q "unknown option" err.log && ok "bad option: 2" || bad "bad option: $rc"
 # getme.geo: the stock gmsh runs `getme gmsh` from the .geo and loads the
 # smoothed mesh (what the GUI does when "Smooth the mesh" is ticked).
-here=$(cd "$(dirname "$0")" && pwd)
 rm -f getme_raw.msh getme_smoothed.msh
 cp "$here/../../examples/gmsh_gui/plate.geo" plate.geo
 printf 'getme_dim = 2;\ngetme_dir = CurrentDirectory;\nInclude "%s";\n' \

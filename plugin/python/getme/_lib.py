@@ -177,3 +177,9 @@ def parameters():
                     "default": p.default_value, "min": p.min, "max": p.max,
                     "open_min": bool(p.open_min), "help": p.help.decode()})
     return out
+
+
+def defaults():
+    """{name: default} of libgetme's parameter table (getme_params_init's
+    values): what every entry point (CLI, Python, GUI) starts from."""
+    return {p["name"]: p["default"] for p in parameters()}

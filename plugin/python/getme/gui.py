@@ -76,23 +76,54 @@ def number(name, default=None):
     return v[0] if v else default
 
 
+RESULT_ROWS = ["q*min before", "q*min after", "q_mean before",
+               "q_mean after", "Iterations", "Finishing passes", "Nodes moved",
+               "Worst element tag", "Worst element quality",
+               "Worst element free nodes"]
+
+
+def clear_result():
+    """Remove the rows of the last run (and its error), so that the panel
+    never shows results of an earlier mesh after a failed run."""
+    for i, label in enumerate(RESULT_ROWS):
+        gmsh.onelab.clear(P + "Result/%d%s" % (i, label))
+    gmsh.onelab.clear(P + "Result/Error")
+
+
+def log_error(message):
+    """Gmsh's Python API raises after logging at level "error" (it reports
+    the last error of the call): log it and carry on, the GUI stays up."""
+    try:
+        gmsh.logger.write(message, "error")
+    except Exception:  # noqa: BLE001 -- the message is logged already
+        pass
+
+
+def show_error(message):
+    clear_result()
+    gmsh.onelab.set(json.dumps([
+        {"type": "string", "name": P + "Result/Error", "values": [message],
+         "readOnly": True}]))
+
+
 def show_result(res):
-    rows = [("q*min before", res["q_min_star_before"]),
-            ("q*min after", res["q_min_star_after"]),
-            ("q_mean before", res["q_mean_before"]),
-            ("q_mean after", res["q_mean_after"]),
-            ("Iterations", res["iterations"]),
-            ("Finishing passes", res["passes_finish"]),
-            ("Nodes moved", res["num_moved"])]
+    clear_result()
+    values = {"q*min before": res["q_min_star_before"],
+              "q*min after": res["q_min_star_after"],
+              "q_mean before": res["q_mean_before"],
+              "q_mean after": res["q_mean_after"],
+              "Iterations": res["iterations"],
+              "Finishing passes": res["passes_finish"],
+              "Nodes moved": res["num_moved"]}
     if res["worst"]:
         w = res["worst"][0]
-        rows.append(("Worst element tag", w["tag"]))
-        rows.append(("Worst element quality", w["quality"]))
-        rows.append(("Worst element free nodes", w["num_free"]))
+        values.update({"Worst element tag": w["tag"],
+                       "Worst element quality": w["quality"],
+                       "Worst element free nodes": w["num_free"]})
     gmsh.onelab.set(json.dumps([
         {"type": "number", "name": P + "Result/%d%s" % (i, label),
-         "values": [float(v)], "readOnly": True}
-        for i, (label, v) in enumerate(rows)]))
+         "values": [float(values[label])], "readOnly": True}
+        for i, label in enumerate(RESULT_ROWS) if label in values]))
 
 
 def redraw():
@@ -122,7 +153,8 @@ def smooth():
                           topology=int(number("7Gmsh swaps first", 0)))
         show_result(res)
     except GetmeError as e:
-        gmsh.logger.write("GETMe: %s" % e, "error")
+        show_error(str(e))
+        log_error("GETMe: %s" % e)
     redraw()
 
 
@@ -137,7 +169,7 @@ def distort_if_asked():
         gmsh.logger.write("Distorted the mesh for the demo (%d nodes moved)"
                           % n, "info")
     except GetmeError as e:
-        gmsh.logger.write("GETMe: %s" % e, "error")
+        log_error("GETMe: %s" % e)
     redraw()
 
 
