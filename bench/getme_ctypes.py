@@ -1,6 +1,9 @@
 #!/usr/bin/python3
-"""A stand-in for the `getme` CLI that drives libgetme through ctypes, for
-when the CLI cannot read the benchmark's files (no MSH adapter yet).
+"""A stand-in for the `getme` CLI that drives libgetme through ctypes.
+bench.py runs it instead of the CLI only when told to (`--getme-runner
+ctypes`) or when the CLI at hand cannot read .msh files (`--getme-runner
+auto` and `getme formats` lists no msh; today's CLI always can).
+bench/untangle.py borrows its Params and Result structures.
 
   getme_ctypes.py --lib libgetme.so smooth IN -o OUT [--method getme|laplace]
                   [--threads N] [--report R.json] [--param NAME=VALUE ...]
@@ -8,11 +11,12 @@ when the CLI cannot read the benchmark's files (no MSH adapter yet).
   getme_ctypes.py --lib libgetme.so quality IN
 
 Same library calls and the same --report JSON keys as the CLI (the subset
-bench.py reads).  Fixed nodes are
-the skin and region interfaces (getme_mesh_fix_boundary), regions being the
-Gmsh physical tags -- what the CLI does for these meshes.  Output: the input
-file rewritten through the Gmsh API with only node coordinates changed.  Used only by the
-benchmark; smoothing time is getme_smooth() alone, as in the CLI.
+bench.py reads).  Fixed nodes are the skin and region interfaces
+(getme_mesh_fix_boundary), regions being the Gmsh physical tags -- what the
+CLI fixes on the benchmark's meshes.  Output: the input opened with the Gmsh
+API, moved nodes set, written as binary MSH (entities, classification and
+tags unchanged).  Used only by the benchmark; smoothing time is
+getme_smooth() alone, as in the CLI.
 """
 
 import argparse

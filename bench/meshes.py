@@ -1,6 +1,6 @@
 """The benchmark's meshes, generated reproducibly with the Gmsh Python API.
 
-Cases (DESIGN.md section 6 and the paper's Sec. 3):
+Cases (docs/design.md §9 and the paper's Sec. 3):
   tet    Delaunay tets of a piston-like OpenCASCADE part: crown with a
          combustion bowl, three ring grooves, a hollow skirt with relief
          windows, pin bosses with a through pin hole, oil drain holes.

@@ -1,6 +1,6 @@
 """Mean ratio quality of mesh elements, vectorised in numpy.
 
-An independent implementation of the definitions in DESIGN.md section 2 (the
+An independent implementation of the definitions in docs/design.md §1 (the
 same ones libgetme uses), so that the benchmark judges every method's output
 -- ours, Gmsh's, Netgen's -- with one yardstick that shares no code with the
 core.  Node order is Gmsh's for every type.

@@ -2,7 +2,7 @@
 
 A node is fixed when it lies on the mesh skin (a face -- an edge in 2-D --
 with one incident element), on a face between elements of different regions
-(DESIGN.md section 5), or is used by no element.  Every other node is free;
+(docs/design.md §5), or is used by no element.  Every other node is free;
 q*_min is the minimum quality over elements with at least one free node.
 Computed here from connectivity alone so that outputs of other tools, whose
 files carry no classification we trust, are judged the same way.

@@ -5,8 +5,8 @@
  *
  * CGNS numbers the nodes of TETRA_4, PYRA_5, PENTA_6, HEXA_8, TRI_3 and
  * QUAD_4 exactly as getme (and Gmsh) do, so connectivity is copied as is
- * (tests/cgns/test_cgns_orientation.py proves it on files written by
- * other tools).
+ * (docs/design.md §1; tests/cgns/test_cgns_interop.py checks it for the
+ * volume types on a file converted by the CGNS project's aflr3_to_cgns).
  */
 #include "cgns_internal.h"
 

@@ -15,7 +15,7 @@
  * the transformed elements and the untransformed nodes of the other
  * elements around I_T; Eq. 10 relaxation keeps every element valid.
  *
- * Our choices where the paper is silent (README "Method notes"):
+ * Our choices where the paper is silent (docs/design.md §3):
  *  - N(j) in Eq. 9 contains E_j itself;
  *  - elements without a free node are never transformed (they could not
  *    move anything);

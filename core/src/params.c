@@ -17,7 +17,8 @@
      191k tets   0.409 / 0.397 / 0.388 / 0.386 / 0.334
      94k hexes   0.853 / 0.854 / 0.839 / 0.829 / 0.830
    0.005 is best on the larger meshes and close to best on the small ones;
-   larger fractions are clearly worse (as DESIGN's prototype found). */
+   larger fractions are clearly worse (as the early prototype found,
+   docs/design.md §3). */
 #define DEFAULT_THRESHOLD_FRACTION 0.005
 
 /* The one table of the numeric parameters: name, kind, default, range and

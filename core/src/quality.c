@@ -1,7 +1,7 @@
 /*
  * quality.c -- element type tables and the mean ratio quality kernels.
  *
- * Mean ratio (paper Eq. 3-5, DESIGN.md section 2): every node simplex k of
+ * Mean ratio (paper Eq. 3-5, docs/design.md §1): every node simplex k of
  * an element has the matrix D_k of its three spanning edges; with the target
  * matrix W of the type (columns: the same edges in the regular element),
  * S_k = D_k W^-1 and
@@ -234,7 +234,7 @@ double getme__quality_prism(const double *x)
  * edge to the apex of the pyramid with all edges 1); W^-1 gives the columns
  * e1, e2, sqrt2 (e3 - (e1 + e2)/2) and det S = sqrt2 det D.  The apex itself
  * has no simplex of its own (its four edges do not span a simplex), as in
- * DESIGN.md: the four base corners see every edge of the pyramid.
+ * docs/design.md §1: the four base corners see every edge of the pyramid.
  */
 static inline double pyramid_corner(const double *x, int a, int b, int c,
                                     double *det)

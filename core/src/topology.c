@@ -1,5 +1,5 @@
 /*
- * topology.c -- which nodes are fixed by default (DESIGN.md §5): nodes on
+ * topology.c -- which nodes are fixed by default (docs/design.md §5): nodes on
  * the skin (faces of volume elements, edges of planar elements, with one
  * incident element) and on interfaces between regions; nodes used by no
  * element.

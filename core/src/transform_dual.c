@@ -1,6 +1,6 @@
 /*
  * transform_dual.c -- the dual element transformation of hexahedra, prisms
- * and pyramids (paper ref. [28, 32]; DESIGN.md section 3), with the
+ * and pyramids (paper ref. [28, 32]; docs/design.md §2), with the
  * per-type calibration that makes prisms and pyramids converge to their
  * regular element (docs/kernels.md explains and measures it).
  *

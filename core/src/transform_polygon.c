@@ -1,6 +1,6 @@
 /*
  * transform_polygon.c -- the GETMe polygon transformation for planar
- * triangles and quads (GETMe book, Def. 5.1; DESIGN.md section 3).
+ * triangles and quads (GETMe book, Def. 5.1; docs/design.md §2).
  *
  * With lambda in (0,1), theta in (0, pi/2), c1 = (1 - lambda) tan theta,
  * c2 = lambda (1 - lambda) - c1^2, c3 = 1 - 2 c2 and R(v) = (v_y, -v_x)

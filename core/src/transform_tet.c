@@ -1,6 +1,6 @@
 /*
  * transform_tet.c -- the opposite face normals transformation of a
- * tetrahedron (Vartziotis et al., paper ref. [26]; DESIGN.md section 3).
+ * tetrahedron (Vartziotis et al., paper ref. [26]; docs/design.md §2).
  *
  * Every node is pushed along the normal of the face opposite to it:
  *

@@ -2,11 +2,11 @@
  * workspace.h -- the smoother's working copy of a mesh.
  *
  * getme_smooth() does not iterate over the caller's arrays directly.  It
- * builds a workspace with
- *  - elements grouped by type and, inside a type, sorted along a Morton
- *    curve of their centroids, and nodes numbered in first-touch order of
- *    that element order, so neighbouring elements and nodes are close in
- *    memory (renumber = 1);
+ * builds a workspace (docs/design.md §6, §7) with
+ *  - elements grouped by type and, inside a type, sorted by the Morton key
+ *    (10 bits per axis in the bounding box) of their first node, and nodes
+ *    numbered in first-touch order of that element order, so neighbouring
+ *    elements and nodes are close in memory (renumber = 1);
  *  - a node -> element CSR ("stars"), each star sorted by element index;
  *  - blocks of consecutive elements, coloured so that no two blocks of one
  *    colour share a node.  Scattering element contributions block by block,

@@ -1,6 +1,6 @@
 /*
  * worst.c -- getme_mesh_worst_elements(): the worst elements of a mesh and
- * why each one cannot get better by moving nodes (README "Method notes").
+ * why each one cannot get better by moving nodes (docs/method.md §5).
  *
  * The reasons, tested in this order:
  *  - every node fixed, at least one of them only because it lies on a

@@ -23,7 +23,7 @@
  * there and rotated back; surfaces that are not planar, or selected surfaces
  * that do not lie in one common plane, are refused.
  *
- * Which nodes move (DESIGN.md section 5): only nodes classified on the
+ * Which nodes move (docs/design.md §5): only nodes classified on the
  * smoothed entities themselves.  Nodes classified on entities of lower
  * dimension (geometric boundaries, interfaces, embedded points, curves and
  * surfaces) are fixed, so are the nodes of the physical groups named in the

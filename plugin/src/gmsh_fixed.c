@@ -1,7 +1,7 @@
 /*
  * gmsh_fixed.c -- which nodes of a Gmsh model must not move.
  *
- * DESIGN.md section 5 for Gmsh models: a node may move only if it is
+ * docs/design.md §5 for Gmsh models: a node may move only if it is
  * classified on one of the entities being smoothed.  Nodes classified on
  * lower-dimensional entities (bounding surfaces, interfaces between
  * volumes, curves, points, embedded entities) carry the geometry and stay

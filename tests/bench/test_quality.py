@@ -6,8 +6,8 @@
 The benchmark judges every tool's output with these numpy functions, so they
 must be right on their own: exact 1 on regular elements, invariant under
 translation, rotation and uniform scaling, 0 on inverted elements, the
-triangle/quad formulas equal to the general polygon mean ratio (DESIGN.md
-section 3), and -- with --lib -- equal to libgetme's getme_element_quality()
+triangle/quad formulas equal to the general polygon mean ratio (docs/design.md
+§1), and -- with --lib -- equal to libgetme's getme_element_quality()
 on random elements of every type (two independent implementations of one
 definition).
 """
@@ -65,7 +65,7 @@ def rotation(rng, planar):
 
 
 def polygon_mean_ratio(xy):
-    """DESIGN.md section 3: q = (2/n) sum delta_k / phi_k."""
+    """docs/design.md §1: q = (2/n) sum delta_k / phi_k."""
     n = len(xy)
     alpha, beta = 1 - np.cos(2 * np.pi / n), np.sin(2 * np.pi / n)
     total = 0.0

@@ -30,8 +30,8 @@ T = Checks(GETME)
 check, run = T.check, T.run
 
 
-# ---- independent mean ratio: bench/quality.py (numpy, DESIGN.md §2, written
-# apart from libgetme and checked against it by the bench_quality test) -----
+# ---- independent mean ratio: bench/quality.py (numpy, docs/design.md §1, -----
+# written apart from libgetme and checked against it by the bench_quality test)
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "bench"))
 from quality import element_quality  # noqa: E402
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))

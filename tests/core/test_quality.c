@@ -4,8 +4,8 @@
  * Expected values never come from the library's own formula: they are hand
  * computed, or come from a different closed form (edge lengths for tets,
  * the affine image of the regular element, the polygon mean ratio of
- * DESIGN.md for planar types).  So a wrong W^-1, a wrong node simplex or a
- * wrong validity test each fail something here.
+ * docs/design.md §1 for planar types).  So a wrong W^-1, a wrong node
+ * simplex or a wrong validity test each fail something here.
  */
 #include "check.h"
 
@@ -242,8 +242,9 @@ static void test_prism_pyramid_heights(void)
     }
 }
 
-/* DESIGN.md's polygon mean ratio: corner k with e1 = x_{k+1} - x_k,
-   e2 = x_{k-1} - x_k, alpha = 1 - cos(2pi/n), beta = sin(2pi/n):
+/* The polygon mean ratio (docs/design.md §1): corner k with
+   e1 = x_{k+1} - x_k, e2 = x_{k-1} - x_k, alpha = 1 - cos(2pi/n),
+   beta = sin(2pi/n):
    delta = (e1 x e2) / (2 alpha beta), phi = |e1 - e2|^2 / (4 beta^2) +
    |e1 + e2|^2 / (4 alpha^2), q = (2/n) sum delta/phi. */
 static double polygon_mean_ratio(const double *x, int n)
