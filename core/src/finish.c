@@ -145,7 +145,6 @@ getme_status getme__finish(getme_run *run)
     p.x = ws->x;
     p.guard = run->guard;
     p.floor = run->corner_floor;
-    p.loss = GETME_PATCH_LOSS;
     double q_mean, q_min;
     getme__ws_summary(ws, run->q, &q_mean, &q_min, NULL);
     getme_status st = GETME_OK;
@@ -157,11 +156,16 @@ getme_status getme__finish(getme_run *run)
             st = GETME_ERR_NOMEM;
             break;
         }
-        for (int32_t i = 0; i < n && st == GETME_OK; i++) {
-            int r = 0;
-            if (run->q[list[i].e] <= bound)
-                st = improve(run, &p, list[i].e, &r);
-            raised += r;
+        /* Two sweeps: the first takes only moves that lose no total
+           quality (and so earns budget), the second may spend it. */
+        for (int sweep = 0; sweep < 2; sweep++) {
+            p.loss = sweep ? GETME_PATCH_LOSS : 0.0;
+            for (int32_t i = 0; i < n && st == GETME_OK; i++) {
+                int r = 0;
+                if (run->q[list[i].e] <= bound)
+                    st = improve(run, &p, list[i].e, &r);
+                raised += r;
+            }
         }
         free(list);
         if (st != GETME_OK)

@@ -36,7 +36,11 @@ typedef struct getme_patch {
                         not end below min(its old value, floor)           */
     double floor;
     double loss;     /* a move may lower the patch's total quality by at
-                        most loss times the rise of its minimum            */
+                        most loss times the rise of its minimum ...        */
+    double budget;   /* ... and by at most this: the total quality that
+                        kept moves gained so far, less what they spent (0
+                        at the start: q_mean never ends lower)            */
+    double change;   /* scratch: the last trial's change of the total    */
     /* the elements (filled by the caller with getme__patch_add) */
     int32_t n, cap;
     int8_t *type;

@@ -76,6 +76,8 @@ def check_case(case, c):
     if rows["getme-1"]["status"] == "ok" and rows["paper-1"]["status"] == "ok":
         check(rows["getme-1"]["q_min_star"] >= rows["paper-1"]["q_min_star"],
               f"{case}: q*min with the finishing step below the paper's")
+        check(rows["getme-1"]["q_mean"] >= rows["paper-1"]["q_mean"] - 1e-9,
+              f"{case}: q_mean with the finishing step below the paper's")
     for a, b in (("getme-1", "getme-2"), ("paper-1", "paper-2"), ("laplace-1", "laplace-2")):
         ra, rb = rows[a], rows[b]
         if ra["status"] == "ok" and rb["status"] == "ok":

@@ -8,7 +8,8 @@
  *  - the corner guard: with corner_floor F, every hex corner ends at or
  *    above min(its input value, F), element by element; without the guard
  *    the same run breaks that (so the check can fail);
- *  - the finishing step never ends below the paper's method alone.
+ *  - the finishing step never ends below the paper's method alone, in
+ *    q*_min or in q_mean.
  */
 #define N 6
 #include "check.h"
@@ -179,6 +180,8 @@ static void check_finish_not_worse(void)
             getme_mesh_free(m);
         }
         CHECK(r[1].q_min_star >= r[0].q_min_star);
+        /* the finishing step spends no more total quality than it gains */
+        CHECK(r[1].q_mean >= r[0].q_mean - 1e-12);
         CHECK_EQ_INT(r[1].iterations, r[0].iterations);
         CHECK(r[1].passes_finish >= 1 && r[0].passes_finish == 0);
         free_gen(&g);
