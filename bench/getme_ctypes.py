@@ -28,7 +28,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from meshdata import read_mesh  # noqa: E402
+from meshdata import read_mesh, write_points  # noqa: E402
 
 TYPES = {"tet": 0, "hex": 1, "prism": 2, "pyramid": 3, "tri": 4, "quad": 5}
 MAX_RELAX = 16
@@ -117,24 +117,10 @@ def build(lib, mesh):
 
 
 def write(lib, handle, mesh, src, path):
-    """Write src again with the new coordinates, through Gmsh (like the CLI's
-    MSH adapter): entities, classification and tags stay as they were."""
-    import gmsh
+    """Write src again with the new coordinates (meshdata.write_points)."""
     pts = np.empty_like(mesh.points)
     lib.check(lib.lib.getme_mesh_get_coords(handle, pts.ctypes.data), handle, "get_coords")
-    moved = np.flatnonzero(np.any(pts != mesh.points, axis=1))
-    gmsh.initialize(["getme_ctypes"])
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.open(src)
-        for i in moved:
-            gmsh.model.mesh.setNode(int(mesh.tags[i]), pts[i].tolist(), [])
-        gmsh.option.setNumber("Mesh.Binary", 1)
-        tmp = path + ".tmp.msh"
-        gmsh.write(tmp)
-    finally:
-        gmsh.finalize()
-    os.replace(tmp, path)
+    write_points(src, mesh, pts, path, app="getme_ctypes")
 
 
 def cmd_smooth(lib, args):

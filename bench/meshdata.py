@@ -7,6 +7,8 @@ physical tag, else elementary entity tag), block by block.
 
 from dataclasses import dataclass, field
 
+import os
+
 import numpy as np
 
 VOLUME = ("tet", "hex", "prism", "pyramid")
@@ -86,3 +88,24 @@ def read_mesh(path):
     finally:
         gmsh.finalize()
     return Mesh(points, blocks, regions, tags).merged()
+
+
+def write_points(src, mesh, points, path, app="bench"):
+    """Write src again with new coordinates through Gmsh (as the CLI's MSH
+    adapter would): the nodes whose points differ from mesh's are set, so
+    entities, classification and tags stay as they were; binary MSH,
+    through a temporary file and a rename."""
+    import gmsh
+    moved = np.flatnonzero(np.any(points != mesh.points, axis=1))
+    gmsh.initialize([app])
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.open(src)
+        for i in moved:
+            gmsh.model.mesh.setNode(int(mesh.tags[i]), points[i].tolist(), [])
+        gmsh.option.setNumber("Mesh.Binary", 1)
+        tmp = path + ".tmp.msh"
+        gmsh.write(tmp)
+    finally:
+        gmsh.finalize()
+    os.replace(tmp, path)

@@ -59,7 +59,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 
-from meshdata import Mesh, read_mesh  # noqa: E402
+from meshdata import Mesh, read_mesh, write_points  # noqa: E402
 from quality import planar_orientation  # noqa: E402
 from skin import fixed_mask  # noqa: E402
 
@@ -370,22 +370,8 @@ def run_sequential(core, mesh, args, tag="", relax_count=None, variant=None,
 
 
 def write_mesh(src, mesh, points, path):
-    """src (read as mesh) rewritten with new coordinates (through Gmsh, like
-    getme_ctypes): the nodes whose points differ from mesh's are set."""
-    import gmsh
-    moved = np.flatnonzero(np.any(points != mesh.points, axis=1))
-    gmsh.initialize(["sequential"])
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.open(src)
-        for i in moved:
-            gmsh.model.mesh.setNode(int(mesh.tags[i]), points[i].tolist(), [])
-        gmsh.option.setNumber("Mesh.Binary", 1)
-        tmp = path + ".tmp.msh"
-        gmsh.write(tmp)
-    finally:
-        gmsh.finalize()
-    os.replace(tmp, path)
+    """src (read as mesh) rewritten with new coordinates."""
+    write_points(src, mesh, points, path, app="sequential")
 
 
 def seed_free(mesh, path):

@@ -21,7 +21,6 @@ cannot raise it.  Asserted:
 import hashlib
 import json
 import os
-import subprocess
 import sys
 
 import numpy as np
@@ -30,19 +29,13 @@ GETME, WORK = sys.argv[1], sys.argv[2]
 HERE = os.path.dirname(os.path.abspath(__file__))
 DATA = os.path.join(HERE, "..", "data", "locked-ring.msh")
 sys.path.insert(0, os.path.join(HERE, "..", "..", "bench"))
+sys.path.insert(0, HERE)
+from checks import Checks  # noqa: E402
 from quality import element_quality  # noqa: E402
 
 os.makedirs(WORK, exist_ok=True)
-failures, passed = [], 0
-
-
-def check(cond, what):
-    global passed
-    if cond:
-        passed += 1
-    else:
-        failures.append(what)
-        print("FAILED:", what, flush=True)
+T = Checks(GETME)
+check = T.check
 
 
 def read_msh22(path):
@@ -67,11 +60,7 @@ def skin_nodes(tets):
 
 def smooth(name, *args):
     out, rep = os.path.join(WORK, name + ".msh"), os.path.join(WORK, name + ".json")
-    p = subprocess.run([GETME, "smooth", DATA, "-o", out, "--report", rep, *args],
-                       capture_output=True, text=True)
-    check(p.returncode == 0, f"getme smooth {' '.join(args)} exits 0")
-    if p.returncode:
-        print(p.stdout[-2000:], p.stderr[-2000:])
+    T.run("smooth", DATA, "-o", out, "--report", rep, *args)
     return out, json.load(open(rep))
 
 
@@ -113,7 +102,7 @@ check(hashlib.sha256(open(DATA, "rb").read()).hexdigest() == sha, "input untouch
 # `getme quality --worst`: on the paper's locked result the worst tet (all 4
 # nodes free) is named with its tag and reported as still improvable; the
 # finishing step is what improves it.
-q = subprocess.run([GETME, "quality", paper_out, "--worst", "2"], capture_output=True, text=True)
+q = T.run("quality", paper_out, "--worst", "2")
 lines = [ln for ln in q.stdout.splitlines() if " tet q " in ln]
 tag = paper["worst_free_elements"][0]["tag"]
 check(q.returncode == 0 and len(lines) == 4, "quality --worst 2 lists 2 + 2 elements")
@@ -123,5 +112,4 @@ check(lines and lines[0].split()[2] == str(tag) and "4/4 free: a node move can s
 print(f"locked ring: q*min {q_in[free_el].min():.4f} -> paper {paper['after']['q_min_star']:.4f}, "
       f"finishing step {rep1['after']['q_min_star']:.4f} in {len(passes)} passes; "
       f"qmean paper {paper['after']['q_mean']:.4f}, finishing {rep1['after']['q_mean']:.4f}")
-print(f"{passed} passed, {len(failures)} failed")
-sys.exit(1 if failures else 0)
+sys.exit(T.summary())
