@@ -74,9 +74,8 @@ static void store(getme_run *run, const getme_patch *p)
         run->q[p->id[i]] = p->q[i];
 }
 
-/* Work on element e; returns 1 if its quality rose. */
-static getme_status improve(getme_run *run, getme_patch *p, int32_t e,
-                            int *raised)
+/* Work on element e. */
+static getme_status improve(getme_run *run, getme_patch *p, int32_t e)
 {
     const getme_ws *ws = run->ws;
     int t = getme__ws_type(ws, e);
@@ -111,7 +110,6 @@ static getme_status improve(getme_run *run, getme_patch *p, int32_t e,
         if (moved)
             store(run, p);
     }
-    *raised = run->q[e] > q0;
     return GETME_OK;
 }
 
@@ -160,13 +158,14 @@ getme_status getme__finish(getme_run *run)
            quality (and so earns budget), the second may spend it. */
         for (int sweep = 0; sweep < 2; sweep++) {
             p.loss = sweep ? GETME_PATCH_LOSS : 0.0;
-            for (int32_t i = 0; i < n && st == GETME_OK; i++) {
-                int r = 0;
+            for (int32_t i = 0; i < n && st == GETME_OK; i++)
                 if (run->q[list[i].e] <= bound)
-                    st = improve(run, &p, list[i].e, &r);
-                raised += r;
-            }
+                    st = improve(run, &p, list[i].e);
         }
+        /* Raised over the pass, whichever sweep did it (the list keeps
+           each element's quality at the pass's start). */
+        for (int32_t i = 0; i < n; i++)
+            raised += run->q[list[i].e] > list[i].q;
         free(list);
         if (st != GETME_OK)
             break;
