@@ -37,7 +37,7 @@ static int list_formats(void)
 {
     const getme_format *const *f = getme_formats();
     for (int i = 0; f[i]; i++)
-        printf("%-6s %s\n", f[i]->name, f[i]->description);
+        printf("%-6s %s\n", getme_format_name(f[i]), getme_format_description(f[i]));
     return 0;
 }
 
@@ -86,7 +86,7 @@ int main(int argc, char **argv)
         return getme_cli_gmsh(argc - 1, argv + 1);
 #else
         cli_error("this getme was built without the Gmsh plugin");
-        return GETME_IO_ERR_UNSUPPORTED;
+        return CLI_EXIT_UNSUPPORTED;
 #endif
     }
     cli_error("unknown command '%s' (see getme --help)", cmd);

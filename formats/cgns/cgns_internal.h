@@ -16,7 +16,7 @@
 #ifndef GETME_CGNS_INTERNAL_H
 #define GETME_CGNS_INTERNAL_H
 
-#include "getme_formats.h"
+#include "adapter.h"
 
 #include <cgnslib.h>
 #include <stddef.h>

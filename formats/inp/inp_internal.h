@@ -17,7 +17,7 @@
 #ifndef GETME_INP_INTERNAL_H
 #define GETME_INP_INTERNAL_H
 
-#include "getme_formats.h"
+#include "adapter.h"
 
 #include <stddef.h>
 #include <stdint.h>

@@ -31,7 +31,7 @@ getme_status getme_gmsh_model_apply(const getme_gmsh_model *m,
             continue;
         double xyz[3];
         int ierr = 0;
-        gg_frame_to_global(&m->frame, p, xyz);
+        getme__frame_to_global(&m->frame, p, xyz);
         gmshModelMeshSetNode(m->node_tags[i], xyz, 3, NULL, 0, &ierr);
         if (ierr) {
             char err[256];

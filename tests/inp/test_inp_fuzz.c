@@ -105,12 +105,12 @@ int main(int argc, char **argv)
         put_file("fuzz.inp", buf, n);
         const char *fix[] = {"All"};
         getme_doc *doc;
-        getme_io_status st = open_deck(&doc, "fuzz.inp", (int)(it & 1),
+        getme_formats_status st = open_deck(&doc, "fuzz.inp", (int)(it & 1),
                                        (int)(it % 3 == 0), fix);
-        if (st == GETME_IO_OK) {
+        if (st == GETME_FORMATS_OK) {
             opened++;
-            getme_io_status ws = getme_doc_write(doc, tpath("fuzz-out.inp"));
-            CHECK(ws == GETME_IO_OK || getme_doc_error(doc)[0] != '\0');
+            getme_formats_status ws = getme_doc_write(doc, tpath("fuzz-out.inp"));
+            CHECK(ws == GETME_FORMATS_OK || getme_doc_error(doc)[0] != '\0');
         } else {
             failed++;
             const char *msg = getme_doc_error(doc);
