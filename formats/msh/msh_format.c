@@ -131,7 +131,6 @@ static void msh_close(getme_doc *doc)
 
 const getme_format getme__format_msh = {
     "msh",
-    "Gmsh MSH 2.2/4.1, ASCII or binary (2.2 and 4.1 read natively, others via the "
-    "Gmsh SDK)",
+    "Gmsh MSH 2.2/4.1, ASCII or binary (read natively)",
     getme__msh_probe,
     msh_open, msh_write, msh_close, ".msh", NULL};

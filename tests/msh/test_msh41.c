@@ -11,6 +11,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "check.h"
+#include "fuzz_check.h"
 
 #include "getme_formats.h"
 
@@ -441,20 +442,7 @@ static void fuzz(const bytes *bin, const bytes *bin22, int iters)
         const char *fix[] = {it % 3 ? "a" : "3:8"};
         getme_doc *doc;
         getme_formats_status st = open_file(&doc, "fuzz.msh", it % 5 == 0, fix);
-        if (st == GETME_FORMATS_OK) {
-            opened++;
-            getme_formats_status ws = getme_doc_write(doc, tpath("fuzz-out.msh"));
-            CHECK(ws == GETME_FORMATS_OK || getme_doc_error(doc)[0] != '\0');
-        } else {
-            failed++;
-            const char *msg = getme_doc_error(doc);
-            if (!msg[0])
-                fprintf(stderr, "iteration %d: status %d without message\n",
-                        it, (int)st);
-            CHECK(msg[0] != '\0');
-            CHECK(strchr(msg, '\n') == NULL);
-        }
-        getme_doc_close(doc);
+        fuzz_outcome(doc, st, tpath("fuzz-out.msh"), it, &opened, &failed);
     }
     printf("fuzz: %d inputs, %d opened and written, %d refused with a "
            "message\n",

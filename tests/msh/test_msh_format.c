@@ -11,6 +11,8 @@
 
 #include <gmshc.h>
 
+#include "gmsh_boxes.h"
+
 #include <stdlib.h>
 #include <string.h>
 
@@ -19,25 +21,7 @@ static void build_files(void)
     int ierr = 0;
     gmshInitialize(0, NULL, 0, &ierr);
     gmshOptionSetNumber("General.Terminal", 0, &ierr);
-    gmshModelAdd("src", &ierr);
-    gmshModelOccAddBox(0, 0, 0, 1, 1, 1, 1, &ierr);
-    gmshModelOccAddBox(1, 0, 0, 1, 1, 1, 2, &ierr);
-    gmshModelOccAddBox(3, 0, 0, 1, 1, 1, 3, &ierr); /* in no group */
-    int obj[2] = {3, 1}, tool[2] = {3, 2}, *o = NULL, **m = NULL;
-    size_t on = 0, *mn = NULL, mnn = 0;
-    gmshModelOccFragment(obj, 2, tool, 2, &o, &on, &m, &mn, &mnn, -1, 1, 1,
-                         &ierr);
-    for (size_t i = 0; i < mnn; i++)
-        gmshFree(m[i]);
-    gmshFree(m);
-    gmshFree(mn);
-    gmshFree(o);
-    gmshModelOccSynchronize(&ierr);
-    int v1 = 1, v2 = 2;
-    gmshModelAddPhysicalGroup(3, &v1, 1, 1, &ierr);
-    gmshModelSetPhysicalName(3, 1, "steel", &ierr);
-    gmshModelAddPhysicalGroup(3, &v2, 1, 2, &ierr);
-    gmshModelSetPhysicalName(3, 2, "alu", &ierr);
+    two_material_boxes("src", 1); /* volume 3 in no group */
     gmshOptionSetNumber("Mesh.MeshSizeMax", 0.25, &ierr);
     gmshModelMeshGenerate(3, &ierr);
     const char *names[4] = {"in22a.msh", "in22b.msh", "in41a.msh",
