@@ -276,10 +276,9 @@ getme_status getme__model_finish(getme__model_in *in, getme__model_out *out)
 
 void getme__model_out_free(getme__model_out *out)
 {
-    free(out->loc);
-    free(out->xyz);
-    free(out->fixed);
-    free(out->elem_ids);
+    void *owned[] = {out->loc, out->xyz, out->fixed, out->elem_ids};
+    for (size_t i = 0; i < sizeof owned / sizeof *owned; i++)
+        free(owned[i]);
     getme_mesh_free(out->mesh);
     memset(out, 0, sizeof *out);
 }

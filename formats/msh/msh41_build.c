@@ -49,14 +49,20 @@ typedef struct block_key {
     size_t pos;
 } block_key;
 
+/* Lexicographic order of two key triples. */
+static int cmp3(long long a0, long long a1, long long a2, long long b0,
+                long long b1, long long b2)
+{
+    return a0 != b0 ? (a0 > b0) - (a0 < b0)
+           : a1 != b1 ? (a1 > b1) - (a1 < b1)
+                      : (a2 > b2) - (a2 < b2);
+}
+
 static int cmp_key(const void *a, const void *b)
 {
     const block_key *x = a, *y = b;
-    if (x->tag != y->tag)
-        return x->tag < y->tag ? -1 : 1;
-    if (x->type != y->type)
-        return x->type < y->type ? -1 : 1;
-    return (x->pos > y->pos) - (x->pos < y->pos);
+    return cmp3(x->tag, x->type, (long long)x->pos, y->tag, y->type,
+                (long long)y->pos);
 }
 
 static getme_io_status sort_blocks(msh41_reader *r)
@@ -82,14 +88,12 @@ static getme_io_status sort_blocks(msh41_reader *r)
 
 /* ---- nodes -------------------------------------------------------------- */
 
+/* Gmsh's node order: by dimension, then tag, then file order. */
 static int cmp_nblock(const void *a, const void *b)
 {
     const msh41_nblock *x = a, *y = b;
-    if (x->dim != y->dim)
-        return x->dim < y->dim ? -1 : 1;
-    if (x->tag != y->tag)
-        return x->tag < y->tag ? -1 : 1;
-    return (x->first > y->first) - (x->first < y->first); /* file order */
+    return cmp3(x->dim, x->tag, (long long)x->first, y->dim, y->tag,
+                (long long)y->first);
 }
 
 static int smoothed_entity(const msh41_reader *r, int dim, int tag)
