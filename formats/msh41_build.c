@@ -382,6 +382,19 @@ static getme_io_status mesh_fail(msh41_reader *r, getme_status st)
                           getme_mesh_error(r->doc->mesh));
 }
 
+int msh41_ho_type(int msh_type, int dim)
+{
+    /* Gmsh's node order is getme_mesh_add_elements_ho's (docs/highorder.md) */
+    switch (dim == 3 ? msh_type : 0) {
+    case 11: return GETME_TET10;
+    case 17: return GETME_HEX20;
+    case 12: return GETME_HEX27;
+    case 18: return GETME_PRISM15;
+    case 13: return GETME_PRISM18;
+    default: return -1;
+    }
+}
+
 /* Blocks [b0, b1) of one (entity, type) become one element block. */
 static getme_io_status add_run(msh41_reader *r, size_t b0, size_t b1,
                                int32_t region_id, int32_t *first)
@@ -410,7 +423,11 @@ static getme_io_status add_run(msh41_reader *r, size_t b0, size_t b1,
         GETME_TET, GETME_TET, GETME_TRI, GETME_QUAD,
         GETME_TET, GETME_HEX, GETME_PRISM, GETME_PYRAMID};
     getme_status gs = GETME_OK;
-    if (st == GETME_IO_OK)
+    int ho = msh41_ho_type(b->type, r->top_dim);
+    if (st == GETME_IO_OK && ho >= 0)
+        gs = getme_mesh_add_elements_ho(r->doc->mesh, (getme_ho_type)ho,
+                                        (int32_t)count, conn, region);
+    else if (st == GETME_IO_OK)
         gs = getme_mesh_add_elements(r->doc->mesh, by_msh[b->type & 7],
                                      (int32_t)count, conn, region);
     if (st == GETME_IO_OK && gs != GETME_OK)

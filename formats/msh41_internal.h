@@ -64,6 +64,9 @@ void msh41_in_echo(msh41_input *in, FILE *out);
 /* Nodes per element of an MSH element type, 0 if this reader does not know
    the type; *order gets its polynomial order (0 for points). */
 int msh41_type_nodes(int msh_type, int *order);
+/* The getme_ho_type of a second-order MSH type smoothed in a mesh of
+   dimension dim (11, 17, 12, 18, 13 in 3-D), or -1 (msh41_build.c). */
+int msh41_ho_type(int msh_type, int dim);
 /* "tetrahedron", "10-node tetrahedron"... as the Gmsh path words them. */
 void msh41_type_name(int msh_type, char *buf, size_t size);
 
