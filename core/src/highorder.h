@@ -69,7 +69,8 @@ typedef struct getme_ho_ws {
     int32_t *cn;      /* 8 * nh: corners, internal indices, canonical order */
     double *ref;      /* 3 * nh: the offset in the entity's frame          */
     double *x0;       /* 3 * nn: workspace coordinates at the start        */
-    int8_t *etype;    /* ne: getme_ho_type of internal element, or -1      */
+    int8_t *etype;    /* ne: getme_ho_type of internal element, or -1 (also
+                         for a tet10/tri6 that stays affine: see attach)   */
     int64_t *eptr;    /* ne + 1: into eho                                  */
     int32_t *eho;     /* dependent node index of each slot k >= nlin       */
     getme_ho_info *info; /* GETME_NUM_HO_TYPES, filled for types present   */

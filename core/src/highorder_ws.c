@@ -327,6 +327,26 @@ getme_status getme__ho_attach(getme_ws *ws, getme_mesh *mesh)
             solve3(f, d, r);
         }
     }
+    /* A tet10 or tri6 whose dependent nodes are all straight and move with
+       their corners (not pinned, or pinned on fixed corners) is the linear
+       element for good: its Jacobian is constant, positive exactly when
+       its mean ratio is.  Its check at all nodes is skipped (etype -1);
+       getme__ho_store still places its nodes. */
+    for (int32_t e = 0; e < ws->ne; e++) {
+        int t = ho->etype[e];
+        if (t != GETME_TET10 && t != GETME_TRI6)
+            continue;
+        int affine = 1;
+        for (int64_t s = ho->eptr[e]; s < ho->eptr[e + 1] && affine; s++) {
+            int32_t h = ho->eho[s];
+            int fixed_corners = 1;
+            for (int i = 0; i < ho->nc[h]; i++)
+                fixed_corners &= ws->fixed[ho->cn[8 * (int64_t)h + i]] != 0;
+            affine = ho->straight[h] && (!ho->pinned[h] || fixed_corners);
+        }
+        if (affine)
+            ho->etype[e] = -1;
+    }
     free(inv_node);
     free(inv_elem);
     free(hid);
