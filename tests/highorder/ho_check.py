@@ -92,3 +92,20 @@ def midpoint_errors(coords, elems, nodes=None):
                 h = np.linalg.norm(c[0] - c[1])
                 worst = max(worst, np.linalg.norm(coords[row[k]] - c.mean(0)) / h)
     return worst
+
+
+def min_node_jacobian_arrays(xyz, gtype, conn):
+    """min_node_jacobian() of nodes xyz (n x 3) and elements conn (0-based,
+    Gmsh order) of Gmsh type gtype, through a discrete Gmsh model."""
+    gmsh.clear()
+    gmsh.model.add("jac")
+    gmsh.model.addDiscreteEntity(3, 1)
+    n = len(xyz)
+    gmsh.model.mesh.addNodes(3, 1, list(range(1, n + 1)),
+                             np.asarray(xyz, dtype=float).ravel().tolist())
+    gmsh.model.mesh.addElementsByType(1, gtype, [],
+                                      (np.asarray(conn) + 1).ravel().tolist())
+    p = gmsh.model.mesh.getElementProperties(gtype)
+    _, dets, _ = gmsh.model.mesh.getJacobians(gtype, p[4])
+    d = np.array(dets).reshape(-1, p[3])
+    return d.min(), int((d.min(axis=1) <= 0).sum())
