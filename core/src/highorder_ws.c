@@ -174,21 +174,35 @@ static void ho_pos(const getme_ho_ws *ho, int32_t h, const double *X,
         out[k] = s[k] + d[k];
 }
 
+/* Corner a before corner b: by input coordinates (x, then y, then z), not
+   by index, so that the result does not depend on how the caller numbered
+   the nodes (two corners of one valid element never coincide). */
+static int before(const double *x0, int32_t a, int32_t b)
+{
+    const double *p = x0 + 3 * (int64_t)a, *q = x0 + 3 * (int64_t)b;
+    for (int d = 0; d < 3; d++)
+        if (p[d] != q[d])
+            return p[d] < q[d];
+    return a < b;
+}
+
 /* Canonical corner order of an entity, so that every element holding a
-   dependent node computes the same function: edges by index, quad faces
-   from the smallest index towards its smaller neighbour; a body keeps its
-   element's order (one element holds it). */
-static void canonical(int nc, const int32_t *in, int32_t *out)
+   dependent node computes the same function: edges from the first corner
+   (before()), quad faces from the first corner towards its first
+   neighbour; a body keeps its element's order (one element holds it). */
+static void canonical(int nc, const int32_t *in, const double *x0,
+                      int32_t *out)
 {
     if (nc == 2) {
-        out[0] = in[0] < in[1] ? in[0] : in[1];
-        out[1] = in[0] < in[1] ? in[1] : in[0];
+        int s = before(x0, in[1], in[0]);
+        out[0] = in[s];
+        out[1] = in[1 - s];
     } else if (nc == 4) {
         int m = 0;
         for (int i = 1; i < 4; i++)
-            if (in[i] < in[m])
+            if (before(x0, in[i], in[m]))
                 m = i;
-        int dir = in[(m + 1) % 4] < in[(m + 3) % 4] ? 1 : 3;
+        int dir = before(x0, in[(m + 1) % 4], in[(m + 3) % 4]) ? 1 : 3;
         for (int i = 0; i < 4; i++)
             out[i] = in[(m + dir * i) % 4];
     } else {
@@ -271,7 +285,7 @@ getme_status getme__ho_attach(getme_ws *ws, getme_mesh *mesh)
             int32_t ent[8], can[8];
             for (int i = 0; i < nc; i++)
                 ent[i] = lc[in->corner[k][i]];
-            canonical(nc, ent, can);
+            canonical(nc, ent, ho->x0, can);
             if (ws->star_ptr[u + 1] > ws->star_ptr[u]) {
                 st = getme__fail(mesh, GETME_ERR_TOPOLOGY,
                                  "node %d is a mid-node of element %d and a "

@@ -56,6 +56,8 @@ const char *gg_dim_Word(int dim);
 void gg_gmsh_last_error(char *buf, size_t size);
 /* getme type of a linear Gmsh element type, or -1. */
 int gg_getme_type(int gmsh_type);
+/* getme_ho_type of a second-order volume type, -1 if none (gmsh_util.c). */
+int gg_ho_type(int gmsh_type);
 /* Readable Gmsh element type name: "tetrahedron", "10-node tetrahedron". */
 void gg_gmsh_type_name(int gmsh_type, char *buf, size_t size);
 /* Order (1, 2, ...) of a Gmsh element type, 0 if unknown. */
@@ -120,7 +122,9 @@ void gg_frame_to_global(const gg_frame *frame, const double *local,
 /* Elements read from one entity and one Gmsh element type. */
 typedef struct gg_block {
     int gmsh_type;
-    int type;           /* getme type */
+    int type;           /* getme type (of the corners)                    */
+    int ho;             /* getme_ho_type, -1 for a linear block            */
+    int nv;             /* nodes per element                              */
     int dim, tag;       /* entity */
     int32_t first;      /* first global element index */
     int32_t count;

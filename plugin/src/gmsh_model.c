@@ -94,7 +94,9 @@ static getme_status add_block(getme_gmsh_model *m, gg_read *r, int dim,
                               int tag, int gmsh_type, const size_t *etags,
                               size_t ne, const size_t *ntags, gg_msg *msg)
 {
-    int type = gg_getme_type(gmsh_type);
+    int ho = dim == 3 ? gg_ho_type(gmsh_type) : -1;
+    int type = ho >= 0 ? getme_ho_type_linear((getme_ho_type)ho)
+                       : gg_getme_type(gmsh_type);
     if (type < 0 || getme_type_dim((getme_elem_type)type) != dim)
         return type_error(dim, tag, gmsh_type, msg);
     if (ne > (size_t)(INT32_MAX - m->num_elements))
@@ -103,7 +105,8 @@ static getme_status add_block(getme_gmsh_model *m, gg_read *r, int dim,
     getme_status st = grow_blocks(m, r, msg);
     if (st != GETME_OK)
         return st;
-    int nv = getme_type_num_nodes((getme_elem_type)type);
+    int nv = ho >= 0 ? getme_ho_type_num_nodes((getme_ho_type)ho)
+                     : getme_type_num_nodes((getme_elem_type)type);
     int32_t *conn = malloc((ne ? ne : 1) * (size_t)nv * sizeof *conn);
     size_t *et = realloc(m->elem_tags,
                          ((size_t)m->num_elements + ne) * sizeof *et);
@@ -130,6 +133,8 @@ static getme_status add_block(getme_gmsh_model *m, gg_read *r, int dim,
     gg_block *b = &m->blocks[m->num_blocks];
     b->gmsh_type = gmsh_type;
     b->type = type;
+    b->ho = ho;
+    b->nv = nv;
     b->dim = dim;
     b->tag = tag;
     b->first = m->num_elements;
@@ -192,8 +197,7 @@ static getme_status compact_nodes(getme_gmsh_model *m, gg_read *r,
                    3 * sizeof(double));
         }
     for (int b = 0; b < m->num_blocks; b++) {
-        size_t len = (size_t)m->blocks[b].count *
-                     (size_t)getme_type_num_nodes(m->blocks[b].type);
+        size_t len = (size_t)m->blocks[b].count * (size_t)m->blocks[b].nv;
         for (size_t i = 0; i < len; i++)
             r->conn[b][i] = loc[r->conn[b][i]];
     }
@@ -236,8 +240,7 @@ static getme_status build_mesh(getme_gmsh_model *m, gg_read *r, gg_msg *msg)
         int32_t id = r->entity_region[entity_index(m, blk->tag)];
         for (int32_t i = 0; i < blk->count; i++)
             region[i] = id;
-        int32_t bad = repeated_node(r->conn[b], blk->count,
-                                    getme_type_num_nodes(blk->type));
+        int32_t bad = repeated_node(r->conn[b], blk->count, blk->nv);
         if (bad >= 0) {
             free(region);
             return gg_fail(msg, GETME_ERR_INVALID_MESH,
@@ -245,8 +248,11 @@ static getme_status build_mesh(getme_gmsh_model *m, gg_read *r, gg_msg *msg)
                            "in it; getme smooths valid meshes only",
                            m->elem_tags[blk->first + bad]);
         }
-        st = getme_mesh_add_elements(m->mesh, (getme_elem_type)blk->type,
-                                     blk->count, r->conn[b], region);
+        st = blk->ho >= 0
+                 ? getme_mesh_add_elements_ho(m->mesh, (getme_ho_type)blk->ho,
+                                              blk->count, r->conn[b], region)
+                 : getme_mesh_add_elements(m->mesh, (getme_elem_type)blk->type,
+                                           blk->count, r->conn[b], region);
         free(region);
         if (st != GETME_OK)
             gg_fail(msg, st, "%s", getme_mesh_error(m->mesh));

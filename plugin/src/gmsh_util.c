@@ -69,6 +69,21 @@ int gg_getme_type(int gmsh_type)
     }
 }
 
+/* Second-order volume types smoothed with their corners
+   (getme_mesh_add_elements_ho takes Gmsh's node order): 11 tet10, 17
+   hex20, 12 hex27, 18 prism15, 13 prism18; -1 otherwise. */
+int gg_ho_type(int gmsh_type)
+{
+    switch (gmsh_type) {
+    case 11: return GETME_TET10;
+    case 17: return GETME_HEX20;
+    case 12: return GETME_HEX27;
+    case 18: return GETME_PRISM15;
+    case 13: return GETME_PRISM18;
+    default: return -1;
+    }
+}
+
 static void lower_first(char *s)
 {
     if (s[0] >= 'A' && s[0] <= 'Z')
