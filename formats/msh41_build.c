@@ -210,9 +210,10 @@ static getme_io_status check_types(msh41_reader *r)
         if (order > 1)
             return getme_doc_fail(
                 r->doc, GETME_IO_ERR_UNSUPPORTED,
-                "'%s': %s %d has second-order elements (%s): GETMe smooths "
-                "linear elements only (set the element order to 1 first)",
-                r->doc->path, dim_word(dim, 1), r->eb[b].tag, name);
+                "'%s': %s %d has elements of order %d (%s): GETMe smooths "
+                "linear elements and second-order tetrahedra, hexahedra and "
+                "prisms (set the element order to 1 or 2 first)",
+                r->doc->path, dim_word(dim, 1), r->eb[b].tag, order, name);
         return getme_doc_fail(
             r->doc, GETME_IO_ERR_UNSUPPORTED,
             "'%s': %s %d has elements of a type GETMe cannot smooth (%s); "

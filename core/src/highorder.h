@@ -77,7 +77,9 @@ typedef struct getme_ho_ws {
 } getme_ho_ws;
 
 /* Attach the mesh's second-order elements to a freshly built workspace
-   (ws->ho stays NULL if there are none).  GETME_OK, GETME_ERR_NOMEM, or
+   (ws->ho stays NULL if there are none): getme_smooth, getme_mesh_untangle
+   and getme_mesh_distort do; the workspaces built only for faces
+   (fix_boundary, topology) need not.  GETME_OK, GETME_ERR_NOMEM, or
    GETME_ERR_TOPOLOGY with the message on the mesh. */
 getme_status getme__ho_attach(struct getme_ws *ws, getme_mesh *mesh);
 void getme__ho_free(getme_ho_ws *ho);

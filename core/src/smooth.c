@@ -204,11 +204,12 @@ getme_status getme__start(getme_mesh *mesh, const getme_params **params,
     int nt = (*params)->num_threads > 0 ? (*params)->num_threads
                                         : omp_get_max_threads();
     getme_status st = getme__ws_build(ws, mesh, (*params)->renumber, nt);
-    if (st == GETME_ERR_NOMEM)
-        return getme__fail(mesh, st, "out of memory building the workspace");
     if (st != GETME_OK)
-        return st; /* second-order topology: message on the mesh */
-    return GETME_OK;
+        return getme__fail(mesh, st, "out of memory building the workspace");
+    /* second-order elements: dependent nodes (message on the mesh) */
+    if ((st = getme__ho_attach(ws, mesh)) != GETME_OK)
+        getme__ws_free(ws);
+    return st;
 }
 
 getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,

@@ -349,8 +349,6 @@ getme_status getme__ws_build(getme_ws *ws, getme_mesh *mesh, int renumber,
                               ws->star_ptr[i + 1] > ws->star_ptr[i];
     if ((st = colour_blocks(ws)) != GETME_OK)
         goto fail;
-    if ((st = getme__ho_attach(ws, mesh)) != GETME_OK)
-        goto fail;
     return GETME_OK;
 fail:
     getme__ws_free(ws);

@@ -58,12 +58,14 @@ static getme_status type_error(int dim, int tag, int gmsh_type, gg_msg *msg)
 {
     char name[96];
     gg_gmsh_type_name(gmsh_type, name, sizeof name);
-    if (gg_gmsh_type_order(gmsh_type) > 1)
+    int order = gg_gmsh_type_order(gmsh_type);
+    if (order > 1)
         return gg_fail(msg, GETME_ERR_TOPOLOGY,
-                       "%s %d has second-order elements (%s): GETMe "
-                       "smooths linear elements only (set the element "
-                       "order to 1 first)",
-                       gg_dim_Word(dim), tag, name);
+                       "%s %d has elements of order %d (%s): GETMe smooths "
+                       "linear elements and second-order tetrahedra, "
+                       "hexahedra and prisms (set the element order to 1 "
+                       "or 2 first)",
+                       gg_dim_Word(dim), tag, order, name);
     return gg_fail(msg, GETME_ERR_TOPOLOGY,
                    "%s %d has elements of a type GETMe cannot smooth (%s); "
                    "supported: %s",
