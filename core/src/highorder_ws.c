@@ -210,6 +210,8 @@ static void canonical(int nc, const int32_t *in, const double *x0,
     }
 }
 
+static int bl_nv(const getme_ho_block *bl) { return getme__ho_nv[bl->type]; }
+
 getme_status getme__ho_attach(getme_ws *ws, getme_mesh *mesh)
 {
     ws->ho = NULL;
@@ -259,15 +261,29 @@ getme_status getme__ho_attach(getme_ws *ws, getme_mesh *mesh)
         ho->eptr[e + 1] += ho->eptr[e];
     int64_t slots = ho->eptr[ws->ne];
     ho->eho = malloc((size_t)(slots + 1) * sizeof *ho->eho);
-    /* at most one dependent node per slot */
-    ho->node = malloc((size_t)(slots + 1) * sizeof *ho->node);
-    ho->nc = malloc((size_t)(slots + 1));
-    ho->cn = malloc((size_t)(slots + 1) * 8 * sizeof *ho->cn);
-    if (!ho->eho || !ho->node || !ho->nc || !ho->cn)
+    if (!ho->eho)
         goto fail;
     /* Number the dependent nodes in internal element order (deterministic
-       and independent of the thread count). */
+       and independent of the thread count), then fill them in. */
     int32_t nh = 0;
+    for (int32_t e = 0; e < ws->ne; e++) {
+        int t = ho->etype[e];
+        if (t < 0)
+            continue;
+        int32_t ec = ws->elem_orig[e];
+        const getme_ho_block *bl = hm->blocks;
+        while (ec < bl->first || ec >= bl->first + bl->count)
+            bl++;
+        const int32_t *conn = bl->conn + (int64_t)(ec - bl->first) * bl_nv(bl);
+        for (int k = ho->info[t].nlin; k < ho->info[t].nv; k++)
+            if (hid[inv_node[conn[k]]] < 0)
+                hid[inv_node[conn[k]]] = nh++;
+    }
+    ho->node = malloc(((size_t)nh + 1) * sizeof *ho->node);
+    ho->nc = calloc((size_t)nh + 1, 1);
+    ho->cn = malloc(((size_t)nh + 1) * 8 * sizeof *ho->cn);
+    if (!ho->node || !ho->nc || !ho->cn)
+        goto fail;
     for (int32_t e = 0; e < ws->ne; e++) {
         int t = ho->etype[e];
         if (t < 0)
@@ -294,8 +310,7 @@ getme_status getme__ho_attach(getme_ws *ws, getme_mesh *mesh)
                 goto fail;
             }
             int32_t h = hid[u];
-            if (h < 0) {
-                h = hid[u] = nh++;
+            if (ho->nc[h] == 0) { /* first element holding it */
                 ho->node[h] = u;
                 ho->nc[h] = (uint8_t)nc;
                 memcpy(ho->cn + 8 * (int64_t)h, can, (size_t)nc * sizeof *can);
