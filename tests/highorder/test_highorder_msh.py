@@ -18,10 +18,11 @@ then `getme smooth`.  Asserted on every output, with Gmsh's own Jacobians
     the input outside the coordinates of $Nodes;
   - 1 and 2 threads give byte-identical outputs; q_mean rises;
   - meshio reads the output with the same cells (round trip).
-A curved case: interior mid-edge nodes of a tet10 box pushed off their
-edges by Gmsh's API: after smoothing every node Jacobian is positive and
-each curved edge node keeps its offset relative to its edge (the mapping
-is a similarity: |d| / |edge| is unchanged).
+Curved cases (tet10, hex27, prism18): interior mid-edge, face and body
+nodes pushed off their straight positions with Gmsh's API: after
+smoothing every node Jacobian is positive, each curved edge node keeps its
+offset relative to its edge (the mapping is a similarity: |d| / |edge| is
+unchanged), face and body nodes keep an offset.
 """
 import os
 import re
@@ -177,11 +178,16 @@ def meshio_round_trip(out, coords, elems, tag):
           (tag, len(coords)))
 
 
-def curved_case():
-    """Interior mid-edge nodes of a tet10 box moved off their edges (2% of
-    the edge length, perpendicular): curved interior elements."""
-    tag = "curved tet10"
-    src = generate("tet10", 4.1, False, n=3)
+def curved_case(kind, gtype):
+    """Interior mid-edge nodes moved off their edges (2% of the edge
+    length, perpendicular), and for hex27/prism18 the interior face and
+    body nodes off their corners' mean (2% of the first edge): curved
+    interior elements.  After distort + smooth: valid at every node, edge
+    nodes keep |offset| / |edge| (the similarity of docs/highorder.md),
+    face and body nodes are no longer at their corners' mean (they kept an
+    offset, mapped with their frame)."""
+    tag = "curved " + kind
+    src = generate(kind, 4.1, False, n=3)
     gmsh.clear()
     gmsh.open(src)
     tags, xyz, _ = gmsh.model.mesh.getNodes()
@@ -189,37 +195,44 @@ def curved_case():
     low = set()
     for d in (0, 1, 2):
         low.update(gmsh.model.mesh.getNodes(d, -1, includeBoundary=True)[0].tolist())
-    _, conn = gmsh.model.mesh.getElementsByType(11)
-    conn = np.array(conn).reshape(-1, 10)
-    done = set()
+    _, conn = gmsh.model.mesh.getElementsByType(gtype)
+    _, _, edges, faces = ho_check.TYPES[gtype]
+    conn = np.array(conn).reshape(-1, ho_check.TYPES[gtype][1] + len(edges) +
+                                  len(faces))
+    done, done_faces = set(), set()
     for row in conn:
-        for k, a, b in ho_check.TYPES[11][2]:
+        for entry in edges + faces:
+            k, cs = entry[0], entry[1:]
             m = row[k]
-            if m in low or m in done:
+            if m in low or m in done or m in done_faces:
                 continue
-            done.add(m)
-            e = coords[row[b]] - coords[row[a]]
+            e = coords[row[cs[1]]] - coords[row[cs[0]]]
             p = np.cross(e, [0.3, 0.5, 0.8])
             p *= 0.02 * np.linalg.norm(e) / np.linalg.norm(p)
+            (done if len(cs) == 2 else done_faces).add(m)
             gmsh.model.mesh.setNode(int(m), list(coords[m] + p), [])
-    src2 = path("curved.msh")
+    src2 = path("curved-%s.msh" % kind)
     gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
     gmsh.option.setNumber("Mesh.Binary", 0)
     gmsh.write(src2)
     w0, bad0 = ho_check.min_node_jacobian(src2)
     check(bad0 == 0, "%s: input valid (%g)" % (tag, w0))
-    dis, out = path("curved-d.msh"), path("curved-s.msh")
+    dis, out = path("curved-%s-d.msh" % kind), path("curved-%s-s.msh" % kind)
     r = run("distort", src2, "-o", dis, "--seed", "5", "--target-qmean", "0.6")
     check(r.returncode == 0, "%s: distort %s" % (tag, r.stderr))
     r = run("smooth", dis, "-o", out)
     check(r.returncode == 0, "%s: smooth %s" % (tag, r.stderr))
     c0, e0, _ = ho_check.load(src2)
+    c1, _, _ = ho_check.load(dis)
     c2, e2, _ = ho_check.load(out)
     w2, bad2 = ho_check.min_node_jacobian(out)
     check(bad2 == 0 and w2 > 0, "%s: smoothed min node det J %g" % (tag, w2))
+    moved = sum(1 for t in done | done_faces if not np.array_equal(c1[t], c2[t]))
+    check(moved > len(done | done_faces) // 4, "%s: %d curved nodes moved" %
+          (tag, moved))
     worst, n = 0.0, 0
-    for row in e0[11][1]:
-        for k, a, b in ho_check.TYPES[11][2]:
+    for row in e0[gtype][1]:
+        for k, a, b in edges:
             if row[k] not in done:
                 continue
             r0 = (np.linalg.norm(c0[row[k]] - 0.5 * (c0[row[a]] + c0[row[b]])) /
@@ -231,6 +244,14 @@ def curved_case():
     check(n > 0 and worst < 1e-9,
           "%s: relative offsets kept on %d edges (worst change %g)" %
           (tag, n, worst))
+    if done_faces:
+        off = min(np.linalg.norm(c2[row[f[0]]] - np.mean([c2[row[i]] for i in
+                                                          f[1:]], axis=0))
+                  for row in e2[gtype][1] for f in faces
+                  if row[f[0]] in done_faces)
+        check(off > 1e-4, "%s: face/body nodes keep an offset (min %g)" %
+              (tag, off))
+    print("%-14s: min node det J after smoothing %.4g" % (tag, w2), flush=True)
 
 
 gmsh.initialize()
@@ -242,7 +263,8 @@ for kind in ("tet10", "hex20", "hex27", "prism15", "prism18"):
         w = case(kind, version, binary)
         print("%-8s %s%s: min node det J after smoothing %.4g" %
               (kind, version, "b" if binary else " ", w), flush=True)
-curved_case()
+for kind, gtype in (("tet10", 11), ("hex27", 12), ("prism18", 13)):
+    curved_case(kind, gtype)
 gmsh.finalize()
 print("%d failure(s)" % len(FAILED))
 sys.exit(1 if FAILED else 0)
