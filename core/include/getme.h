@@ -226,6 +226,12 @@ GETME_API int32_t getme_mesh_num_elements_ho(const getme_mesh *mesh);
 GETME_API getme_status getme_mesh_element_jacobian_ratio(getme_mesh *mesh,
                                                          int32_t e,
                                                          double *ratio);
+/* The smallest getme_mesh_element_jacobian_ratio() over the second-order
+   elements into *ratio (1 if there are none) and that element's index into
+   *element (-1 if none; the smallest index on ties). */
+GETME_API getme_status getme_mesh_jacobian_ratio_min(getme_mesh *mesh,
+                                                     double *ratio,
+                                                     int32_t *element);
 
 /* ---- fixed nodes -------------------------------------------------------- */
 

@@ -116,6 +116,54 @@ getme_status getme_mesh_add_elements_ho(getme_mesh *mesh, getme_ho_type type,
     return GETME_OK;
 }
 
+/* Ratio of the smallest to the largest det J over the nodes of one element
+   of a block (x: scratch for its nodes). */
+static double block_ratio(const getme_mesh *mesh, const getme_ho_info *info,
+                          const int32_t *c, double *x)
+{
+    double ysign = mesh->mirror == 1 ? -1.0 : 1.0;
+    for (int i = 0; i < info->nv; i++) {
+        const double *p = mesh->coords + 3 * (int64_t)c[i];
+        x[3 * i] = p[0];
+        x[3 * i + 1] = ysign * p[1];
+        x[3 * i + 2] = p[2];
+    }
+    double lo, hi;
+    getme__ho_det_range(info, x, &lo, &hi);
+    return hi > 0.0 ? lo / hi : (lo < 0.0 ? -1.0 : 0.0);
+}
+
+getme_status getme_mesh_jacobian_ratio_min(getme_mesh *mesh, double *ratio,
+                                           int32_t *element)
+{
+    if (!mesh || !ratio || !element)
+        return GETME_ERR_ARGUMENT;
+    *ratio = 1.0;
+    *element = -1;
+    if (!mesh->ho)
+        return GETME_OK;
+    if (mesh->mirror < 0)
+        getme__detect_orientation(mesh);
+    double x[3 * GETME_HO_MAX_NV];
+    for (int b = 0; b < mesh->ho->num_blocks; b++) {
+        const getme_ho_block *bl = &mesh->ho->blocks[b];
+        getme_ho_info info;
+        if (getme__ho_info_init(bl->type, &info))
+            return getme__fail(mesh, GETME_ERR_ARGUMENT, "bad tables");
+        for (int32_t l = 0; l < bl->count; l++) {
+            double r = block_ratio(mesh, &info,
+                                   bl->conn + (int64_t)l * info.nv, x);
+            /* blocks come in element order: strict < keeps the smallest
+               index on ties */
+            if (*element < 0 || r < *ratio) {
+                *ratio = r;
+                *element = bl->first + l;
+            }
+        }
+    }
+    return GETME_OK;
+}
+
 getme_status getme_mesh_element_jacobian_ratio(getme_mesh *mesh, int32_t e,
                                                double *ratio)
 {
@@ -132,17 +180,10 @@ getme_status getme_mesh_element_jacobian_ratio(getme_mesh *mesh, int32_t e,
         if (getme__ho_info_init(bl->type, &info))
             return getme__fail(mesh, GETME_ERR_ARGUMENT, "bad tables");
         double x[3 * GETME_HO_MAX_NV];
-        const int32_t *c = bl->conn + (int64_t)(e - bl->first) * info.nv;
-        double ysign = mesh->mirror == 1 ? -1.0 : 1.0;
-        for (int i = 0; i < info.nv; i++) {
-            const double *p = mesh->coords + 3 * (int64_t)c[i];
-            x[3 * i] = p[0];
-            x[3 * i + 1] = ysign * p[1];
-            x[3 * i + 2] = p[2];
-        }
-        double lo, hi;
-        getme__ho_det_range(&info, x, &lo, &hi);
-        *ratio = hi > 0.0 ? lo / hi : (lo < 0.0 ? -1.0 : 0.0);
+        if (mesh->mirror < 0)
+            getme__detect_orientation(mesh);
+        *ratio = block_ratio(mesh, &info,
+                             bl->conn + (int64_t)(e - bl->first) * info.nv, x);
         return GETME_OK;
     }
     return GETME_OK;

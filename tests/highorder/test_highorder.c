@@ -44,6 +44,10 @@ static void test_jacobian_ratio(void)
     CHECK(getme_mesh_set_coords(m, xyz) == GETME_OK);
     CHECK(getme_mesh_element_jacobian_ratio(m, 0, &r) == GETME_OK);
     CHECK_NEAR(r, 0.6 / 1.4, 1e-12);
+    int32_t worst = -2;
+    CHECK(getme_mesh_jacobian_ratio_min(m, &r, &worst) == GETME_OK);
+    CHECK_NEAR(r, 0.6 / 1.4, 1e-12);
+    CHECK_EQ_INT(worst, 0);
     /* x = 0.2: dx/dxi = -0.2 at node 0: invalid though the corners are
        the regular tet's. */
     xyz[12] = 0.2;

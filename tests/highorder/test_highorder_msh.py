@@ -142,6 +142,10 @@ def case(kind, version, binary):
                                         r1.stderr[-300:]))
     check(open(out1, "rb").read() == open(out2, "rb").read(),
           "%s: 1 and 2 threads byte-identical" % tag)
+    ratio = re.findall(r"Second order \(after\): \d+ elements, worst node "
+                       r"Jacobian ratio ([-0-9.]+)", r1.stdout + r1.stderr)
+    check(len(ratio) == 1 and float(ratio[0]) > 0,
+          "%s: the log's worst node Jacobian ratio after (%s)" % (tag, ratio))
     q = qmeans(r1.stdout + r1.stderr)
     check(len(q) >= 2 and q[-1] > q[0] + 0.05,
           "%s: q_mean rises (%s)" % (tag, q))
