@@ -70,6 +70,9 @@ void cli_print_measures(const cli_log *log, const char *title,
 /* Compute and print; on failure warn (the statistics stay empty). */
 void cli_measures_log(const cli_log *log, getme_mesh *mesh, const char *title,
                       cli_measures *m);
+/* Second-order meshes (highorder.c): "Second order (WHEN): N elements,
+   worst node Jacobian ratio R (element ID)"; nothing for a linear mesh. */
+void cli_ho_log(const cli_log *log, getme_doc *doc, const char *when);
 /* Summary and 10-bin histogram of every measure but the mean ratio. */
 void cli_print_measure_histograms(const cli_log *log, const cli_measures *m,
                                   int type);

@@ -182,6 +182,7 @@ static int run(smooth_args *a)
     cli_print_stats(log, "Quality before", &before);
     cli_measures mbefore, mafter;
     cli_measures_log(log, mesh, "Measures before", &mbefore);
+    cli_ho_log(log, doc, "before");
     cli_worst_list worst = {0}, worst_free = {0};
     cli_guard guard = {0};
     getme_untangle_result ur;
@@ -204,6 +205,7 @@ static int run(smooth_args *a)
     if (st != GETME_OK) {
         cli_error("%s: %s", a->input, getme_mesh_error(mesh));
         code = st == GETME_ERR_INVALID_MESH ? CLI_EXIT_INVALID
+               : st == GETME_ERR_TOPOLOGY   ? CLI_EXIT_UNSUPPORTED
                                             : CLI_EXIT_INTERNAL;
         goto out;
     }
@@ -211,6 +213,7 @@ static int run(smooth_args *a)
     getme_mesh_quality_stats(mesh, -1, &after);
     cli_print_stats(log, "Quality after ", &after);
     cli_measures_log(log, mesh, "Measures after ", &mafter);
+    cli_ho_log(log, doc, "after");
     if (res.corner_sj_initial < 1.0 || res.corner_sj < 1.0)
         cli_info(log, "Worst corner scaled Jacobian (hex, prism, pyramid, "
                       "quad): %.4f before, %.4f after",

@@ -44,6 +44,13 @@ int getme__msh_type_name(int msh_type, char *buf, size_t size);
 int getme__msh_type_dim(int msh_type);
 /* The getme type of a linear MSH type (2 tri .. 7 pyramid), else -1. */
 int getme__msh_type_getme(int msh_type);
+/* The getme_ho_type of a second-order MSH type smoothed in a mesh of
+   dimension dim (11, 17, 12, 18, 13 in 3-D), or -1. */
+int getme__msh_type_ho(int msh_type, int dim);
+/* The getme type of the corners of a type smoothed in a mesh of dimension
+   dim: getme__msh_type_getme for linear types, the corners' linear type
+   for getme__msh_type_ho's, else -1. */
+int getme__msh_type_corners(int msh_type, int dim);
 /* "point", "curve", "surface", "volume" (capital: "Point"...), as Gmsh
    words them; "entity" outside 0..3. */
 const char *getme__dim_word(int dim, int capital);

@@ -25,9 +25,10 @@ getme_status getme__model_type_error(int dim, int tag, int msh_type,
     getme__msh_type_name(msh_type, name, sizeof name);
     if (order > 1)
         snprintf(msg, size,
-                 "%s %d has second-order elements (%s): GETMe smooths "
-                 "linear elements only (set the element order to 1 first)",
-                 getme__dim_word(dim, 1), tag, name);
+                 "%s %d has elements of order %d (%s): GETMe smooths "
+                 "linear elements and second-order tetrahedra, hexahedra "
+                 "and prisms (set the element order to 1 or 2 first)",
+                 getme__dim_word(dim, 1), tag, order, name);
     else
         snprintf(msg, size,
                  "%s %d has elements of a type GETMe cannot smooth (%s); "
@@ -51,7 +52,7 @@ static getme_status check_blocks(const getme__model_in *in,
     int64_t total = 0;
     for (size_t b = 0; b < in->num_blocks; b++) {
         const getme__model_block *blk = &in->blocks[b];
-        int type = getme__msh_type_getme(blk->type);
+        int type = getme__msh_type_corners(blk->type, in->dim);
         if (!blk->conn || type < 0 ||
             getme_type_dim((getme_elem_type)type) != in->dim)
             return getme__model_type_error(in->dim, blk->tag, blk->type,
@@ -199,9 +200,14 @@ static getme_status add_run(getme__model_in *in, getme__model_out *out,
     for (size_t i = 0; st == GETME_OK && i < count; i++)
         region[i] = region_id;
     if (st == GETME_OK) {
-        getme_status gs = getme_mesh_add_elements(
-            out->mesh, (getme_elem_type)getme__msh_type_getme(b->type),
-            (int32_t)count, conn, region);
+        int ho = getme__msh_type_ho(b->type, in->dim);
+        getme_status gs =
+            ho >= 0 ? getme_mesh_add_elements_ho(out->mesh, (getme_ho_type)ho,
+                                                 (int32_t)count, conn, region)
+                    : getme_mesh_add_elements(
+                          out->mesh,
+                          (getme_elem_type)getme__msh_type_getme(b->type),
+                          (int32_t)count, conn, region);
         if (gs != GETME_OK)
             st = mesh_error(out, gs);
     }

@@ -81,6 +81,28 @@ int getme__msh_type_getme(int msh_type)
     return msh_type >= 2 && msh_type <= 7 ? by_msh[msh_type - 2] : -1;
 }
 
+/* Second-order volume types smoothed with their corners (Gmsh's node order
+   is getme_mesh_add_elements_ho's, docs/highorder.md): 11 tet10, 17 hex20,
+   12 hex27, 18 prism15, 13 prism18 in a 3-D mesh; -1 otherwise. */
+int getme__msh_type_ho(int msh_type, int dim)
+{
+    switch (dim == 3 ? msh_type : 0) {
+    case 11: return GETME_TET10;
+    case 17: return GETME_HEX20;
+    case 12: return GETME_HEX27;
+    case 18: return GETME_PRISM15;
+    case 13: return GETME_PRISM18;
+    default: return -1;
+    }
+}
+
+int getme__msh_type_corners(int msh_type, int dim)
+{
+    int ho = getme__msh_type_ho(msh_type, dim);
+    return ho >= 0 ? getme_ho_type_linear((getme_ho_type)ho)
+                   : getme__msh_type_getme(msh_type);
+}
+
 const char *getme__dim_word(int dim, int capital)
 {
     static const char *const w[2][5] = {

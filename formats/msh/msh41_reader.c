@@ -658,7 +658,7 @@ static getme_io_status new_eblock(msh41_reader *r, int dim, int tag,
     msh41_type_nodes(type, &order);
     int linear = order == 1 && ((dim == 3 && type >= 4 && type <= 7) ||
                                 (dim == 2 && (type == 2 || type == 3)));
-    if (linear) {
+    if (linear || getme__msh_type_ho(type, dim) >= 0) {
         b->conn = malloc((size_t)count * (size_t)nv * sizeof *b->conn);
         b->ids = malloc((size_t)count * sizeof *b->ids);
         if (!b->conn || !b->ids)

@@ -99,13 +99,13 @@ static getme_status add_block(gg_read *r, int dim, int tag, int gmsh_type,
     memset(b, 0, sizeof *b);
     b->tag = tag;
     b->type = gmsh_type;
-    int type = getme__msh_type_getme(gmsh_type);
+    int type = getme__msh_type_corners(gmsh_type, dim);
     if (type < 0 || getme_type_dim((getme_elem_type)type) != dim)
         return GETME_OK;
     if (ne > (size_t)INT32_MAX)
         return gg_fail(msg, GETME_ERR_ARGUMENT,
                        "More than 2^31-1 elements are not supported");
-    int nv = getme_type_num_nodes((getme_elem_type)type);
+    int nv = getme__msh_type_nodes(gmsh_type, NULL);
     b->conn = malloc((ne ? ne : 1) * (size_t)nv * sizeof *b->conn);
     b->ids = malloc((ne ? ne : 1) * sizeof *b->ids);
     if (!b->conn || !b->ids)
@@ -163,7 +163,7 @@ static getme_status keep_blocks(getme_gmsh_model *m, const gg_read *r,
     int32_t first = 0;
     for (size_t b = 0; b < r->num_blocks; b++) {
         const getme__model_block *rb = &r->blocks[b];
-        m->blocks[b] = (gg_block){rb->type, getme__msh_type_getme(rb->type),
+        m->blocks[b] = (gg_block){rb->type, getme__msh_type_corners(rb->type, m->dim),
                                   m->dim, rb->tag, first, rb->count};
         first += rb->count;
     }

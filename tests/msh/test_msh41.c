@@ -5,7 +5,7 @@
  *    nodes, element ids; a moved node is written back and nothing else
  *    changes (binary: same size, only its 24 bytes);
  *  - errors: every truncation of both files, bad $MeshFormat, a missing
- *    node, second-order tets, unknown --fix name: status and one line
+ *    node, third-order tets, unknown --fix name: status and one line
  *    naming the file (and the line for ASCII);
  *  - mutation fuzzing: thousands of mutants open or fail with a message.
  */
@@ -340,9 +340,11 @@ static void check_errors(const bytes *bin)
     expect("missing.msh", buf, strlen(buf), GETME_FORMATS_ERR_PARSE,
            "line 38: element 3 uses node 77", 0, NULL);
     snprintf(buf, sizeof buf, "%s", ascii_seed);
-    replace(buf, "3 1 4 1\n2 1 2 3 4\n", "3 1 11 1\n2 1 2 3 4 1 2 3 4 5 5\n");
-    expect("order2.msh", buf, strlen(buf), GETME_FORMATS_ERR_UNSUPPORTED,
-           "Volume 1 has second-order elements (10-node tetrahedron)", 0,
+    /* order 3 (second order is smoothed: tests/highorder) */
+    replace(buf, "3 1 4 1\n2 1 2 3 4\n",
+            "3 1 29 1\n2 1 2 3 4 1 2 3 4 1 2 3 4 1 2 3 4 1 2 3 4\n");
+    expect("order3.msh", buf, strlen(buf), GETME_FORMATS_ERR_UNSUPPORTED,
+           "Volume 1 has elements of order 3 (20-node tetrahedron)", 0,
            NULL);
     const char *fix[] = {"a", "nosuch"};
     expect("fix.msh", ascii_seed, na, GETME_FORMATS_ERR_ARGUMENT,
