@@ -170,9 +170,9 @@ GETME_API getme_status getme_mesh_set_coords(getme_mesh *mesh,
 /* ---- second-order elements (docs/highorder.md) ------------------------- */
 
 /* Second-order element types.  Node order is Gmsh's (MSH types 11, 17, 12,
-   18, 13, 9, 16, 10): the corners first, in the linear type's order, then
-   the mid-edge nodes, then face and body nodes.  Second-order pyramids
-   (Gmsh 19, 14) are not supported: their shape functions are rational. */
+   18, 13, 9, 16, 10, 19, 14): the corners first, in the linear type's
+   order, then the mid-edge nodes, then face and body nodes.  The
+   pyramids' shape functions are Gmsh's rational ones (docs/highorder.md). */
 typedef enum getme_ho_type {
     GETME_TET10 = 0,
     GETME_HEX20 = 1,
@@ -182,10 +182,13 @@ typedef enum getme_ho_type {
     GETME_TRI6 = 5,
     GETME_QUAD8 = 6,
     GETME_QUAD9 = 7,
-    GETME_NUM_HO_TYPES = 8
+    GETME_PYRAMID13 = 8,
+    GETME_PYRAMID14 = 9,
+    GETME_NUM_HO_TYPES = 10
 } getme_ho_type;
 
-/* Nodes per element (10, 20, 27, 15, 18, 6, 8, 9); 0 for an unknown type. */
+/* Nodes per element (10, 20, 27, 15, 18, 6, 8, 9, 13, 14); 0 for an
+   unknown type. */
 GETME_API int getme_ho_type_num_nodes(getme_ho_type type);
 /* The linear type of its corners (GETME_TET for GETME_TET10 ...), -1 if
    unknown. */

@@ -9,7 +9,8 @@
 #include <string.h>
 
 static const char *const ho_names[GETME_NUM_HO_TYPES] = {
-    "tet10", "hex20", "hex27", "prism15", "prism18", "tri6", "quad8", "quad9"};
+    "tet10", "hex20", "hex27", "prism15", "prism18", "tri6", "quad8", "quad9",
+    "pyramid13", "pyramid14"};
 
 int getme_ho_type_num_nodes(getme_ho_type type)
 {

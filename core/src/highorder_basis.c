@@ -17,10 +17,11 @@
 #include <math.h>
 #include <string.h>
 
-const int getme__ho_nv[GETME_NUM_HO_TYPES] = {10, 20, 27, 15, 18, 6, 8, 9};
+const int getme__ho_nv[GETME_NUM_HO_TYPES] = {10, 20, 27, 15, 18, 6, 8, 9,
+                                               13, 14};
 const int getme__ho_lin[GETME_NUM_HO_TYPES] = {
     GETME_TET, GETME_HEX, GETME_HEX, GETME_PRISM, GETME_PRISM,
-    GETME_TRI, GETME_QUAD, GETME_QUAD};
+    GETME_TRI, GETME_QUAD, GETME_QUAD, GETME_PYRAMID, GETME_PYRAMID};
 
 /* Reference nodes, Gmsh's order (getElementProperties of MSH types 11, 17,
    12, 18, 13, 9, 16, 10). */
@@ -46,7 +47,14 @@ static const double ref_quad9[9][3] = {
     {-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0},
     {0, -1, 0}, {1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, 0, 0}};
 
-/* hex20, prism15 and quad8 are the first nodes of hex27, prism18, quad9. */
+/* Gmsh's pyramid: base [-1, 1]^2 at z = 0, apex (0, 0, 1) (types 19, 14). */
+static const double ref_pyr14[14][3] = {
+    {-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, {0, 0, 1},
+    {0, -1, 0}, {-1, 0, 0}, {-.5, -.5, .5}, {1, 0, 0}, {.5, -.5, .5},
+    {0, 1, 0}, {.5, .5, .5}, {-.5, .5, .5}, {0, 0, 0}};
+
+/* hex20, prism15, quad8 and pyramid13 are the first nodes of hex27,
+   prism18, quad9 and pyramid14. */
 static const double (*ref_nodes(int type))[3]
 {
     switch (type) {
@@ -54,6 +62,7 @@ static const double (*ref_nodes(int type))[3]
     case GETME_HEX20: case GETME_HEX27: return ref_hex27;
     case GETME_PRISM15: case GETME_PRISM18: return ref_prism18;
     case GETME_TRI6: return ref_tri6;
+    case GETME_PYRAMID13: case GETME_PYRAMID14: return ref_pyr14;
     default: return ref_quad9;
     }
 }
@@ -91,6 +100,22 @@ static int fill_space(int type, space *s)
                 }
         return n;
     }
+    case GETME_PYRAMID13: case GETME_PYRAMID14:
+        /* Gmsh's (Bergot's) rational pyramid space of order 2: with
+           w = 1 - z, xh = x / w, yh = y / w, the functions
+           xh^a yh^b w^max(a, b) z^c for a, b <= 2, c <= 2 - max(a, b)
+           (14); pyramid13 drops xh^2 yh^2 w^2.  e holds (a, b, c); see
+           pyr_fn.  tests/highorder/test_highorder_msh.py compares values
+           and gradients with gmsh.model.mesh.getBasisFunctions. */
+        for (int a = 0; a <= 2; a++)
+            for (int b = 0; b <= 2; b++)
+                for (int c = 0; c <= 2 - (a > b ? a : b); c++) {
+                    if (type == GETME_PYRAMID13 && a == 2 && b == 2)
+                        continue;
+                    s->e[n][0] = (int8_t)a, s->e[n][1] = (int8_t)b;
+                    s->e[n++][2] = (int8_t)c;
+                }
+        return n;
     default: { /* prisms: P2(x, y) times powers of z */
         for (int a = 0; a <= 2; a++)
             for (int b = 0; a + b <= 2; b++)
@@ -124,6 +149,46 @@ static double mono(const int8_t e[3], const double p[3], int d)
         }
     }
     return v;
+}
+
+/* Value, or derivative along axis d, of the pyramid function e at p (see
+   fill_space).  At the apex (w = 0) the gradients are 0/0; their limit
+   along the axis (xh = yh = 0) is taken, which is what Gmsh 4.8's
+   getBasisFunctions returns there (and at z = 1 - 1e-6 on the axis). */
+static double pyr_fn(const int8_t e[3], const double p[3], int d)
+{
+    int a = e[0], b = e[1], c = e[2], m = a > b ? a : b;
+    double w = 1.0 - p[2], z = p[2];
+    double xh = w != 0.0 ? p[0] / w : 0.0, yh = w != 0.0 ? p[1] / w : 0.0;
+    switch (d) {
+    case -1:
+        return ipow(xh, a) * ipow(yh, b) * ipow(w, m) * ipow(z, c);
+    case 0:
+        return a ? a * ipow(xh, a - 1) * ipow(yh, b) * ipow(w, m - 1) *
+                       ipow(z, c)
+                 : 0.0;
+    case 1:
+        return b ? b * ipow(xh, a) * ipow(yh, b - 1) * ipow(w, m - 1) *
+                       ipow(z, c)
+                 : 0.0;
+    default: {
+        /* x^a y^b w^(m-a-b) z^c: d/dz of w^(m-a-b) is (a+b-m) w^(m-a-b-1) */
+        double v = 0.0;
+        if (a + b > m)
+            v += (a + b - m) * ipow(xh, a) * ipow(yh, b) * ipow(w, m - 1) *
+                 ipow(z, c);
+        if (c)
+            v += c * ipow(xh, a) * ipow(yh, b) * ipow(w, m) * ipow(z, c - 1);
+        return v;
+    }
+    }
+}
+
+static double basis_fn(int type, const int8_t e[3], const double p[3], int d)
+{
+    return type == GETME_PYRAMID13 || type == GETME_PYRAMID14
+               ? pyr_fn(e, p, d)
+               : mono(e, p, d);
 }
 
 /* Invert the n x n matrix a (row-major, GETME_HO_MAX_NV stride) into inv by
@@ -209,7 +274,7 @@ static int find_entity(getme_ho_info *info, const double (*ref)[3],
 
 int getme__ho_info_init(int type, getme_ho_info *info)
 {
-    _Static_assert(GETME_NUM_HO_TYPES == 8, "tables cover every type");
+    _Static_assert(GETME_NUM_HO_TYPES == 10, "tables cover every type");
     memset(info, 0, sizeof *info);
     info->nv = getme__ho_nv[type];
     info->lin = getme__ho_lin[type];
@@ -223,7 +288,7 @@ int getme__ho_info_init(int type, getme_ho_info *info)
     double v[GETME_HO_MAX_NV][GETME_HO_MAX_NV], c[GETME_HO_MAX_NV][GETME_HO_MAX_NV];
     for (int k = 0; k < n; k++)
         for (int m = 0; m < n; m++)
-            v[k][m] = mono(s.e[m], ref[k], -1);
+            v[k][m] = basis_fn(type, s.e[m], ref[k], -1);
     if (invert(n, v, c))
         return -1;
     /* N_j = sum_m c[m][j] m_m, so dN_j/dd at node k = sum_m c[m][j] dm_m */
@@ -232,7 +297,7 @@ int getme__ho_info_init(int type, getme_ho_info *info)
             for (int d = 0; d < 3; d++) {
                 double sum = 0.0;
                 for (int m = 0; m < n; m++)
-                    sum += c[m][j] * mono(s.e[m], ref[k], d);
+                    sum += c[m][j] * basis_fn(type, s.e[m], ref[k], d);
                 info->dn[k][j][d] = sum;
             }
     for (int k = info->nlin; k < n; k++)

@@ -1,6 +1,6 @@
 /*
  * cgns_highorder.c -- CGNS second-order volume elements (TETRA_10,
- * HEXA_20, HEXA_27, PENTA_15, PENTA_18): which getme_ho_type each is, and
+ * HEXA_20, HEXA_27, PENTA_15, PENTA_18, PYRA_13, PYRA_14): which getme_ho_type each is, and
  * the CGNS (SIDS) node order mapped to Gmsh's, the order of
  * getme_mesh_add_elements_ho.  SIDS lists the mid-edge nodes edge by edge
  * around the bottom face, then the vertical edges, then around the top
@@ -16,6 +16,9 @@ static const int8_t order_tetra10[10] = {0, 1, 2, 3, 4, 5, 6, 7, 9, 8};
 static const int8_t order_hexa27[27] = {
     0,  1,  2,  3,  4,  5,  6,  7,  8,  11, 12, 9,  13, 10,
     14, 15, 16, 19, 17, 18, 20, 21, 24, 22, 23, 25, 26};
+/* PYRA_14: base edges 1-2, 2-3, 3-4, 4-1, then 1-5 ... 4-5, base centre. */
+static const int8_t order_pyra14[14] = {0, 1, 2, 3,  4,  5,  8,
+                                        9, 6, 10, 7, 11, 12, 13};
 static const int8_t order_penta18[18] = {0,  1,  2,  3,  4,  5,  6,  8,  9,
                                          7,  10, 11, 12, 14, 13, 15, 17, 16};
 
@@ -27,6 +30,8 @@ int cgns_ho_type(cgns_elem_t type)
     case CGNS_ENUMV(HEXA_27):  return GETME_HEX27;
     case CGNS_ENUMV(PENTA_15): return GETME_PRISM15;
     case CGNS_ENUMV(PENTA_18): return GETME_PRISM18;
+    case CGNS_ENUMV(PYRA_13):  return GETME_PYRAMID13;
+    case CGNS_ENUMV(PYRA_14):  return GETME_PYRAMID14;
     default:                   return -1;
     }
 }
@@ -39,6 +44,7 @@ const int8_t *cgns_ho_order(int ho_type)
     case GETME_TET10: return order_tetra10;
     case GETME_HEX20: case GETME_HEX27: return order_hexa27;
     case GETME_PRISM15: case GETME_PRISM18: return order_penta18;
+    case GETME_PYRAMID13: case GETME_PYRAMID14: return order_pyra14;
     default: return NULL;
     }
 }

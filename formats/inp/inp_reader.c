@@ -545,12 +545,17 @@ static getme_io_status kw_element(reader *rd)
         up[i] = (char)(type[i] >= 'a' && type[i] <= 'z' ? type[i] - 32 : type[i]);
     rd->kind = inp_element_kind(up, &rd->gtype, &rd->nv);
     memcpy(rd->type, up, sizeof up);
+    /* 13 nodes: a second-order pyramid, which neither Abaqus (C3D5 is its
+       only pyramid) nor CalculiX defines, so no deck fixes its node order */
     if (rd->kind == INP_KIND_SOLID2)
         return fail(rd, GETME_IO_ERR_UNSUPPORTED,
-                    "element type %s is second order (%d nodes): getme smooths "
-                    "linear elements (C3D4, C3D5, C3D6, C3D8, CPS3, CPS4...) "
-                    "and C3D10, C3D15, C3D20",
-                    up, rd->nv);
+                    "element type %s is second order (%d nodes)%s: getme "
+                    "smooths linear elements (C3D4, C3D5, C3D6, C3D8, CPS3, "
+                    "CPS4...) and C3D10, C3D15, C3D20",
+                    up, rd->nv,
+                    rd->nv == 13 ? ", a pyramid that Abaqus and CalculiX do "
+                                   "not define"
+                                 : "");
     if (rd->kind == INP_KIND_PLANAR2 && rd->d->planar2_line == 0) {
         rd->d->planar2_file = rd->file;
         rd->d->planar2_line = rd->line;

@@ -83,7 +83,8 @@ int getme__msh_type_getme(int msh_type)
 
 /* Second-order volume types smoothed with their corners (Gmsh's node order
    is getme_mesh_add_elements_ho's, docs/highorder.md): 11 tet10, 17 hex20,
-   12 hex27, 18 prism15, 13 prism18 in a 3-D mesh; -1 otherwise. */
+   12 hex27, 18 prism15, 13 prism18, 19 pyramid13, 14 pyramid14 in a 3-D
+   mesh; -1 otherwise. */
 int getme__msh_type_ho(int msh_type, int dim)
 {
     switch (dim == 3 ? msh_type : 0) {
@@ -92,6 +93,8 @@ int getme__msh_type_ho(int msh_type, int dim)
     case 12: return GETME_HEX27;
     case 18: return GETME_PRISM15;
     case 13: return GETME_PRISM18;
+    case 19: return GETME_PYRAMID13;
+    case 14: return GETME_PYRAMID14;
     default: return -1;
     }
 }

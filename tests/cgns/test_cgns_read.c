@@ -203,12 +203,13 @@ static void test_malformed(const char *good_h5, const char *good_adf)
                          tet_bad, 0);
     expect_fail(path_of("range.cgns"), GETME_FORMATS_ERR_PARSE,
                 "/Base/Zone/Elem_TETRA_4: element 28 refers to node 999", NULL);
-    /* second-order pyramids (the volume types getme does not smooth; the
-       others: tests/highorder) are refused with the node path */
-    cgsize_t pyra13[13] = {1, 2, 5, 4, 17, 3, 6, 7, 8, 9, 10, 11, 12};
-    fixture_write_custom(path_of("pyra13.cgns"), CGNS_ENUMV(PYRA_13), 1, pyra13, 0);
-    expect_fail(path_of("pyra13.cgns"), GETME_FORMATS_ERR_UNSUPPORTED,
-                "/Base/Zone/Elem_PYRA_13", "PYRA_13");
+    /* third-order volume types (second order: tests/highorder) are
+       refused with the node path */
+    cgsize_t tet20[20] = {1,  2,  5,  17, 3,  6,  7,  8,  9,  10,
+                          11, 12, 13, 14, 15, 16, 18, 19, 20, 21};
+    fixture_write_custom(path_of("tetra20.cgns"), CGNS_ENUMV(TETRA_20), 1, tet20, 0);
+    expect_fail(path_of("tetra20.cgns"), GETME_FORMATS_ERR_UNSUPPORTED,
+                "/Base/Zone/Elem_TETRA_20", "TETRA_20");
     /* a TRI_6 boundary section only fixes its nodes */
     cgsize_t tri6[6] = {1, 2, 5, 3, 4, 6};
     fixture_write_custom(path_of("tri6.cgns"), CGNS_ENUMV(TRI_6), 1, tri6, 0);

@@ -23,6 +23,10 @@ TYPES[12] = ("hex27", 8, TYPES[17][2],
               (26, 0, 1, 2, 3, 4, 5, 6, 7)])
 TYPES[13] = ("prism18", 6, TYPES[18][2],
              [(15, 0, 1, 4, 3), (16, 0, 2, 5, 3), (17, 1, 2, 5, 4)])
+TYPES[19] = ("pyramid13", 5, [(5, 0, 1), (6, 0, 3), (7, 0, 4), (8, 1, 2),
+                              (9, 1, 4), (10, 2, 3), (11, 2, 4), (12, 3, 4)],
+             [])
+TYPES[14] = ("pyramid14", 5, TYPES[19][2], [(13, 0, 1, 2, 3)])
 
 
 def check_tables():
@@ -109,3 +113,52 @@ def min_node_jacobian_arrays(xyz, gtype, conn):
     _, dets, _ = gmsh.model.mesh.getJacobians(gtype, p[4])
     d = np.array(dets).reshape(-1, p[3])
     return d.min(), int((d.min(axis=1) <= 0).sum())
+
+
+def pyramid_space_errors():
+    """The pyramid space of highorder_basis.c (xh^a yh^b w^max(a,b) z^c,
+    w = 1 - z, xh = x / w, yh = y / w; pyramid13 without a = b = 2),
+    rebuilt here with numpy: largest difference of its Lagrange functions'
+    values and gradients from gmsh.model.mesh.getBasisFunctions for types
+    19 and 14, at two interior points and the apex (axis limit)."""
+    def space(n):
+        s = [(a, b, c) for a in range(3) for b in range(3)
+             for c in range(3 - max(a, b))]
+        return [e for e in s if n == 14 or e[:2] != (2, 2)]
+
+    def fn(e, p, d):
+        a, b, c = e
+        m, w, z = max(a, b), 1 - p[2], p[2]
+        xh, yh = (p[0] / w, p[1] / w) if w else (0.0, 0.0)
+        pw = lambda t, k: 1.0 if k == 0 else t ** k
+        if d < 0:
+            return pw(xh, a) * pw(yh, b) * pw(w, m) * pw(z, c)
+        if d < 2:
+            k = (a, b)[d]
+            if k == 0:
+                return 0.0
+            ea = (a - 1, b) if d == 0 else (a, b - 1)
+            return k * pw(xh, ea[0]) * pw(yh, ea[1]) * pw(w, m - 1) * pw(z, c)
+        v = 0.0
+        if a + b > m:
+            v += (a + b - m) * pw(xh, a) * pw(yh, b) * pw(w, m - 1) * pw(z, c)
+        if c:
+            v += c * pw(xh, a) * pw(yh, b) * pw(w, m) * pw(z, c - 1)
+        return v
+
+    worst = 0.0
+    pts = [0.3, -0.2, 0.4, 0.1, 0.2, 0.7, 0.0, 0.0, 1.0]
+    for t, n in ((19, 13), (14, 14)):
+        ref = np.array(gmsh.model.mesh.getElementProperties(t)[4]).reshape(-1, 3)
+        s = space(n)
+        inv = np.linalg.inv(np.array([[fn(e, r, -1) for e in s] for r in ref]))
+        _, bf, _ = gmsh.model.mesh.getBasisFunctions(t, pts, "Lagrange")
+        _, gf, _ = gmsh.model.mesh.getBasisFunctions(t, pts, "GradLagrange")
+        bf, gf = np.array(bf).reshape(3, n), np.array(gf).reshape(3, n, 3)
+        for i in range(3):
+            p = pts[3 * i:3 * i + 3]
+            val = np.array([fn(e, p, -1) for e in s]) @ inv
+            grad = inv.T @ np.array([[fn(e, p, d) for d in range(3)] for e in s])
+            worst = max(worst, abs(grad - gf[i]).max(),
+                        abs(val - bf[i]).max() if i < 2 else 0.0)
+    return worst

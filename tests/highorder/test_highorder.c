@@ -242,8 +242,50 @@ static void test_topology(void)
     getme_mesh_free(m);
 }
 
+/* Second-order pyramids: rational shape functions (Gmsh's, docs/highorder.md).
+   Expected values are gmsh.model.mesh.getJacobians (Gmsh 4.8) at the 13/14
+   reference nodes of this element: Gmsh's reference pyramid with mid-node 5
+   moved by (0, .3, 0), mid-node 7 (edge 0-apex) by (.1, .1, -.2) and, for
+   pyramid14, the base centre by (0, 0, dz).  det J is 0.2 at node 0 and 1.1
+   at most (0.2 / 1.1 for both types at dz = 0.1); at dz = 0.25 Gmsh gives
+   det J = 0 (-1.1e-16) at node 6. */
+static void test_pyramid(void)
+{
+    static const double ref[14][3] = {
+        {-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, {0, 0, 1},
+        {0, -1, 0}, {-1, 0, 0}, {-.5, -.5, .5}, {1, 0, 0}, {.5, -.5, .5},
+        {0, 1, 0}, {.5, .5, .5}, {-.5, .5, .5}, {0, 0, 0}};
+    const double dz[3] = {0, 0.1, 0.25};
+    for (int c = 0; c < 3; c++) {
+        int pyr14 = c > 0;
+        double xyz[42];
+        memcpy(xyz, ref, sizeof xyz);
+        xyz[3 * 5 + 1] += 0.3;
+        xyz[3 * 7 + 0] += 0.1, xyz[3 * 7 + 1] += 0.1, xyz[3 * 7 + 2] -= 0.2;
+        xyz[3 * 13 + 2] += dz[c];
+        int32_t conn[14] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13};
+        getme_mesh *m;
+        CHECK(getme_mesh_create(&m, 3, 14, xyz) == GETME_OK);
+        CHECK(getme_mesh_add_elements_ho(
+                  m, pyr14 ? GETME_PYRAMID14 : GETME_PYRAMID13, 1, conn,
+                  NULL) == GETME_OK);
+        CHECK_EQ_INT(getme_mesh_num_elements_of_type(m, GETME_PYRAMID), 1);
+        double r = 0;
+        CHECK(getme_mesh_element_jacobian_ratio(m, 0, &r) == GETME_OK);
+        if (c < 2)
+            CHECK_NEAR(r, 0.2 / 1.1, 1e-12);
+        else
+            CHECK_NEAR(r, 0.0, 1e-12);
+        getme_mesh_free(m);
+    }
+    CHECK_EQ_INT(getme_ho_type_num_nodes(GETME_PYRAMID13), 13);
+    CHECK_EQ_INT(getme_ho_type_num_nodes(GETME_PYRAMID14), 14);
+    CHECK(!strcmp(getme_ho_type_name(GETME_PYRAMID14), "pyramid14"));
+}
+
 int main(void)
 {
+    test_pyramid();
     test_jacobian_ratio();
     test_hex27_smooth();
     test_pinned_midnode();

@@ -41,6 +41,16 @@ def model(kind):
         gmsh.model.occ.addCylinder(0, 0, 0, 0, 0, 1, 0.5)
         gmsh.model.occ.synchronize()
         gmsh.option.setNumber("Mesh.MeshSizeMax", 0.15)
+    elif kind.startswith("pyr"):
+        # hex block and tet block sharing a quad face: pyramids on it
+        geo = gmsh.model.geo
+        p = geo.addPoint(0, 0, 0)
+        ln = geo.extrude([(0, p)], 1, 0, 0, [4], recombine=True)
+        s = geo.extrude([ln[1]], 0, 1, 0, [4], recombine=True)
+        v = geo.extrude([s[1]], 0, 0, 1, [4], recombine=True)
+        geo.extrude([[e for e in v if e[0] == 2][2]], 1, 0, 0)
+        geo.synchronize()
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 0.25)
     else:
         geo = gmsh.model.geo
         p = geo.addPoint(0, 0, 0)
@@ -51,7 +61,7 @@ def model(kind):
         geo.synchronize()
     gmsh.model.mesh.generate(3)
     gmsh.option.setNumber("Mesh.SecondOrderIncomplete",
-                          1 if kind in ("hex20", "prism15") else 0)
+                          1 if kind in ("hex20", "prism15", "pyr13") else 0)
     gmsh.model.mesh.setOrder(2)
 
 
@@ -131,7 +141,8 @@ def reader_paths():
 
 gmsh.initialize()
 gmsh.option.setNumber("General.Terminal", 0)
-for kind in ("tet10", "hex20", "hex27", "prism15", "prism18"):
+for kind in ("tet10", "hex20", "hex27", "prism15", "prism18", "pyr13",
+             "pyr14"):
     live(kind)
 reader_paths()
 gmsh.finalize()

@@ -60,7 +60,19 @@ def generate(kind, version, binary, n=4):
     """Unit cube of kind tet10/hex20/hex27/prism15/prism18, written by Gmsh."""
     gmsh.clear()
     gmsh.model.add(kind)
-    if kind.startswith("tet"):
+    if kind.startswith("pyr"):
+        # a hex block [0,1]^3 and a tet block [1,2]x[0,1]^2 sharing its quad
+        # face: Gmsh puts pyramids on the tets' side of that face
+        geo = gmsh.model.geo
+        p = geo.addPoint(0, 0, 0)
+        ln = geo.extrude([(0, p)], 1, 0, 0, [n], recombine=True)
+        s = geo.extrude([ln[1]], 0, 1, 0, [n], recombine=True)
+        v = geo.extrude([s[1]], 0, 0, 1, [n], recombine=True)
+        right = [e for e in v if e[0] == 2][2]
+        geo.extrude([right], 1, 0, 0)
+        geo.synchronize()
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 1.0 / n)
+    elif kind.startswith("tet"):
         gmsh.model.occ.addBox(0, 0, 0, 1, 1, 1)
         gmsh.model.occ.synchronize()
         gmsh.option.setNumber("Mesh.MeshSizeMax", 1.0 / n)
@@ -76,7 +88,7 @@ def generate(kind, version, binary, n=4):
     gmsh.model.addPhysicalGroup(3, [t for _, t in gmsh.model.getEntities(3)])
     gmsh.model.mesh.generate(3)
     gmsh.option.setNumber("Mesh.SecondOrderIncomplete",
-                          1 if kind in ("hex20", "prism15") else 0)
+                          1 if kind in ("hex20", "prism15", "pyr13") else 0)
     gmsh.model.mesh.setOrder(2)
     gmsh.option.setNumber("Mesh.MshFileVersion", version)
     gmsh.option.setNumber("Mesh.Binary", 1 if binary else 0)
@@ -119,7 +131,11 @@ def case(kind, version, binary):
     tag = "%s %s%s" % (kind, version, " binary" if binary else "")
     src = generate(kind, version, binary)
     c0, e0, low = ho_check.load(src)
-    check(ho_check.midpoint_errors(c0, e0) < 1e-12,
+    # the two-block pyramid model: Gmsh itself puts its mid-nodes on the
+    # extruded surfaces up to 1.5e-12 of the edge (1.2e-13 for hex27 face
+    # nodes), and MSH 2.2 has no classification to tell them from interior
+    tol = 1e-11 if kind.startswith("pyr") else 1e-12
+    check(ho_check.midpoint_errors(c0, e0) < tol,
           "%s: Gmsh's straight-sided input has its nodes where the tables "
           "say" % tag)
     dis, out1, out2 = src[:-4] + "-d.msh", src[:-4] + "-s1.msh", src[:-4] + "-s2.msh"
@@ -129,7 +145,7 @@ def case(kind, version, binary):
     check(bad == 0 and wd > 0, "%s: distorted min node det J %g" % (tag, wd))
     c1, e1, _ = ho_check.load(dis)
     interior = set(c1) - low
-    check(ho_check.midpoint_errors(c1, e1, interior) < 1e-12,
+    check(ho_check.midpoint_errors(c1, e1, interior) < tol,
           "%s: distorted interior mid-nodes at midpoints" % tag)
     moved = sum(1 for t in interior if not np.array_equal(c0[t], c1[t]))
     check(moved > len(interior) // 4, "%s: distort moved %d of %d interior "
@@ -154,7 +170,7 @@ def case(kind, version, binary):
     check(low2 == low, "%s: classification unchanged" % tag)
     check(all(np.array_equal(c1[t], c2[t]) for t in low),
           "%s: skin nodes (corners and mid-nodes) bit-identical" % tag)
-    check(ho_check.midpoint_errors(c2, e2, interior) < 1e-12,
+    check(ho_check.midpoint_errors(c2, e2, interior) < tol,
           "%s: smoothed interior mid-nodes at midpoints" % tag)
     check(outside_coords_equal(dis, out1),
           "%s: output equals input outside node coordinates" % tag)
@@ -163,7 +179,8 @@ def case(kind, version, binary):
               "%s: connectivity of type %d unchanged" % (tag, t))
     # meshio 1.x (Debian) has no topological dimension for wedge15 and
     # raises reading it: its own limitation, so prism15 is not round-tripped
-    if version == 4.1 and not binary and kind != "prism15":
+    if version == 4.1 and not binary and kind not in ("prism15", "pyr13",
+                                                      "pyr14"):
         meshio_round_trip(out1, c2, e2, tag)
     return ws
 
@@ -261,7 +278,11 @@ gmsh.initialize()
 gmsh.option.setNumber("General.Terminal", 0)
 bad = ho_check.check_tables()
 check(not bad, "node-order tables against Gmsh's reference elements: %s" % bad)
-for kind in ("tet10", "hex20", "hex27", "prism15", "prism18"):
+err = ho_check.pyramid_space_errors()
+check(err < 1e-12, "the pyramids' rational space gives Gmsh's basis functions "
+      "and gradients (apex included): %g" % err)
+for kind in ("tet10", "hex20", "hex27", "prism15", "prism18", "pyr13",
+             "pyr14"):
     for version, binary in ((4.1, False), (4.1, True), (2.2, False)):
         w = case(kind, version, binary)
         print("%-8s %s%s: min node det J after smoothing %.4g" %

@@ -29,7 +29,8 @@ static const bad_case cases[] = {
     {TET_NODES "*ELEMENT, TYPE=C3D4\n1, 1, 2,\n", GETME_FORMATS_ERR_PARSE,
      "file ends inside element 1"},
     {TET_NODES "*ELEMENT, TYPE=C3D13\n1, 1, 2, 3, 4, 1, 2, 3, 4, 1, 2, 3, 4, 1\n",
-     GETME_FORMATS_ERR_UNSUPPORTED, "bad.inp:6: element type C3D13 is second order"},
+     GETME_FORMATS_ERR_UNSUPPORTED, "bad.inp:6: element type C3D13 is second order (13 nodes), a pyramid "
+                                     "that Abaqus and CalculiX do not define"},
     {TET_NODES "*ELEMENT, TYPE=CPS8\n1, 1, 2, 3, 4, 1, 2, 3, 4\n",
      GETME_FORMATS_ERR_UNSUPPORTED, "bad.inp:6: element type CPS8 is second order"},
     {TET_NODES "*ELEMENT, TYPE=B31\n1, 1, 2\n", GETME_FORMATS_ERR_UNSUPPORTED,
