@@ -84,9 +84,12 @@ int getme__msh_type_getme(int msh_type)
 /* Second-order volume types smoothed with their corners (Gmsh's node order
    is getme_mesh_add_elements_ho's, docs/highorder.md): 11 tet10, 17 hex20,
    12 hex27, 18 prism15, 13 prism18, 19 pyramid13, 14 pyramid14 in a 3-D
-   mesh; -1 otherwise. */
+   mesh; 9 tri6, 16 quad8, 10 quad9 in a planar one; -1 otherwise. */
 int getme__msh_type_ho(int msh_type, int dim)
 {
+    if (dim == 2)
+        return msh_type == 9 ? GETME_TRI6 : msh_type == 16 ? GETME_QUAD8
+               : msh_type == 10 ? GETME_QUAD9 : -1;
     switch (dim == 3 ? msh_type : 0) {
     case 11: return GETME_TET10;
     case 17: return GETME_HEX20;

@@ -13,7 +13,9 @@
  * Gmsh orients each surface mesh like its surface, so two surfaces of one
  * plane can be oriented oppositely; libgetme wants one orientation, so the
  * elements of clockwise surfaces are handed over with reversed node order
- * (this only changes our copy, never the Gmsh model).
+ * (this only changes our copy, never the Gmsh model).  Second-order
+ * elements (tri6, quad8, quad9) are reversed with their mid-edge nodes, so
+ * each mid-node stays on its edge (reverse_element).
  */
 #include "model.h"
 
@@ -45,6 +47,18 @@ static double dot3(const double *a, const double *b)
 }
 
 static double norm3(const double *a) { return sqrt(dot3(a, a)); }
+
+/* Corners and all nodes of an element of a planar block (MSH type: 2 tri,
+   3 quad, 9 tri6, 16 quad8, 10 quad9). */
+static int corners_of(const getme__model_block *b)
+{
+    return getme__msh_type_corners(b->type, 2) == GETME_TRI ? 3 : 4;
+}
+
+static int nodes_of(const getme__model_block *b)
+{
+    return getme__msh_type_nodes(b->type, NULL);
+}
 
 /* Twice the area vector of a tri, or of a quad through its diagonals. */
 static void element_normal(const double *xyz, const int32_t *c, int nv,
@@ -100,9 +114,9 @@ static int surface_normal(const double *xyz, const getme__model_block *blocks, s
     double ref[3] = {0, 0, 0}, e[3];
     nrm[0] = nrm[1] = nrm[2] = 0;
     for (size_t b = b0; b < b1; b++) {
-        int nv = blocks[b].type == 2 ? 3 : 4;
+        int nv = corners_of(&blocks[b]), stride = nodes_of(&blocks[b]);
         for (int32_t i = 0; i < blocks[b].count; i++) {
-            element_normal(xyz, blocks[b].conn + (size_t)nv * i, nv, e);
+            element_normal(xyz, blocks[b].conn + (size_t)stride * i, nv, e);
             if (norm3(ref) == 0)
                 memcpy(ref, e, sizeof ref);
             double s = dot3(e, ref) < 0 ? -1.0 : 1.0;
@@ -125,7 +139,7 @@ static double plane_distance(const double *xyz, const getme__model_block *blocks
 {
     double worst = 0, d[3];
     for (size_t b = b0; b < b1; b++) {
-        int nv = blocks[b].type == 2 ? 3 : 4;
+        int nv = nodes_of(&blocks[b]);
         for (int64_t i = 0; i < (int64_t)blocks[b].count * nv; i++) {
             sub3(xyz + 3 * blocks[b].conn[i], p0, d);
             worst = fmax(worst, fabs(dot3(d, nrm)));
@@ -228,11 +242,20 @@ static double signed_area(const double *xyz, const int32_t *c, int nv)
     return 0.5 * s;
 }
 
-static void reverse_element(int32_t *c, int nv)
+/* Corners 0 1 .. n-1 become 0 n-1 .. 1 (swap 1 and n-1, enough for n = 3,
+   4).  Mid-edge node k of edge (k, k+1) then belongs to the new edge n-1-k,
+   so the mid-edge list (Gmsh order: after the corners) is reversed; a
+   quad9's centre stays. */
+static void reverse_element(int32_t *c, int nv, int all)
 {
     int32_t t = c[1];
     c[1] = c[nv - 1];
     c[nv - 1] = t;
+    for (int i = 0, j = nv - 1; all > nv && i < j; i++, j--) {
+        t = c[nv + i];
+        c[nv + i] = c[nv + j];
+        c[nv + j] = t;
+    }
 }
 
 static void orient_surfaces(const double *xyz,
@@ -242,16 +265,18 @@ static void orient_surfaces(const double *xyz,
         size_t b1 = entity_end(blocks, nb, b0);
         double total = 0;
         for (size_t b = b0; b < b1; b++) {
-            int nv = blocks[b].type == 2 ? 3 : 4;
+            int nv = corners_of(&blocks[b]), stride = nodes_of(&blocks[b]);
             for (int32_t i = 0; i < blocks[b].count; i++)
-                total += signed_area(xyz, blocks[b].conn + (size_t)nv * i, nv);
+                total += signed_area(xyz, blocks[b].conn + (size_t)stride * i,
+                                     nv);
         }
         if (total >= 0)
             continue;
         for (size_t b = b0; b < b1; b++) {
-            int nv = blocks[b].type == 2 ? 3 : 4;
+            int nv = corners_of(&blocks[b]), stride = nodes_of(&blocks[b]);
             for (int32_t i = 0; i < blocks[b].count; i++)
-                reverse_element(blocks[b].conn + (size_t)nv * i, nv);
+                reverse_element(blocks[b].conn + (size_t)stride * i, nv,
+                                stride);
         }
     }
 }
