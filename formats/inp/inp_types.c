@@ -59,12 +59,20 @@ static const int8_t order_c3d20[20] = {0,  1,  2,  3,  4,  5,  6,
                                        7,  8,  11, 16, 9,  17, 10,
                                        18, 19, 12, 15, 13, 14};
 
+/* The planar ones (CPS6, CPS8, STRI65, M3D9, S9R5...): corners, then the
+   mid-edge nodes of edges 1-2, 2-3, ... in turn, then (9 nodes) the centre:
+   Gmsh's tri6/quad8/quad9 order as it is (test_highorder_planar.py). */
+static const int8_t order_same[9] = {0, 1, 2, 3, 4, 5, 6, 7, 8};
+
 const int8_t *inp_ho_order(int ho_type)
 {
     return ho_type == GETME_TET10     ? order_c3d10
            : ho_type == GETME_PRISM15 ? order_c3d15
            : ho_type == GETME_HEX20   ? order_c3d20
-                                      : NULL;
+           : ho_type == GETME_TRI6 || ho_type == GETME_QUAD8 ||
+                   ho_type == GETME_QUAD9
+               ? order_same
+               : NULL;
 }
 
 inp_kind inp_element_kind(const char *type, int *gtype, int *nv)
@@ -92,7 +100,8 @@ inp_kind inp_element_kind(const char *type, int *gtype, int *nv)
     /* STRI65: triangular shell, 6 nodes ("65": 6 nodes, 5 dof). */
     if (strcmp(type, "STRI65") == 0) {
         *nv = 6;
-        return INP_KIND_PLANAR2;
+        *gtype = INP_HO + GETME_TRI6;
+        return INP_KIND_PLANAR;
     }
     for (int i = 0; planar_families[i]; i++) {
         int c = family_count(type, planar_families[i]);
@@ -102,7 +111,10 @@ inp_kind inp_element_kind(const char *type, int *gtype, int *nv)
         switch (c) {
         case 3: *gtype = GETME_TRI; return INP_KIND_PLANAR;
         case 4: *gtype = GETME_QUAD; return INP_KIND_PLANAR;
-        case 6: case 8: case 9: return INP_KIND_PLANAR2;
+        /* second order, smoothed with their corners */
+        case 6: *gtype = INP_HO + GETME_TRI6; return INP_KIND_PLANAR;
+        case 8: *gtype = INP_HO + GETME_QUAD8; return INP_KIND_PLANAR;
+        case 9: *gtype = INP_HO + GETME_QUAD9; return INP_KIND_PLANAR;
         default: *nv = 0; return INP_KIND_OTHER;
         }
     }

@@ -173,10 +173,81 @@ def case(kind):
           (kind, q[0], q[-1], moved), flush=True)
 
 
+def read_inp_nodes(path):
+    xyz, on = {}, False
+    for line in open(path):
+        if line.startswith("*"):
+            on = line.upper().startswith("*NODE")
+            continue
+        if on and line.strip():
+            f = line.split(",")
+            xyz[int(f[0])] = np.array([float(v) for v in f[1:4]])
+    return xyz
+
+
+def flip(row, nc):
+    """Reverse an element: corners 0, nc-1, ..., 1 and the mid-edge nodes
+    in reverse (the centre stays): an independent statement of the rule
+    in planar.c."""
+    row = list(row)
+    mids = row[nc:2 * nc]
+    return [row[0]] + row[1:nc][::-1] + mids[::-1] + row[2 * nc:]
+
+
+def inp_case(kind):
+    """The same mesh as an Abaqus deck (CPS6, CPS8R, M3D9), every element
+    clockwise: the core smooths it as its mirror image (getme.h)."""
+    gtype, abq = {"tri6": (9, "CPS6"), "quad8": (16, "CPS8R"),
+                  "quad9": (10, "M3D9")}[kind]
+    c0, e0, low, _ = load(os.path.join(WORK, kind + "-d.msh"))
+    nc = TYPES[gtype][0]
+    rows = [r if signed_area(c0, r, nc) < 0 else flip(r, nc)
+            for r in e0[gtype]]
+    check(all(signed_area(c0, r, nc) < 0 for r in rows) and
+          midpoint_error(c0, {gtype: np.array(rows)}, set(c0) - low) < 1e-12,
+          "%s INP: flip() keeps the mid-nodes on their edges" % kind)
+    src = os.path.join(WORK, kind + ".inp")
+    with open(src, "w") as f:
+        f.write("*NODE\n")
+        for t in sorted(c0):
+            f.write("%d, %r, %r, %r\n" % ((t,) + tuple(c0[t])))
+        f.write("*ELEMENT, TYPE=%s, ELSET=ALL\n" % abq)
+        for i, r in enumerate(rows):
+            f.write("%d, %s\n" % (i + 1, ", ".join(str(v) for v in r)))
+    o1, o2 = src[:-4] + "-s1.inp", src[:-4] + "-s2.inp"
+    r1 = run("smooth", src, "-o", o1, "-v", threads=1)
+    r2 = run("smooth", src, "-o", o2, "-v", threads=2)
+    check(r1.returncode == 0 and r2.returncode == 0,
+          "%s INP: smooth exit %d/%d %s" % (kind, r1.returncode, r2.returncode,
+                                            r1.stderr[-300:]))
+    check(open(o1, "rb").read() == open(o2, "rb").read(),
+          "%s INP: 1 and 2 threads byte-identical" % kind)
+    c2 = read_inp_nodes(o1)
+    skin = {t for t, p in c0.items() if p[0] in (0, 1) or p[1] in (0, 1)}
+    check(all(np.array_equal(c0[t], c2[t]) for t in skin),
+          "%s INP: skin nodes bit-identical" % kind)
+    inner = set(c0) - skin
+    moved = sum(1 for t in inner if not np.array_equal(c0[t], c2[t]))
+    check(moved > len(inner) // 2, "%s INP: moved %d of %d" %
+          (kind, moved, len(inner)))
+    err = midpoint_error(c2, {gtype: np.array(rows)}, inner)
+    check(err < 1e-12, "%s INP: interior mid-nodes at midpoints (%g)" %
+          (kind, err))
+    check(all(signed_area(c2, r, nc) < 0 for r in rows),
+          "%s INP: every element still clockwise (valid)" % kind)
+    q = [float(v) for v in re.findall(r"qmean ([0-9.]+)", r1.stdout + r1.stderr)]
+    check(len(q) >= 2 and q[-1] > q[0] + 0.05, "%s INP: q_mean rises %s" %
+          (kind, q))
+    print("%-6s INP (%s, all clockwise) ok: q_mean %.4f -> %.4f" %
+          (kind, abq, q[0], q[-1]),
+          flush=True)
+
+
 gmsh.initialize()
 gmsh.option.setNumber("General.Terminal", 0)
 for kind in ("tri6", "quad8", "quad9"):
     case(kind)
+    inp_case(kind)
 gmsh.finalize()
 print("%d failure(s)" % len(FAILED))
 sys.exit(1 if FAILED else 0)

@@ -31,8 +31,9 @@ static const bad_case cases[] = {
     {TET_NODES "*ELEMENT, TYPE=C3D13\n1, 1, 2, 3, 4, 1, 2, 3, 4, 1, 2, 3, 4, 1\n",
      GETME_FORMATS_ERR_UNSUPPORTED, "bad.inp:6: element type C3D13 is second order (13 nodes), a pyramid "
                                      "that Abaqus and CalculiX do not define"},
-    {TET_NODES "*ELEMENT, TYPE=CPS8\n1, 1, 2, 3, 4, 1, 2, 3, 4\n",
-     GETME_FORMATS_ERR_UNSUPPORTED, "bad.inp:6: element type CPS8 is second order"},
+    /* CPS8 is read (second order, tests/highorder); a repeated node is not */
+    {TET_NODES "*ELEMENT, TYPE=CPS8\n1, 1, 2, 3, 1, 2, 3, 1, 2\n",
+     GETME_FORMATS_ERR_INVALID, "bad.inp:7: element 1 is degenerate: node 1 appears twice"},
     {TET_NODES "*ELEMENT, TYPE=B31\n1, 1, 2\n", GETME_FORMATS_ERR_UNSUPPORTED,
      "no linear solid"},
     {"*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 0, 1, 1\n*ELEMENT, TYPE=CPS3\n"
