@@ -1,6 +1,7 @@
 /*
  * cgns_highorder.c -- CGNS second-order volume elements (TETRA_10,
- * HEXA_20, HEXA_27, PENTA_15, PENTA_18, PYRA_13, PYRA_14): which getme_ho_type each is, and
+ * HEXA_20, HEXA_27, PENTA_15, PENTA_18, PYRA_13, PYRA_14) and planar
+ * ones (TRI_6, QUAD_8, QUAD_9): which getme_ho_type each is, and
  * the CGNS (SIDS) node order mapped to Gmsh's, the order of
  * getme_mesh_add_elements_ho.  SIDS lists the mid-edge nodes edge by edge
  * around the bottom face, then the vertical edges, then around the top
@@ -16,6 +17,10 @@ static const int8_t order_tetra10[10] = {0, 1, 2, 3, 4, 5, 6, 7, 9, 8};
 static const int8_t order_hexa27[27] = {
     0,  1,  2,  3,  4,  5,  6,  7,  8,  11, 12, 9,  13, 10,
     14, 15, 16, 19, 17, 18, 20, 21, 24, 22, 23, 25, 26};
+/* TRI_6, QUAD_8, QUAD_9 (2-D zones; in a 3-D zone they are boundary faces
+   and only fix their nodes): corners, the mid-edge nodes of edges 1-2,
+   2-3, ... in turn, then QUAD_9's centre, as Gmsh. */
+static const int8_t order_same[9] = {0, 1, 2, 3, 4, 5, 6, 7, 8};
 /* PYRA_14: base edges 1-2, 2-3, 3-4, 4-1, then 1-5 ... 4-5, base centre. */
 static const int8_t order_pyra14[14] = {0, 1, 2, 3,  4,  5,  8,
                                         9, 6, 10, 7, 11, 12, 13};
@@ -32,6 +37,9 @@ int cgns_ho_type(cgns_elem_t type)
     case CGNS_ENUMV(PENTA_18): return GETME_PRISM18;
     case CGNS_ENUMV(PYRA_13):  return GETME_PYRAMID13;
     case CGNS_ENUMV(PYRA_14):  return GETME_PYRAMID14;
+    case CGNS_ENUMV(TRI_6):    return GETME_TRI6;
+    case CGNS_ENUMV(QUAD_8):   return GETME_QUAD8;
+    case CGNS_ENUMV(QUAD_9):   return GETME_QUAD9;
     default:                   return -1;
     }
 }
@@ -45,6 +53,7 @@ const int8_t *cgns_ho_order(int ho_type)
     case GETME_HEX20: case GETME_HEX27: return order_hexa27;
     case GETME_PRISM15: case GETME_PRISM18: return order_penta18;
     case GETME_PYRAMID13: case GETME_PYRAMID14: return order_pyra14;
+    case GETME_TRI6: case GETME_QUAD8: case GETME_QUAD9: return order_same;
     default: return NULL;
     }
 }

@@ -267,8 +267,9 @@ static getme_io_status refuse(const zone_ctx *c, const cgns_section *sec,
         : (t == CGNS_ENUMV(NGON_n) || t == CGNS_ENUMV(NFACE_n))
             ? "polygonal/polyhedral elements are not smoothed"
             : "only TETRA_4, PYRA_5, PENTA_6, HEXA_8, TETRA_10, HEXA_20, "
-              "HEXA_27, PENTA_15, PENTA_18 (3-D) and TRI_3, QUAD_4 (2-D) "
-              "elements are smoothed";
+              "HEXA_27, PENTA_15, PENTA_18, PYRA_13, PYRA_14 (3-D) and "
+              "TRI_3, QUAD_4, TRI_6, QUAD_8, QUAD_9 (2-D) elements are "
+              "smoothed";
     return getme_doc_fail(c->doc, GETME_IO_ERR_UNSUPPORTED,
                           "%s: %s/%s: element %ld is %s: %s", c->doc->path,
                           c->path, sec->name, (long)number,

@@ -2,7 +2,7 @@
  * cgns_ho_write.c -- write a CGNS file with libcgns from a text
  * description, for test_highorder_cgns.py (Gmsh cannot write CGNS here and
  * meshio writes tetrahedra only):
- *   cgns_ho_write IN.txt OUT.cgns
+ *   cgns_ho_write IN.txt OUT.cgns [CELL_DIM]   (default 3; 2 for planar)
  * IN.txt: the node count N, N lines "x y z", then sections
  * "<SIDS type name> <count> <nodes per element>" each followed by count
  * lines of 1-based node numbers in the CGNS order.
@@ -22,8 +22,8 @@ static int type_by_name(const char *name)
 
 int main(int argc, char **argv)
 {
-    if (argc != 3) {
-        fprintf(stderr, "usage: cgns_ho_write IN.txt OUT.cgns\n");
+    if (argc != 3 && argc != 4) {
+        fprintf(stderr, "usage: cgns_ho_write IN.txt OUT.cgns [CELL_DIM]\n");
         return 2;
     }
     FILE *f = fopen(argv[1], "r");
@@ -53,7 +53,7 @@ int main(int argc, char **argv)
     fseek(f, pos, SEEK_SET);
     int fn, B, Z, C, S;
     cgsize_t size[3] = {(cgsize_t)n, (cgsize_t)ne, 0};
-    if (cg_open(argv[2], CG_MODE_WRITE, &fn) || cg_base_write(fn, "Base", 3, 3, &B) ||
+    if (cg_open(argv[2], CG_MODE_WRITE, &fn) || cg_base_write(fn, "Base", argc == 4 ? atoi(argv[3]) : 3, 3, &B) ||
         cg_zone_write(fn, B, "Zone", size, CGNS_ENUMV(Unstructured), &Z) ||
         cg_coord_write(fn, B, Z, CGNS_ENUMV(RealDouble), "CoordinateX", c[0], &C) ||
         cg_coord_write(fn, B, Z, CGNS_ENUMV(RealDouble), "CoordinateY", c[1], &C) ||

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """
-test_highorder_planar.py GETME WORKDIR -- planar second-order meshes
+test_highorder_planar.py GETME WORKDIR [CGNS_HO_WRITE] -- planar second-order meshes
 (tri6, quad8, quad9: Gmsh types 9, 16, 10) in MSH files written by Gmsh
 (issue #12 part 2, docs/highorder.md).
 
@@ -15,7 +15,9 @@ byte; the file is written back in its original node order (connectivity
 unchanged); skin nodes bit-identical; every interior mid-edge node at its
 edge's midpoint and the quad9 centre at its corners' mean (1e-12 of the
 edge); det J has one sign at every node of each element (Gmsh's
-getJacobians); q_mean rises.
+getJacobians); q_mean rises.  Then the same mesh, every element made
+clockwise, as an Abaqus deck (CPS6, CPS8R, M3D9) and as CGNS (TRI_6,
+QUAD_8, QUAD_9 in a cell-dimension-2 base, written by libcgns).
 """
 import os
 import re
@@ -26,6 +28,7 @@ import gmsh
 import numpy as np
 
 GETME, WORK = sys.argv[1], sys.argv[2]
+WRITER = sys.argv[3] if len(sys.argv) > 3 else None  # cgns_ho_write
 os.makedirs(WORK, exist_ok=True)
 FAILED = []
 DETS = {}
@@ -194,6 +197,56 @@ def flip(row, nc):
     return [row[0]] + row[1:nc][::-1] + mids[::-1] + row[2 * nc:]
 
 
+def cgns_case(kind, c0, low, rows):
+    import h5py
+    gtype, sids = {"tri6": (9, "TRI_6"), "quad8": (16, "QUAD_8"),
+                   "quad9": (10, "QUAD_9")}[kind]
+    tags = sorted(c0)
+    index = {t: i + 1 for i, t in enumerate(tags)}
+    txt = os.path.join(WORK, kind + "-cgns.txt")
+    with open(txt, "w") as f:
+        f.write("%d\n" % len(tags))
+        for t in tags:
+            f.write("%r %r %r\n" % tuple(c0[t]))
+        f.write("%s %d %d\n" % (sids, len(rows), len(rows[0])))
+        for r in rows:
+            f.write(" ".join(str(index[v]) for v in r) + "\n")
+    src = os.path.join(WORK, kind + ".cgns")
+    r = subprocess.run([WRITER, txt, src, "2"], capture_output=True, text=True)
+    check(r.returncode == 0, "%s CGNS: cgns_ho_write %s" % (kind, r.stderr))
+    o1, o2 = src[:-5] + "-s1.cgns", src[:-5] + "-s2.cgns"
+    r1 = run("smooth", src, "-o", o1, threads=1)
+    r2 = run("smooth", src, "-o", o2, threads=2)
+    check(r1.returncode == 0 and r2.returncode == 0,
+          "%s CGNS: smooth exit %d/%d %s" % (kind, r1.returncode,
+                                             r2.returncode, r1.stderr[-300:]))
+
+    def coords(path):
+        with h5py.File(path, "r") as h:
+            g = h["Base"]["Zone"]["GridCoordinates"]
+            x = np.stack([g["Coordinate" + a][" data"][()] for a in "XYZ"], 1)
+        return {t: x[index[t] - 1] for t in tags}
+    c2 = coords(o1)
+    c3 = coords(o2)
+    check(all(np.array_equal(c2[t], c3[t]) for t in tags),
+          "%s CGNS: 1 = 2 threads" % kind)
+    skin = {t for t, p in c0.items() if p[0] in (0, 1) or p[1] in (0, 1)}
+    check(all(np.array_equal(c0[t], c2[t]) for t in skin),
+          "%s CGNS: skin nodes bit-identical" % kind)
+    inner = set(tags) - skin
+    moved = sum(1 for t in inner if not np.array_equal(c0[t], c2[t]))
+    check(moved > len(inner) // 2, "%s CGNS: moved %d of %d" %
+          (kind, moved, len(inner)))
+    err = midpoint_error(c2, {gtype: np.array(rows)}, inner)
+    check(err < 1e-12, "%s CGNS: interior mid-nodes at midpoints (%g)" %
+          (kind, err))
+    nc = TYPES[gtype][0]
+    check(all(signed_area(c2, r, nc) < 0 for r in rows),
+          "%s CGNS: every element still clockwise (valid)" % kind)
+    print("%-6s CGNS (%s, all clockwise) ok: %d interior nodes moved" %
+          (kind, sids, moved), flush=True)
+
+
 def inp_case(kind):
     """The same mesh as an Abaqus deck (CPS6, CPS8R, M3D9), every element
     clockwise: the core smooths it as its mirror image (getme.h)."""
@@ -238,6 +291,8 @@ def inp_case(kind):
     q = [float(v) for v in re.findall(r"qmean ([0-9.]+)", r1.stdout + r1.stderr)]
     check(len(q) >= 2 and q[-1] > q[0] + 0.05, "%s INP: q_mean rises %s" %
           (kind, q))
+    if WRITER:
+        cgns_case(kind, c0, low, rows)
     print("%-6s INP (%s, all clockwise) ok: q_mean %.4f -> %.4f" %
           (kind, abq, q[0], q[-1]),
           flush=True)
