@@ -72,7 +72,16 @@ void cli_measures_log(const cli_log *log, getme_mesh *mesh, const char *title,
                       cli_measures *m);
 /* Second-order meshes (highorder.c): "Second order (WHEN): N elements,
    worst node Jacobian ratio R (element ID)"; nothing for a linear mesh. */
-void cli_ho_log(const cli_log *log, getme_doc *doc, const char *when);
+/* The worst node Jacobian ratio of a mesh's second-order elements
+   (cli/highorder.c): n = 0 when it has none. */
+typedef struct cli_ho_ratio {
+    int32_t n;
+    double ratio;
+    long long id; /* the element's id in the file */
+} cli_ho_ratio;
+/* Log it (when: "before"/"after") and store it in out (may be NULL). */
+void cli_ho_log(const cli_log *log, getme_doc *doc, const char *when,
+                cli_ho_ratio *out);
 /* Summary and 10-bin histogram of every measure but the mean ratio. */
 void cli_print_measure_histograms(const cli_log *log, const cli_measures *m,
                                   int type);
@@ -213,6 +222,7 @@ typedef struct cli_report_extra {
     const getme_doc *doc;
     const cli_worst_list *worst, *worst_free;
     const cli_measures *measures_before, *measures_after;
+    const cli_ho_ratio *ho_before, *ho_after; /* "second_order" if n > 0 */
 } cli_report_extra;
 
 int cli_write_report(const char *path, const char *input, const char *output,

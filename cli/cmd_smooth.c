@@ -182,7 +182,8 @@ static int run(smooth_args *a)
     cli_print_stats(log, "Quality before", &before);
     cli_measures mbefore, mafter;
     cli_measures_log(log, mesh, "Measures before", &mbefore);
-    cli_ho_log(log, doc, "before");
+    cli_ho_ratio ho_before = {0}, ho_after = {0};
+    cli_ho_log(log, doc, "before", &ho_before);
     cli_worst_list worst = {0}, worst_free = {0};
     cli_guard guard = {0};
     getme_untangle_result ur;
@@ -213,7 +214,7 @@ static int run(smooth_args *a)
     getme_mesh_quality_stats(mesh, -1, &after);
     cli_print_stats(log, "Quality after ", &after);
     cli_measures_log(log, mesh, "Measures after ", &mafter);
-    cli_ho_log(log, doc, "after");
+    cli_ho_log(log, doc, "after", &ho_after);
     if (res.corner_sj_initial < 1.0 || res.corner_sj < 1.0)
         cli_info(log, "Worst corner scaled Jacobian (hex, prism, pyramid, "
                       "quad): %.4f before, %.4f after",
@@ -249,8 +250,9 @@ static int run(smooth_args *a)
     } else {
         cli_mesh_counts counts;
         cli_count_mesh(mesh, &counts);
-        cli_report_extra extra = {doc, &worst, &worst_free, &mbefore,
-                                  &mafter};
+        cli_report_extra extra = {doc,      &worst,     &worst_free,
+                                  &mbefore, &mafter,    &ho_before,
+                                  &ho_after};
         if (so->report &&
             cli_write_report(paths.rep, a->input, a->output, &so->params,
                              &counts, &before, &after, &res, &so->history,

@@ -6,14 +6,22 @@
  */
 #include "cli.h"
 
-void cli_ho_log(const cli_log *log, getme_doc *doc, const char *when)
+void cli_ho_log(const cli_log *log, getme_doc *doc, const char *when,
+                cli_ho_ratio *out)
 {
     getme_mesh *mesh = getme_doc_mesh(doc);
     int32_t n = getme_mesh_num_elements_ho(mesh), e = -1;
     double r = 1.0;
+    if (out)
+        out->n = 0;
     if (n == 0 || getme_mesh_jacobian_ratio_min(mesh, &r, &e) != GETME_OK ||
         e < 0)
         return;
+    if (out) {
+        out->n = n;
+        out->ratio = r;
+        out->id = (long long)getme_doc_element_id(doc, e);
+    }
     cli_info(log, "Second order (%s): %ld elements, worst node Jacobian ratio "
                   "%.4f (element %lld)",
              when, (long)n, r, (long long)getme_doc_element_id(doc, e));

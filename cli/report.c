@@ -128,6 +128,12 @@ int cli_write_report(const char *path, const char *input, const char *output,
             r->untangle_seconds);
     fprintf(f, "  \"corner_sj\": {\"before\": %.17g, \"after\": %.17g},\n",
             r->corner_sj_initial, r->corner_sj);
+    if (x && x->ho_before && x->ho_after && x->ho_before->n > 0)
+        fprintf(f, "  \"second_order\": {\"elements\": %ld, "
+                   "\"jacobian_ratio\": {\"before\": %.17g, \"after\": %.17g}, "
+                   "\"worst_element\": {\"before\": %lld, \"after\": %lld}},\n",
+                (long)x->ho_before->n, x->ho_before->ratio, x->ho_after->ratio,
+                x->ho_before->id, x->ho_after->id);
     if (x && x->doc && x->worst && x->worst_free) {
         fputs("  \"worst_elements\": ", f);
         cli_json_worst(f, x->doc, x->worst);

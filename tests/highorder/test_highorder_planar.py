@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """
-test_highorder_planar.py GETME WORKDIR [CGNS_HO_WRITE] -- planar second-order meshes
+test_highorder_planar.py GETME [CGNS_HO_WRITE] WORKDIR -- planar second-order meshes
 (tri6, quad8, quad9: Gmsh types 9, 16, 10) in MSH files written by Gmsh
 (issue #12 part 2, docs/highorder.md).
 
@@ -27,8 +27,8 @@ import sys
 import gmsh
 import numpy as np
 
-GETME, WORK = sys.argv[1], sys.argv[2]
-WRITER = sys.argv[3] if len(sys.argv) > 3 else None  # cgns_ho_write
+GETME, WORK = sys.argv[1], sys.argv[-1]
+WRITER = sys.argv[2] if len(sys.argv) > 3 else None  # cgns_ho_write
 os.makedirs(WORK, exist_ok=True)
 FAILED = []
 DETS = {}
