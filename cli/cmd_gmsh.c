@@ -429,12 +429,16 @@ static int run(gmsh_args *a)
         int wrc = write_output(a, paths.out, out);
         rc = rc ? rc : wrc;
     }
+    cli_ho_ratio hob = {res.rep.num_second_order, res.rep.jacobian_ratio_before,
+                        (long long)res.rep.jacobian_ratio_tag_before};
+    cli_ho_ratio hoa = {res.rep.num_second_order, res.rep.jacobian_ratio_after,
+                        (long long)res.rep.jacobian_ratio_tag_after};
     if (rc == 0 && a->o.report &&
         cli_write_report(paths.rep, a->input, out, &a->o.params, &res.counts,
                          &res.before, &res.rep.after, &res.rep.result,
                          &a->o.history, "gmsh",
                          &(cli_report_extra){NULL, NULL, NULL, &res.mbefore,
-                                             &res.mafter}) != 0) {
+                                             &res.mafter, &hob, &hoa}) != 0) {
         cli_error("%s: cannot write the report: %s", a->o.report,
                   strerror(errno));
         rc = CLI_EXIT_WRITE;

@@ -158,6 +158,13 @@ typedef struct getme_gmsh_report {
     int topology_ran;
     int32_t topology_elements_before, topology_elements_after;
     int32_t topology_changed;
+    /* Second-order elements (docs/highorder.md): how many, and the worst
+       ratio of the smallest to the largest det J over an element's nodes
+       before and after (getme_mesh_jacobian_ratio_min), with the Gmsh tag
+       of that element; ratios 1 and tags 0 when there are none. */
+    int32_t num_second_order;
+    double jacobian_ratio_before, jacobian_ratio_after;
+    size_t jacobian_ratio_tag_before, jacobian_ratio_tag_after;
 } getme_gmsh_report;
 
 /*
@@ -206,6 +213,8 @@ GETME_GMSH_API getme_status getme_gmsh_quality(
    "topology_changed", "topology_elements_before", "topology_elements_after",
    "num_worst", "num_worst_free", "untangle_invalid_before",
    "untangle_invalid_after", "untangle_sweeps", "untangle_moved",
+   "num_second_order", "jacobian_ratio_before", "jacobian_ratio_after",
+   "jacobian_ratio_tag_before", "jacobian_ratio_tag_after",
    "untangle_seconds", "<worst|worst_free><i>_<tag|index|type|
    quality|corner_sj|num_free|num_nodes|reason>", "<before|after>_<q_min_star|q_min|q_mean|q_max|
    num_invalid|num_below_04|num_below_01|num_elements|num_free>",

@@ -213,6 +213,12 @@ static void log_end(gg_run *run)
         gg_log("info", "Worst corner scaled Jacobian (hex, prism, pyramid, "
                        "quad): %.4g before, %.4g after",
                res->corner_sj_initial, res->corner_sj);
+    if (r->num_second_order > 0)
+        gg_log("info", "Second order: %ld elements, worst node Jacobian ratio "
+                       "%.4g before (element %zu), %.4g after (element %zu)",
+               (long)r->num_second_order, r->jacobian_ratio_before,
+               r->jacobian_ratio_tag_before, r->jacobian_ratio_after,
+               r->jacobian_ratio_tag_after);
     if (r->after.q_min < r->after.q_min_star)
         gg_log("warning", "Worst element %.4g is below the worst with a free "
                           "node %.4g: no node move can fix it (option "
@@ -239,6 +245,20 @@ static getme_status read_and_check(gg_run *run, const int *dim_tags,
     return check_model(run);
 }
 
+/* The worst node Jacobian ratio of the second-order elements and its
+   element's Gmsh tag (docs/highorder.md); ratio 1, tag 0 without any. */
+static void ho_ratio(gg_run *run, double *ratio, size_t *tag)
+{
+    getme_mesh *mesh = getme_gmsh_model_mesh(run->model);
+    int32_t e = -1;
+    *ratio = 1.0;
+    *tag = 0;
+    run->rep->num_second_order = getme_mesh_num_elements_ho(mesh);
+    if (run->rep->num_second_order > 0 &&
+        getme_mesh_jacobian_ratio_min(mesh, ratio, &e) == GETME_OK && e >= 0)
+        *tag = run->model->elem_tags[e];
+}
+
 /* Sizes and quality of run->model into the report; refuse invalid ones. */
 static getme_status check_model(gg_run *run)
 {
@@ -255,6 +275,9 @@ static getme_status check_model(gg_run *run)
         st = getme_mesh_measure_all(mesh, &r->measures_before[0][0]);
     if (st != GETME_OK)
         return fail(run, st, getme_mesh_error(mesh));
+    ho_ratio(run, &r->jacobian_ratio_before, &r->jacobian_ratio_tag_before);
+    r->jacobian_ratio_after = r->jacobian_ratio_before;
+    r->jacobian_ratio_tag_after = r->jacobian_ratio_tag_before;
     return check_valid(run);
 }
 
@@ -298,6 +321,9 @@ static getme_status smooth_and_apply(gg_run *run, int niter)
         st2 = fill_worst(run);
     if (st2 == GETME_OK)
         st2 = getme_mesh_measure_all(mesh, &run->rep->measures_after[0][0]);
+    if (st2 == GETME_OK)
+        ho_ratio(run, &run->rep->jacobian_ratio_after,
+                 &run->rep->jacobian_ratio_tag_after);
     char text[GG_MSG];
     if (st2 == GETME_OK)
         st2 = getme_gmsh_model_apply(run->model, getme_mesh_coords(mesh),

@@ -98,7 +98,9 @@ double getme_gmsh_report_value(const getme_gmsh_report *r, const char *name)
         "corner_sj_after", "topology_ran", "topology_changed",
         "topology_elements_before", "topology_elements_after", "num_worst",
         "num_worst_free", "untangle_invalid_before", "untangle_invalid_after",
-        "untangle_sweeps", "untangle_moved", "untangle_seconds"};
+        "untangle_sweeps", "untangle_moved", "untangle_seconds",
+        "num_second_order", "jacobian_ratio_before", "jacobian_ratio_after",
+        "jacobian_ratio_tag_before", "jacobian_ratio_tag_after"};
     const getme_untangle_result *u = &r->untangle;
     const double values[] = {r->dim,
                              r->num_entities,
@@ -130,7 +132,12 @@ double getme_gmsh_report_value(const getme_gmsh_report *r, const char *name)
                              (double)u->num_invalid_after,
                              u->sweeps,
                              u->num_moved,
-                             u->seconds};
+                             u->seconds,
+                             r->num_second_order,
+                             r->jacobian_ratio_before,
+                             r->jacobian_ratio_after,
+                             (double)r->jacobian_ratio_tag_before,
+                             (double)r->jacobian_ratio_tag_after};
     for (size_t i = 0; i < sizeof names / sizeof *names; i++)
         if (strcmp(name, names[i]) == 0)
             return values[i];

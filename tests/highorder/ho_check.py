@@ -162,3 +162,22 @@ def pyramid_space_errors():
             worst = max(worst, abs(grad - gf[i]).max(),
                         abs(val - bf[i]).max() if i < 2 else 0.0)
     return worst
+
+
+def worst_jacobian_ratio():
+    """Over the second-order 3-D elements of the current Gmsh model: the
+    smallest ratio of the smallest to the largest det J over an element's
+    nodes (Gmsh's getJacobians), and that element's tag."""
+    worst, tag = np.inf, 0
+    for t in gmsh.model.mesh.getElementTypes(3):
+        if t not in TYPES:
+            continue
+        p = gmsh.model.mesh.getElementProperties(t)
+        tags, _ = gmsh.model.mesh.getElementsByType(t)
+        _, dets, _ = gmsh.model.mesh.getJacobians(t, p[4])
+        d = np.array(dets).reshape(-1, p[3])
+        r = d.min(1) / d.max(1)
+        i = int(np.argmin(r))
+        if r[i] < worst:
+            worst, tag = float(r[i]), int(tags[i])
+    return worst, tag

@@ -103,6 +103,16 @@ def live(kind):
           "%s: skin nodes (curved mid-nodes included) bit-identical" % kind)
     check(ho_check.midpoint_errors(c2, e2, interior) < 1e-12,
           "%s: interior mid-nodes at midpoints" % kind)
+    so = res.get("second_order")
+    gr, gtag = ho_check.worst_jacobian_ratio()
+    check(so is not None and
+          so["elements"] == sum(len(e2[t][1]) for t in e2) and
+          abs(so["jacobian_ratio_after"] - gr) < 1e-9 and
+          so["element_after"] == gtag and
+          so["jacobian_ratio_before"] <= so["jacobian_ratio_after"] + 1 and
+          so["element_before"] > 0,
+          "%s: result's second_order = Gmsh's worst ratio %.12g (element %d):"
+          " %s" % (kind, gr, gtag, so))
     q0, q1 = res["q_mean_before"], res["q_mean_after"]
     check(q1 > q0, "%s: q_mean %.4f -> %.4f" % (kind, q0, q1))
     print("%-8s live model: q_mean %.4f -> %.4f, min node det J %.4g" %

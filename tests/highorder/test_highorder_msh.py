@@ -25,6 +25,7 @@ offset relative to its edge (the mapping is a similarity: |d| / |edge| is
 unchanged), face and body nodes keep an offset.
 """
 import os
+import json
 import re
 import subprocess
 import sys
@@ -150,7 +151,8 @@ def case(kind, version, binary):
     moved = sum(1 for t in interior if not np.array_equal(c0[t], c1[t]))
     check(moved > len(interior) // 4, "%s: distort moved %d of %d interior "
           "nodes" % (tag, moved, len(interior)))
-    r1 = run("smooth", dis, "-o", out1, "-v", threads=1)
+    rep = out1[:-4] + ".json"
+    r1 = run("smooth", dis, "-o", out1, "-v", "--report", rep, threads=1)
     r2 = run("smooth", dis, "-o", out2, "-v", threads=2)
     check(r1.returncode == 0 and r2.returncode == 0,
           "%s: smooth exit %d/%d %s" % (tag, r1.returncode, r2.returncode,
@@ -164,6 +166,20 @@ def case(kind, version, binary):
     q = qmeans(r1.stdout + r1.stderr)
     check(len(q) >= 2 and q[-1] > q[0] + 0.05,
           "%s: q_mean rises (%s)" % (tag, q))
+    # --report: the worst node Jacobian ratio before and after, and its
+    # element, are Gmsh's (getJacobians) for the distorted and the
+    # smoothed file
+    so = json.load(open(rep)).get("second_order") if os.path.exists(rep) else None
+    check(so is not None and so["elements"] == sum(len(e1[t][0]) for t in e1),
+          "%s: --report has second_order with every element (%s)" % (tag, so))
+    for when, f in (("before", dis), ("after", out1)):
+        gmsh.clear()
+        gmsh.open(f)
+        gr, gtag = ho_check.worst_jacobian_ratio()
+        check(so is not None and abs(so["jacobian_ratio"][when] - gr) < 1e-9
+              and so["worst_element"][when] == gtag,
+              "%s: --report jacobian ratio %s = Gmsh's %.12g (element %d): %s"
+              % (tag, when, gr, gtag, so))
     ws, bad = ho_check.min_node_jacobian(out1)
     check(bad == 0 and ws > 0, "%s: smoothed min node det J %g" % (tag, ws))
     c2, e2, low2 = ho_check.load(out1)

@@ -34,7 +34,11 @@ measures_before / measures_after: {type: {measure: {"min", "max", "mean",
 "num_elements", "num_negative", "histogram", ...}}} for the dihedral
 angles, scaled Jacobian, Gmsh's gamma and SICN (docs/quality.md), and
 "untangle": invalid_before / invalid_after / sweeps / nodes_moved /
-seconds of the untangling step.
+seconds of the untangling step; "second_order": None, or for a mesh with
+second-order elements {"elements", "jacobian_ratio_before",
+"jacobian_ratio_after", "element_before", "element_after"}: the worst
+ratio of the smallest to the largest det J over an element's nodes, and
+that element's Gmsh tag (docs/highorder.md).
 Raises getme.GetmeError (with the Gmsh-logged message) on bad use, and with
 status 3 when inverted elements could not be untangled (the message names
 them by their Gmsh tags); the model is then unchanged, except with
@@ -128,6 +132,14 @@ def _report_dict(rep):
     for k in ("invalid_before", "invalid_after", "sweeps", "moved"):
         out["untangle"][k] = int(out["untangle"][k])
     out["untangle"]["nodes_moved"] = out["untangle"].pop("moved")
+    out["second_order"] = None
+    if val("num_second_order") > 0:
+        out["second_order"] = {
+            "elements": int(val("num_second_order")),
+            "jacobian_ratio_before": val("jacobian_ratio_before"),
+            "jacobian_ratio_after": val("jacobian_ratio_after"),
+            "element_before": int(val("jacobian_ratio_tag_before")),
+            "element_after": int(val("jacobian_ratio_tag_after"))}
     return out
 
 
