@@ -34,7 +34,8 @@ class UntangleResult(C.Structure):  # getme_untangle_result of getme.h
     _fields_ = [("num_invalid_before", C.c_int64), ("num_invalid_after", C.c_int64),
                 ("num_stuck", C.c_int64), ("num_reported", C.c_int32),
                 ("remaining", C.c_int32 * MAXREP), ("num_moved", C.c_int32),
-                ("sweeps", C.c_int), ("rings", C.c_int), ("seconds", C.c_double)]
+                ("sweeps", C.c_int), ("rings", C.c_int), ("seconds", C.c_double),
+                ("num_ho_repaired", C.c_int32), ("num_ho_moved", C.c_int32)]
 
 
 class Stats(C.Structure):  # getme_quality_stats

@@ -189,7 +189,12 @@ static int run(smooth_args *a)
     getme_untangle_result ur;
     memset(&ur, 0, sizeof ur);
     code = 0;
-    if (before.num_invalid > 0 && (code = untangle(a, doc, &ur)) != 0) {
+    /* a second-order element invalid only at a mid-node has valid corners,
+       so the statistics count it valid: untangling repairs it */
+    int ho_invalid = ho_before.n > 0 && ho_before.ratio <= 0.0 &&
+                     so->params.untangle;
+    if ((before.num_invalid > 0 || ho_invalid) &&
+        (code = untangle(a, doc, &ur)) != 0) {
         if (code == CLI_EXIT_TANGLED && so->allow_invalid) {
             cli_write_guard(&guard, 1);
             write_output(a, &paths, doc, "partly untangled, not smoothed, ");

@@ -212,6 +212,13 @@ void cli_untangle_warning(const cli_log *log, const getme_untangle_result *ur)
                 before, before == 1 ? "" : "s", after,
                 after == 1 ? "s" : "", ur->sweeps, ur->sweeps == 1 ? "" : "s",
                 (int)ur->num_moved, ur->seconds);
+    if (ur->num_ho_moved > 0)
+        cli_warning(log, "%d second-order element%s invalid only at curved "
+                         "mid-nodes: %d mid-node%s pulled toward the straight "
+                         "position (docs/highorder.md)",
+                    (int)ur->num_ho_repaired,
+                    ur->num_ho_repaired == 1 ? " was" : "s were",
+                    (int)ur->num_ho_moved, ur->num_ho_moved == 1 ? "" : "s");
 }
 
 void cli_smooth_begin(cli_smooth_opts *o, getme_params *params)

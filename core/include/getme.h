@@ -703,6 +703,11 @@ typedef struct getme_untangle_result {
     int rings;                  /* rings of nodes added around the invalid
                                    elements' nodes (0: only their own)      */
     double seconds;
+    int32_t num_ho_repaired;    /* second-order elements invalid only at
+                                   their non-corner nodes, repaired by
+                                   pulling their free mid-nodes toward the
+                                   straight position (docs/highorder.md)   */
+    int32_t num_ho_moved;       /* dependent nodes moved to repair them     */
 } getme_untangle_result;
 
 /*

@@ -793,9 +793,16 @@ getme_status getme_mesh_untangle(getme_mesh *mesh, const getme_params *params,
         getme__ws_free(&ws);
         return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
     }
-    getme__ws_qualities(&ws, q);
-    st = getme__untangle(&ws, q, result);
-    if (st == GETME_OK && result->num_moved > 0)
+    int32_t ho_e = 0, ho_n = 0; /* second order: highorder_repair.c */
+    st = getme__ho_repair(&ws, &ho_e, &ho_n);
+    if (st == GETME_OK) {
+        getme__ws_qualities(&ws, q);
+        st = getme__untangle(&ws, q, result);
+    }
+    result->num_invalid_before += ho_e;
+    result->num_ho_repaired = ho_e;
+    result->num_ho_moved = ho_n;
+    if (st == GETME_OK && (result->num_moved > 0 || ho_n > 0))
         getme__ws_store(&ws, mesh);
     free(q);
     getme__ws_free(&ws);

@@ -138,6 +138,11 @@ static getme_status untangle(gg_run *run)
                (long long)u->num_invalid_after,
                u->num_invalid_after == 1 ? "s" : "", u->sweeps,
                u->sweeps == 1 ? "" : "s", (long)u->num_moved, u->seconds);
+    if (run->opt->log >= 1 && u->num_ho_moved > 0)
+        gg_log("warning", "%d second-order element%s invalid only at curved "
+               "mid-nodes: %d mid-nodes pulled toward the straight position",
+               (int)u->num_ho_repaired, u->num_ho_repaired == 1 ? "" : "s",
+               (int)u->num_ho_moved);
     if (st == GETME_OK)
         return GETME_OK;
     char text[GG_MSG], head[128];
@@ -438,7 +443,12 @@ getme_status getme_gmsh_optimize(int niter, const int *dim_tags,
         st = check_model(&run);
     if (st == GETME_OK && options->log >= 1)
         log_start(&run);
-    if (st == GETME_OK && run.rep->before.num_invalid > 0)
+    /* second-order elements invalid only at mid-nodes count as valid in
+       the statistics (their corners are): untangling repairs them */
+    if (st == GETME_OK && (run.rep->before.num_invalid > 0 ||
+                           (run.rep->num_second_order > 0 &&
+                            run.rep->jacobian_ratio_before <= 0.0 &&
+                            options->params.untangle)))
         st = untangle(&run);
     if (st == GETME_OK)
         st = smooth_and_apply(&run, niter);

@@ -100,7 +100,8 @@ double getme_gmsh_report_value(const getme_gmsh_report *r, const char *name)
         "num_worst_free", "untangle_invalid_before", "untangle_invalid_after",
         "untangle_sweeps", "untangle_moved", "untangle_seconds",
         "num_second_order", "jacobian_ratio_before", "jacobian_ratio_after",
-        "jacobian_ratio_tag_before", "jacobian_ratio_tag_after"};
+        "jacobian_ratio_tag_before", "jacobian_ratio_tag_after",
+        "untangle_ho_repaired", "untangle_ho_moved"};
     const getme_untangle_result *u = &r->untangle;
     const double values[] = {r->dim,
                              r->num_entities,
@@ -137,7 +138,9 @@ double getme_gmsh_report_value(const getme_gmsh_report *r, const char *name)
                              r->jacobian_ratio_before,
                              r->jacobian_ratio_after,
                              (double)r->jacobian_ratio_tag_before,
-                             (double)r->jacobian_ratio_tag_after};
+                             (double)r->jacobian_ratio_tag_after,
+                             u->num_ho_repaired,
+                             u->num_ho_moved};
     for (size_t i = 0; i < sizeof names / sizeof *names; i++)
         if (strcmp(name, names[i]) == 0)
             return values[i];

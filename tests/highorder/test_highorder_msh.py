@@ -290,6 +290,56 @@ def curved_case(kind, gtype):
     print("%-14s: min node det J after smoothing %.4g" % (tag, w2), flush=True)
 
 
+def midnode_repair_case(kind, gtype, k, a, b):
+    """An element invalid only because of one interior mid-edge node (k, on
+    edge a-b) pulled along its edge to 0.2 of it (det J < 0 at corner a,
+    corners untouched): untangling cannot fix it by moving corners; the
+    repair pulls the node back toward the midpoint (highorder_repair.c),
+    then getme smooths as usual."""
+    tag = "mid-node repair %s" % kind
+    src = path("%s-4.1.msh" % kind)
+    gmsh.clear()
+    gmsh.open(src)
+    inner = set(gmsh.model.mesh.getNodes(3, -1)[0].tolist())
+    et, nt = gmsh.model.mesh.getElementsByType(gtype)
+    nv = gmsh.model.mesh.getElementProperties(gtype)[3]
+    conn = np.array(nt).reshape(-1, nv)
+    row = next(r for r in conn if r[k] in inner and r[a] in inner)
+    pa = np.array(gmsh.model.mesh.getNode(row[a])[0])
+    pb = np.array(gmsh.model.mesh.getNode(row[b])[0])
+    gmsh.model.mesh.setNode(int(row[k]), (pa + 0.2 * (pb - pa)).tolist(), [])
+    bad = path("%s-midbad.msh" % kind)
+    gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+    gmsh.option.setNumber("Mesh.Binary", 0)
+    gmsh.write(bad)
+    w0, n0 = ho_check.min_node_jacobian(bad)
+    check(w0 < 0 and n0 >= 1, "%s: the input is invalid at a node (%g, %d)"
+          % (tag, w0, n0))
+    r = run("smooth", bad, "-o", path("%s-midno.msh" % kind), "--no-untangle")
+    check(r.returncode == 6, "%s: --no-untangle exits 6 (%d)" %
+          (tag, r.returncode))
+    o1, o2 = path("%s-mid1.msh" % kind), path("%s-mid2.msh" % kind)
+    r1 = run("smooth", bad, "-o", o1, threads=1)
+    r2 = run("smooth", bad, "-o", o2, threads=2)
+    check(r1.returncode == 0 and r2.returncode == 0,
+          "%s: smooth exit %d/%d %s" % (tag, r1.returncode, r2.returncode,
+                                        r1.stderr[-300:]))
+    m = re.search(r"(\d+) second-order elements? w(?:as|ere) invalid only at "
+                  r"curved mid-nodes: (\d+) mid-nodes? pulled",
+                  r1.stdout + r1.stderr)
+    check(m is not None and int(m.group(1)) == n0 and int(m.group(2)) == 1,
+          "%s: the warning counts %d elements and 1 node (%s)" %
+          (tag, n0, m and m.groups()))
+    check(os.path.exists(o1) and os.path.exists(o2) and
+          open(o1, "rb").read() == open(o2, "rb").read(),
+          "%s: 1 and 2 threads byte-identical" % tag)
+    w1, n1 = ho_check.min_node_jacobian(o1)
+    check(n1 == 0 and w1 > 0, "%s: output valid at every node (%g)" %
+          (tag, w1))
+    print("%s: input min det J %.4g in %d elements -> %.4g" %
+          (tag, w0, n0, w1), flush=True)
+
+
 gmsh.initialize()
 gmsh.option.setNumber("General.Terminal", 0)
 bad = ho_check.check_tables()
@@ -305,6 +355,8 @@ for kind in ("tet10", "hex20", "hex27", "prism15", "prism18", "pyr13",
               (kind, version, "b" if binary else " ", w), flush=True)
 for kind, gtype in (("tet10", 11), ("hex27", 12), ("prism18", 13)):
     curved_case(kind, gtype)
+midnode_repair_case("tet10", 11, 4, 0, 1)
+midnode_repair_case("hex20", 17, 8, 0, 1)
 gmsh.finalize()
 print("%d failure(s)" % len(FAILED))
 sys.exit(1 if FAILED else 0)

@@ -1,0 +1,126 @@
+/*
+ * highorder_repair.c -- repair of second-order elements that are invalid
+ * only because of their curved non-corner nodes (docs/highorder.md).
+ *
+ * Untangling moves corners: it cannot repair an element whose corners are
+ * valid but whose det J is <= 0 at a mid-node, because a curved mid-node
+ * too far from its edge folds the element whatever the corners do.  Such a
+ * node is pulled toward its straight position instead: its offset (in the
+ * entity's frame, ho->ref, and in the input coordinates, ho->x0) is halved,
+ * round after round: in each element still invalid with valid corners, that
+ * of its free curved dependent node farthest (relative to its edge or face)
+ * from its straight position, until no such element is left or 64 rounds
+ * (2^-64 of the offset: straight to rounding) are done.  Pinned nodes
+ * (skin, fixed edges and faces, fixed groups) never move.  The rounds are
+ * serial and visit elements and nodes in index order, so the result does
+ * not depend on the thread count.
+ */
+#include "highorder.h"
+#include "workspace.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define REPAIR_ROUNDS 64
+
+static int corners_valid(const getme_ws *ws, int32_t e)
+{
+    double x[3 * GETME_MAX_NV];
+    int t = getme__ws_type(ws, e);
+    getme__ws_gather(ws, ws->x, t, e, x);
+    return getme__quality(t, x) > 0.0;
+}
+
+static void straight_of(const getme_ho_ws *ho, int32_t h, double *s)
+{
+    const int32_t *c = ho->cn + 8 * (int64_t)h;
+    s[0] = s[1] = s[2] = 0.0;
+    for (int i = 0; i < ho->nc[h]; i++)
+        for (int d = 0; d < 3; d++)
+            s[d] += ho->x0[3 * (int64_t)c[i] + d];
+    for (int d = 0; d < 3; d++)
+        s[d] /= ho->nc[h];
+}
+
+/* |x0 - S| / |corner 1 - corner 0| of dependent node h. */
+static double rel_offset(const getme_ho_ws *ho, int32_t h)
+{
+    const int32_t *c = ho->cn + 8 * (int64_t)h;
+    const double *x = ho->x0 + 3 * (int64_t)ho->node[h];
+    const double *a = ho->x0 + 3 * (int64_t)c[0], *b = ho->x0 + 3 * (int64_t)c[1];
+    double s[3], o = 0.0, l = 0.0;
+    straight_of(ho, h, s);
+    for (int d = 0; d < 3; d++)
+        o += (x[d] - s[d]) * (x[d] - s[d]), l += (b[d] - a[d]) * (b[d] - a[d]);
+    return l > 0.0 ? sqrt(o / l) : 0.0;
+}
+
+static int needs_repair(const getme_ws *ws, int32_t e)
+{
+    return ws->ho->etype[e] >= 0 && corners_valid(ws, e) &&
+           !getme__ho_valid(ws, ws->x, e);
+}
+
+getme_status getme__ho_repair(getme_ws *ws, int32_t *num_elements,
+                              int32_t *num_nodes)
+{
+    getme_ho_ws *ho = ws->ho;
+    *num_elements = 0;
+    *num_nodes = 0;
+    if (!ho)
+        return GETME_OK;
+    uint8_t *mark = calloc((size_t)ho->nh + 1, 1);
+    uint8_t *moved = calloc((size_t)ho->nh + 1, 1);
+    uint8_t *bad = calloc((size_t)ws->ne + 1, 1);
+    if (!mark || !moved || !bad) {
+        free(mark), free(moved), free(bad);
+        return GETME_ERR_NOMEM;
+    }
+    for (int round = 0; round < REPAIR_ROUNDS; round++) {
+        int any = 0;
+        memset(mark, 0, (size_t)ho->nh);
+        for (int32_t e = 0; e < ws->ne; e++) {
+            if (!needs_repair(ws, e))
+                continue;
+            bad[e] = 1;
+            /* the free node farthest from its straight position, relative
+               to its entity's size: the culprit (a straight node has no
+               offset to reduce; nodes a rounding off it are not touched) */
+            int32_t best = -1;
+            double far = 0.0;
+            for (int64_t j = ho->eptr[e]; j < ho->eptr[e + 1]; j++) {
+                int32_t h = ho->eho[j];
+                double r = rel_offset(ho, h);
+                if (!ho->pinned[h] && !ho->straight[h] && r > far)
+                    best = h, far = r;
+            }
+            if (best >= 0 && !mark[best])
+                mark[best] = 1, any = 1;
+        }
+        if (!any)
+            break;
+        for (int32_t h = 0; h < ho->nh; h++) {
+            if (!mark[h])
+                continue;
+            moved[h] = 1;
+            /* the offset is linear in the node's position for fixed
+               corners, so halving ref halves x0 - S(x0) */
+            double s[3];
+            straight_of(ho, h, s);
+            int64_t u = ho->node[h];
+            for (int d = 0; d < 3; d++) {
+                double p = s[d] + 0.5 * (ho->x0[3 * u + d] - s[d]);
+                ho->x0[3 * u + d] = p;
+                ws->x[3 * u + d] = p;
+                ho->ref[3 * (int64_t)h + d] *= 0.5;
+            }
+        }
+    }
+    for (int32_t h = 0; h < ho->nh; h++)
+        *num_nodes += moved[h];
+    for (int32_t e = 0; e < ws->ne; e++)
+        *num_elements += bad[e] && getme__ho_valid(ws, ws->x, e);
+    free(mark), free(moved), free(bad);
+    return GETME_OK;
+}
