@@ -26,8 +26,8 @@ getme_status getme__model_type_error(int dim, int tag, int msh_type,
     if (order > 1)
         snprintf(msg, size,
                  "%s %d has elements of order %d (%s): GETMe smooths "
-                 "linear elements and second-order tetrahedra, hexahedra "
-                 "and prisms (set the element order to 1 or 2 first)",
+                 "linear and second-order elements (set the element order "
+                 "to 1 or 2 first)",
                  getme__dim_word(dim, 1), tag, order, name);
     else
         snprintf(msg, size,
