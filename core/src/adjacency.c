@@ -339,16 +339,19 @@ static inline void add_block_sums(int t, getme_adj *adj, const getme_ws *ws,
     int nv = getme__nv[t];
     int ned = ws->dim == 3 ? getme__edges[t].num_edges : 0;
     for (int32_t e = e0; e < e1; e++) {
-        double v = q[e];
+        getme_fx v = getme__fx_q(q[e]);
         const int32_t *c = getme__ws_nodes(ws, t, e);
         for (int i = 0; i < nv; i++)
-            adj->nsum[c[i]] += v;
+            adj->nsum[c[i]] = getme__fx_add(adj->nsum[c[i]], v);
         if (ned == 0)
             continue; /* planar: no edge sums (and no edge arrays) */
         const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
         for (int j = 0; j < ned; j++)
             if (slot[j] != GETME_NO_SLOT)
-                adj->esum[getme__adj_edge(adj, c, t, j, slot[j])] += v;
+            {
+                getme_fx *d = &adj->esum[getme__adj_edge(adj, c, t, j, slot[j])];
+                *d = getme__fx_add(*d, v);
+            }
     }
 }
 

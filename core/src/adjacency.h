@@ -31,6 +31,7 @@
 #ifndef GETME_ADJACENCY_H
 #define GETME_ADJACENCY_H
 
+#include "exact.h"
 #include "workspace.h"
 
 /* An element edge's slot that does not fit in a byte (a node with more
@@ -50,8 +51,10 @@ typedef struct getme_adj {
     uint8_t *irregular; /* ne: 1 = use the union walk for this element     */
     int32_t num_irregular;
     int32_t num_edges;  /* 3-D only                                        */
-    double *nsum;       /* nn: S_v at the current qualities                */
-    double *esum;       /* num_edges: S_e at the current qualities         */
+    /* Exact fixed-point sums (exact.h, scale GETME_FX_Q): the same bits
+       whatever order the elements are added in. */
+    getme_fx *nsum;     /* nn: S_v at the current qualities                */
+    getme_fx *esum;     /* num_edges: S_e at the current qualities         */
 } getme_adj;
 
 /* Build everything above for ws (parallel, deterministic).  GETME_OK or
@@ -88,7 +91,10 @@ static inline int32_t getme__adj_edge(const getme_adj *adj, const int32_t *c,
     return adj->eptr[a < b ? a : b] + slot;
 }
 
-/* Sum of q over N(e) for a regular element e of type t (see above). */
+/* Sum of q over N(e) for a regular element e of type t (see above), as
+   the nearest double to the exact sum of the fixed-point qualities: the
+   inclusion-exclusion is exact in integers, so it equals the union walk's
+   exact sum (weights.c) bit for bit. */
 static inline double getme__adj_nsum(const getme_adj *adj,
                                      const getme_ws *ws, const double *q,
                                      int t, int32_t e)
@@ -97,17 +103,21 @@ static inline double getme__adj_nsum(const getme_adj *adj,
     const getme_face_table *ft = &getme__faces[t];
     const int32_t *f = getme__adj_faces(adj, ws, t, e);
     int nv = getme__nv[t];
-    double sv = 0.0, sf = 0.0, se = 0.0;
+    getme_ufx sv = 0, sf = 0, se = 0;
     for (int i = 0; i < nv; i++)
-        sv += adj->nsum[c[i]];
+        sv += (getme_ufx)adj->nsum[c[i]];
     for (int k = 0; k < ft->num_faces; k++)
-        sf += f[k] >= 0 ? q[f[k]] : 0.0;
+        sf += f[k] >= 0 ? (getme_ufx)getme__fx_q(q[f[k]]) : 0;
+    getme_ufx qe = (getme_ufx)getme__fx_q(q[e]);
     if (ws->dim == 2) /* sum_e S_e = nv q_E + sf, plus q_E once */
-        return sv - (double)(nv - 1) * q[e] - sf;
+        return getme__fx_double((getme_fx)(sv - (getme_ufx)(nv - 1) * qe - sf),
+                                GETME_FX_QINV);
     const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
     for (int k = 0; k < getme__edges[t].num_edges; k++)
-        se += adj->esum[getme__adj_edge(adj, c, t, k, slot[k])];
-    return sv - se + (double)(ft->num_faces - 1) * q[e] + sf;
+        se += (getme_ufx)adj->esum[getme__adj_edge(adj, c, t, k, slot[k])];
+    return getme__fx_double(
+        (getme_fx)(sv - se + (getme_ufx)(ft->num_faces - 1) * qe + sf),
+        GETME_FX_QINV);
 }
 
 #endif /* GETME_ADJACENCY_H */

@@ -47,9 +47,29 @@ static inline double weight(const getme_run *run, int t, int32_t e)
                 ((double)adj->count[e] * q[e]));
 }
 
-/* AddTransformedElementNodesAndWeights for element e (type t). */
-static inline void add_transformed(getme_run *run, int t, int32_t e,
-                                   double sigma)
+/* A node's contribution w * x (3 coordinates) and w, added to its exact
+   fixed-point sums at this iteration's scales (set_scales).  Returns 1 if a
+   coordinate is beyond run->xbound, where the scale's bound would not hold
+   (the term is then not added; the caller redoes the scatter). */
+static inline int add_node(const getme_run *run, int32_t n, double w,
+                           const double *x)
+{
+    double b = run->xbound;
+    if (!(fabs(x[0]) < b && fabs(x[1]) < b && fabs(x[2]) < b))
+        return 1;
+    getme_fx *a = run->facc + 4 * (int64_t)n;
+    double ps = run->pscale;
+    a[0] = getme__fx_add(a[0], getme__fx(w * x[0], ps));
+    a[1] = getme__fx_add(a[1], getme__fx(w * x[1], ps));
+    a[2] = getme__fx_add(a[2], getme__fx(w * x[2], ps));
+    a[3] = getme__fx_add(a[3], getme__fx(w, run->wscale));
+    return 0;
+}
+
+/* AddTransformedElementNodesAndWeights for element e (type t); returns 1
+   on a bound overflow (add_node). */
+static inline int add_transformed(getme_run *run, int t, int32_t e,
+                                  double sigma)
 {
     const getme_ws *ws = run->ws;
     double x[3 * GETME_MAX_NV], y[3 * GETME_MAX_NV];
@@ -57,54 +77,48 @@ static inline void add_transformed(getme_run *run, int t, int32_t e,
     getme__ws_gather(ws, ws->x, t, e, x);
     getme__transform(t, x, sigma, y);
     const int32_t *c = getme__ws_nodes(ws, t, e);
+    int ovf = 0;
     for (int i = 0; i < getme__nv[t]; i++) {
         int32_t n = c[i];
         if (ws->fixed[n])
             continue;
-        double *a = run->acc + 4 * (int64_t)n;
-        a[0] += w * y[3 * i];
-        a[1] += w * y[3 * i + 1];
-        a[2] += w * y[3 * i + 2];
-        a[3] += w;
+        ovf |= add_node(run, n, w, y + 3 * i);
         run->in_t[n] = 1;
     }
+    return ovf;
 }
 
 /* AddUntransformedElementNodesAndWeights for element e (type t). */
-static inline void add_untransformed(getme_run *run, int t, int32_t e)
+static inline int add_untransformed(getme_run *run, int t, int32_t e)
 {
     const getme_ws *ws = run->ws;
     double w = weight(run, t, e);
     const int32_t *c = getme__ws_nodes(ws, t, e);
+    int ovf = 0;
     for (int i = 0; i < getme__nv[t]; i++) {
         int32_t n = c[i];
-        if (!run->in_t[n])
-            continue;
-        const double *x = ws->x + 3 * (int64_t)n;
-        double *a = run->acc + 4 * (int64_t)n;
-        a[0] += w * x[0];
-        a[1] += w * x[1];
-        a[2] += w * x[2];
-        a[3] += w;
+        if (run->in_t[n])
+            ovf |= add_node(run, n, w, ws->x + 3 * (int64_t)n);
     }
+    return ovf;
 }
 
 /* The free elements of [e0, e1), all of type t, transformed; t is a
    constant in each copy (GETME_FOR_TYPE). */
 static inline void transform_block(int t, getme_run *run, int32_t e0,
-                                   int32_t e1, double sigma, int32_t *count)
+                                   int32_t e1, double sigma, int32_t *count,
+                                   int *ovf)
 {
     for (int32_t e = e0; e < e1; e++)
         if (run->ws->free_elem[e]) {
-            add_transformed(run, t, e, sigma);
+            *ovf |= add_transformed(run, t, e, sigma);
             (*count)++;
         }
 }
 
 /* q_mean stage: every free element is transformed.  Blocks run colour by
    colour: blocks of one colour share no node, so they scatter without
-   atomics, and each node receives its contributions in the same order
-   whatever the thread count. */
+   atomics; the sums are exact (exact.h), so their order does not matter. */
 static int32_t scatter_all(getme_run *run, double sigma)
 {
     const getme_ws *ws = run->ws;
@@ -113,15 +127,17 @@ static int32_t scatter_all(getme_run *run, double sigma)
         int32_t b0 = ws->colour_ptr[c], b1 = ws->colour_ptr[c + 1];
         int nt = c == ws->serial_colour ? 1 : ws->nt;
         int32_t count = 0;
+        int ovf = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nt) \
-    reduction(+ : count)
+    reduction(+ : count) reduction(| : ovf)
         for (int32_t k = b0; k < b1; k++) {
             int32_t b = ws->colour_blocks[k];
             int32_t e0 = ws->block_start[b], e1 = ws->block_start[b + 1];
             GETME_FOR_TYPE(getme__ws_type(ws, e0), transform_block, run, e0,
-                           e1, sigma, &count);
+                           e1, sigma, &count, &ovf);
         }
         total += count;
+        run->overflow |= ovf;
     }
     return total;
 }
@@ -174,15 +190,17 @@ static int32_t scatter_some(getme_run *run, double qt, double sigma)
         run->eflag[run->elems[k]] = 0;
     run->num_nodes = nn;
     run->num_elems = ne;
+    int ovf = 0;
     for (int32_t k = 0; k < run->num_t; k++) {
         int32_t e = run->tlist[k];
-        add_transformed(run, getme__ws_type(ws, e), e, sigma);
+        ovf |= add_transformed(run, getme__ws_type(ws, e), e, sigma);
     }
     for (int32_t k = 0; k < ne; k++) {
         int32_t e = run->elems[k];
         if (run->q[e] > qt)
-            add_untransformed(run, getme__ws_type(ws, e), e);
+            ovf |= add_untransformed(run, getme__ws_type(ws, e), e);
     }
+    run->overflow |= ovf;
     return run->num_t;
 }
 
@@ -209,10 +227,9 @@ static int tlist_reserve(getme_run *run, int64_t n)
 /* After an iteration of the q*_min stage: bring the Eq. 9 sums up to date
    by the quality changes of the elements that moved (run->elems; their old
    qualities are in run->qold), and the list of elements with q <= q_t
-   (only those elements can have entered or left it).  The sums are
-   updated serially in list order, so they do not depend on the thread
-   count; each cycle start recomputes them from scratch, which bounds the
-   rounding drift of the updates. */
+   (only those elements can have entered or left it).  The sums are exact
+   fixed point (exact.h): an update by the difference of the old and new
+   fixed-point qualities gives the same bits as a recomputation. */
 static getme_status update_after(getme_run *run, double qt)
 {
     const getme_ws *ws = run->ws;
@@ -221,18 +238,22 @@ static getme_status update_after(getme_run *run, double qt)
         getme__adj_sums_all(adj, ws, run->q);
     for (int32_t k = 0; run->qold && k < run->num_elems; k++) {
         int32_t e = run->elems[k];
-        double d = run->q[e] - run->qold[k];
-        if (d == 0.0)
+        if (run->q[e] == run->qold[k])
             continue;
+        getme_fx d = getme__fx_sub(getme__fx_q(run->q[e]),
+                                   getme__fx_q(run->qold[k]));
         int t = getme__ws_type(ws, e);
         const int32_t *c = getme__ws_nodes(ws, t, e);
         for (int i = 0; i < getme__nv[t]; i++)
-            adj->nsum[c[i]] += d;
+            adj->nsum[c[i]] = getme__fx_add(adj->nsum[c[i]], d);
         if (ws->dim == 3) {
             const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
             for (int j = 0; j < getme__edges[t].num_edges; j++)
-                if (slot[j] != GETME_NO_SLOT)
-                    adj->esum[getme__adj_edge(adj, c, t, j, slot[j])] += d;
+                if (slot[j] != GETME_NO_SLOT) {
+                    getme_fx *s =
+                        &adj->esum[getme__adj_edge(adj, c, t, j, slot[j])];
+                    *s = getme__fx_add(*s, d);
+                }
         }
     }
 
@@ -278,18 +299,78 @@ static getme_status start_tlist(getme_run *run, double qt)
     return GETME_OK;
 }
 
-/* ComputeNewNodes: p-hat = weighted sum / weight sum, for I_T. */
+/* ComputeNewNodes: p-hat = weighted sum / weight sum, for I_T, from the
+   exact sums (which are cleared for the next iteration).  The quotient of
+   the two integers' doubles is scaled back by wscale / pscale, a power of
+   two, so the only roundings are the two conversions and the division. */
 static void compute_new_nodes(getme_run *run)
 {
+    double back = run->wscale / run->pscale;
 #pragma omp parallel for schedule(static) num_threads(run->ws->nt) \
     if (run->num_nodes > GETME_PAR_MIN)
     for (int32_t k = 0; k < run->num_nodes; k++) {
-        double *a = run->acc + 4 * (int64_t)run->nodes[k];
-        double inv = 1.0 / a[3];
-        a[0] *= inv;
-        a[1] *= inv;
-        a[2] *= inv;
+        int64_t n = run->nodes[k];
+        getme_fx *f = run->facc + 4 * n;
+        double *a = run->acc + 4 * n;
+        double inv = 1.0 / (double)f[3];
+        a[0] = (double)f[0] * inv * back;
+        a[1] = (double)f[1] * inv * back;
+        a[2] = (double)f[2] * inv * back;
+        f[0] = f[1] = f[2] = f[3] = 0;
     }
+}
+
+/* Undo a scatter: zero the sums and the I_T flags it set. */
+static void clear_sums(getme_run *run)
+{
+    memset(run->facc, 0, (size_t)run->ws->nn * 4 * sizeof *run->facc);
+    for (int32_t k = 0; k < run->num_nodes; k++)
+        run->in_t[run->nodes[k]] = 0;
+}
+
+/* This iteration's fixed-point scales (exact.h), from bounds every term
+   obeys:
+     w = sqrt(mean of q over N(E) / q_E) <= sqrt(2 / q_lo) <= W, where
+       q_lo is the lowest quality of a free element (every element that
+       contributes has a free node, and q <= 1 up to rounding);
+     |x| < xbound for every node contributed (add_node checks it);
+     a node sums fewer than star_bound terms (its elements).
+   So |sum w x| < star_bound W xbound and |sum w| < star_bound W, and the
+   scales 2^126 / (star_bound W xbound), 2^126 / (star_bound W) keep both
+   below 2^126.  All factors are powers of two, so the scales are exact.
+   Precision: a term's truncation is < 1 / pscale; p-hat = sum w x / sum w
+   with sum w >= n w_lo, w_lo >= sqrt(q_lo), so p-hat's error is below
+   star_bound W xbound 2^-126 / sqrt(q_lo) <= star_bound xbound 2^-124 / q_lo:
+   for star_bound <= 2^12 and q_lo >= 2^-50 that is < 2^-62 xbound, far
+   below the double rounding of a coordinate near xbound (docs/distributed.md
+   gives the full argument). */
+static void set_scales(getme_run *run, double q_lo)
+{
+    double lo = q_lo > 0x1p-600 ? q_lo : 0x1p-600;
+    double W = getme__pow2_ceil(sqrt(2.0 / lo) * (1.0 + 0x1p-40));
+    run->wscale = ldexp(0x1p126 / run->star_bound, -ilogb(W));
+    run->pscale = ldexp(run->wscale, -ilogb(run->xbound));
+}
+
+/* xbound: a power of two above 16 |x| for every coordinate x of the mesh
+   (a transformed element stays near its own nodes, so its nodes are far
+   inside; add_node checks), and star_bound. */
+static void set_bounds(getme_run *run)
+{
+    const getme_ws *ws = run->ws;
+    double m = 0.0;
+    int64_t big = 0;
+#pragma omp parallel for schedule(static) num_threads(ws->nt) \
+    reduction(max : m, big)
+    for (int32_t i = 0; i < ws->nn; i++) {
+        const double *x = ws->x + 3 * (int64_t)i;
+        for (int d = 0; d < 3; d++)
+            m = fabs(x[d]) > m ? fabs(x[d]) : m;
+        int64_t s = ws->star_ptr[i + 1] - ws->star_ptr[i];
+        big = s > big ? s : big;
+    }
+    run->xbound = 16.0 * getme__pow2_ceil(m > 0x1p-500 ? m : 0x1p-500);
+    run->star_bound = getme__pow2_ceil((double)big + 1.0);
 }
 
 /* Room for the old qualities of run->num_elems elements in run->qold,
@@ -311,15 +392,24 @@ static void qold_reserve(getme_run *run)
    Decided by the stage, not by qt: a q*_min cycle's qt can be 1 on a
    mesh that is mostly perfect, and must still use its own lists. */
 static getme_status iterate(getme_run *run, int mean_stage, double qt,
-                            const double *R, int nR,
+                            double q_lo, const double *R, int nR,
                             int32_t *num_transformed, int32_t *num_relaxed)
 {
     double sigma = run->params->sigma;
-    if (mean_stage) {
+    if (mean_stage)
         getme__adj_sums_all(run->adj, run->ws, run->q);
-        *num_transformed = scatter_all(run, sigma);
-    } else {
-        *num_transformed = scatter_some(run, qt, sigma);
+    for (;;) {
+        set_scales(run, q_lo);
+        run->overflow = 0;
+        *num_transformed = mean_stage ? scatter_all(run, sigma)
+                                      : scatter_some(run, qt, sigma);
+        if (!run->overflow)
+            break;
+        /* A transformed node beyond xbound (never seen in practice): clear
+           the sums and start over with room for it; deterministic, since
+           the bound and the test are. */
+        clear_sums(run);
+        run->xbound *= 256.0;
     }
     compute_new_nodes(run);
     if (!mean_stage) {
@@ -443,7 +533,8 @@ static getme_status alloc_adaptive(getme_run *run)
     const getme_ws *ws = run->ws;
     size_t ne = (size_t)(ws->ne ? ws->ne : 1);
     run->tflag = calloc(ne, 1);
-    if (!run->tflag)
+    run->facc = calloc((size_t)(ws->nn ? ws->nn : 1) * 4, sizeof *run->facc);
+    if (!run->tflag || !run->facc)
         return GETME_ERR_NOMEM;
     if (run->adj->num_irregular == 0)
         return GETME_OK;
@@ -461,6 +552,8 @@ static void free_adaptive(getme_run *run)
     free(run->tlist);
     free(run->tflag);
     free(run->qold);
+    free(run->facc);
+    run->facc = NULL;
     run->qold = NULL, run->cap_qold = 0, run->cap_t = 0;
     if (run->stamps)
         for (int t = 0; t < run->ws->nt; t++)
@@ -496,6 +589,7 @@ getme_status getme__adaptive(getme_run *run)
     if (p->keep_best && !best)
         goto done;
     lists_all(run);
+    set_bounds(run);
     run->guard = p->corner_guard;
     set_corner_floor(run, p->corner_floor > res->corner_sj_initial
                               ? p->corner_floor
@@ -515,8 +609,8 @@ getme_status getme__adaptive(getme_run *run)
         int32_t ntrans, nrelax;
         getme_stage stage = state == MEAN_RUNNING ? GETME_STAGE_MEAN
                                                   : GETME_STAGE_MIN;
-        if ((st = iterate(run, state == MEAN_RUNNING, qt, R, nR, &ntrans,
-                          &nrelax)) != GETME_OK)
+        if ((st = iterate(run, state == MEAN_RUNNING, qt, q_min, R, nR,
+                          &ntrans, &nrelax)) != GETME_OK)
             break;
         double prev_mean = q_mean, prev_min = q_min;
         getme__ws_summary(ws, run->q, &q_mean, &q_min, NULL);

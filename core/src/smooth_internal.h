@@ -5,6 +5,7 @@
 #ifndef GETME_SMOOTH_INTERNAL_H
 #define GETME_SMOOTH_INTERNAL_H
 
+#include "exact.h"
 #include "workspace.h"
 
 /* Loops over fewer items than this run on one thread: in the q*_min stage
@@ -48,6 +49,13 @@ typedef struct getme_run {
     double *qold;       /* q*_min stage: qualities of run->elems before the
                            relaxation step (NULL: sums are recomputed)      */
     int64_t cap_qold;
+    /* GETMe's node sums in exact fixed point (exact.h, getme_adaptive.c):
+       per node sum w x' (3) and sum w, zero between iterations. */
+    getme_fx *facc;     /* 4 * nn                                          */
+    double xbound;      /* power of two >= |x'| of any transformed node    */
+    double star_bound;  /* power of two > any node's number of elements    */
+    double pscale, wscale; /* this iteration's scales of sum w x', sum w   */
+    int overflow;       /* a term exceeded xbound: the scatter is redone   */
     /* The corner guard (params.corner_guard): relaxation and the finishing
        step treat a hex/prism/pyramid/quad whose worst corner falls below
        min(its old value, corner_floor) like an invalid element. */

@@ -45,21 +45,23 @@ static double union_weight(const getme_ws *ws, const double *q, int t,
         total += ws->star_ptr[c[i] + 1] - ws->star_ptr[c[i]];
 
     if (total > MAX_UNION) {
-        double sum = 0.0;
+        getme_ufx sum = 0;
         int32_t count = 0;
         for (int i = 0; i < nv; i++)
             for (int64_t k = ws->star_ptr[c[i]]; k < ws->star_ptr[c[i] + 1]; k++) {
                 int32_t n = ws->star[k];
                 int fresh = mark[n] != now;
                 mark[n] = now;
-                sum += fresh ? q[n] : 0.0;
+                sum += fresh ? (getme_ufx)getme__fx_q(q[n]) : 0;
                 count += fresh;
             }
-        return sqrt(sum / ((double)count * q[e]));
+        return sqrt(getme__fx_double((getme_fx)sum, GETME_FX_QINV) /
+                    ((double)count * q[e]));
     }
     /* Pass 1: the union's members, each once (branch-free append).
-       Pass 2: their qualities, summed in four independent chains so the
-       additions overlap; the order is fixed, so the result is too. */
+       Pass 2: their qualities, summed exactly in fixed point (exact.h), so
+       the result equals the inclusion-exclusion formula's (adjacency.h)
+       and does not depend on the order of the stars. */
     int32_t u[MAX_UNION];
     int32_t count = 0;
     for (int i = 0; i < nv; i++) {
@@ -72,17 +74,11 @@ static double union_weight(const getme_ws *ws, const double *q, int t,
             mark[n] = now;
         }
     }
-    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
-    int32_t k = 0;
-    for (; k + 4 <= count; k += 4) {
-        s0 += q[u[k]];
-        s1 += q[u[k + 1]];
-        s2 += q[u[k + 2]];
-        s3 += q[u[k + 3]];
-    }
-    for (; k < count; k++)
-        s0 += q[u[k]];
-    return sqrt(((s0 + s1) + (s2 + s3)) / ((double)count * q[e]));
+    getme_ufx sum = 0;
+    for (int32_t k = 0; k < count; k++)
+        sum += (getme_ufx)getme__fx_q(q[u[k]]);
+    return sqrt(getme__fx_double((getme_fx)sum, GETME_FX_QINV) /
+                ((double)count * q[e]));
 }
 
 double getme__weight_union(const getme_run *run, int t, int32_t e)

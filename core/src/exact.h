@@ -1,0 +1,93 @@
+/*
+ * exact.h -- order-independent exact sums: 128-bit fixed point.
+ *
+ * Why: a floating-point sum depends on the order of its terms.  GETMe
+ * adaptive adds element contributions into nodes (Eq. 9 numerators and
+ * weights, the per-node and per-edge quality sums behind the weights) and
+ * sums all qualities into q_mean; the order of those additions follows the
+ * colouring of the workspace, which depends on how the mesh is numbered and
+ * split (threads, MPI ranks).  Integers add associatively, so if every term
+ * is first rounded to a fixed-point integer (a deterministic function of
+ * the term alone) and the sum is exact, the total is the same bits for any
+ * order, any thread count and any partition of the mesh (docs/distributed.md).
+ *
+ * Representation: a signed 128-bit integer n standing for n * 2^-s; the
+ * scale s belongs to the kind of sum (GETME_FX_Q for qualities, per
+ * iteration for GETMe's position sums, getme_adaptive.c).  A term v is
+ * stored as trunc(v * 2^s) (towards zero): error < 2^-s per term.
+ *
+ * Bounds (why nothing overflows): the sum of n terms with |v| <= 2^b has
+ * |sum * 2^s| <= n * 2^(b + s), which fits when log2(n) + b + s <= 126
+ * (the 127th bit is the sign).  Each user states its b and n in a comment.
+ * Sums are kept in unsigned arithmetic (wrap-around is defined, and the
+ * bounds keep the true value representable, so the wrap never happens in
+ * the final result even if a partial sum of mixed signs would overflow).
+ */
+#ifndef GETME_EXACT_H
+#define GETME_EXACT_H
+
+#include <math.h>
+#include <stdint.h>
+
+__extension__ typedef __int128 getme_fx;
+__extension__ typedef unsigned __int128 getme_ufx;
+
+/* Scale of quality sums: q in [-2, 2] (mean ratio <= 1 plus rounding;
+   relaxation's trial values may be negative), at most 2^31 terms (32-bit
+   element indices) plus the inclusion-exclusion's few multiples: 1 + 31 +
+   GETME_FX_Q <= 126 with room to spare.  A term keeps 2^-90 absolute
+   precision: finer than a double's 2^-53 relative precision of any
+   quality above 2^-37, and of any sum of more than one such quality. */
+#define GETME_FX_Q 90
+#define GETME_FX_QSCALE 0x1p90
+#define GETME_FX_QINV 0x1p-90
+
+/* trunc(v * scale) as a fixed-point integer; scale is a power of two and
+   |v * scale| < 2^126 (the caller's bound).  Exact: a = |v| * scale is a
+   double with an integer part of at most 126 bits; hi = floor(a / 2^63)
+   has at most 53 significant bits (a's own), so hi * 2^63 is exact and so
+   is the remainder a - hi * 2^63 in [0, 2^63) (it keeps a subset of a's
+   mantissa bits); its integer part is lo. */
+static inline getme_fx getme__fx(double v, double scale)
+{
+    double a = fabs(v * scale);
+    int64_t hi = (int64_t)(a * 0x1p-63);
+    int64_t lo = (int64_t)(a - (double)hi * 0x1p63);
+    getme_ufx r = ((getme_ufx)(uint64_t)hi << 63) + (getme_ufx)(uint64_t)lo;
+    return v < 0.0 ? (getme_fx)(-r) : (getme_fx)r;
+}
+
+/* Wrap-around addition (see above). */
+static inline getme_fx getme__fx_add(getme_fx a, getme_fx b)
+{
+    return (getme_fx)((getme_ufx)a + (getme_ufx)b);
+}
+
+static inline getme_fx getme__fx_sub(getme_fx a, getme_fx b)
+{
+    return (getme_fx)((getme_ufx)a - (getme_ufx)b);
+}
+
+/* n * 2^-s as the nearest double (inv = 2^-s, a power of two: exact). */
+static inline double getme__fx_double(getme_fx n, double inv)
+{
+    return (double)n * inv;
+}
+
+/* A quality as a fixed-point term. */
+static inline getme_fx getme__fx_q(double q)
+{
+    return getme__fx(q, GETME_FX_QSCALE);
+}
+
+/* The smallest power of two >= v (v > 0, finite); 1 for v <= 0. */
+static inline double getme__pow2_ceil(double v)
+{
+    if (!(v > 0.0))
+        return 1.0;
+    int ex;
+    double m = frexp(v, &ex); /* v = m 2^ex, m in [0.5, 1) */
+    return ldexp(1.0, m == 0.5 ? ex - 1 : ex);
+}
+
+#endif /* GETME_EXACT_H */
