@@ -51,10 +51,19 @@ typedef struct getme_adj {
     uint8_t *irregular; /* ne: 1 = use the union walk for this element     */
     int32_t num_irregular;
     int32_t num_edges;  /* 3-D only                                        */
-    /* Exact fixed-point sums (exact.h, scale GETME_FX_Q): the same bits
-       whatever order the elements are added in. */
-    getme_fx *nsum;     /* nn: S_v at the current qualities                */
-    getme_fx *esum;     /* num_edges: S_e at the current qualities         */
+    /* Exact fixed-point sums (exact.h): the same bits whatever order the
+       elements are added in.  A quality q (|q| < 2) is the integer
+       trunc(q * qscale), qscale = 2^(61 - b) with 2^b > the largest star,
+       so a term is below 2^(62 - b) and a node's or an edge's sum (at most
+       2^b - 1 terms) below 2^62: int64 holds it.  The inclusion-exclusion
+       of up to 8 node and 12 edge sums is done in 128 bits.  A term's
+       truncation (< 1 / qscale = 2^(b - 61)) is below double's rounding of
+       a sum of 2^b terms averaging more than 2^(2b - 8) / 2^b... in short:
+       for stars up to 2^7 elements and mean qualities above 1/128, no
+       worse than the double sums it replaces (docs/distributed.md). */
+    int64_t *nsum;      /* nn: S_v at the current qualities                */
+    int64_t *esum;      /* num_edges: S_e at the current qualities         */
+    double qscale, qinv; /* 2^(61 - b) and its inverse                    */
 } getme_adj;
 
 /* Build everything above for ws (parallel, deterministic).  GETME_OK or
@@ -103,21 +112,20 @@ static inline double getme__adj_nsum(const getme_adj *adj,
     const getme_face_table *ft = &getme__faces[t];
     const int32_t *f = getme__adj_faces(adj, ws, t, e);
     int nv = getme__nv[t];
-    getme_ufx sv = 0, sf = 0, se = 0;
+    const double qs = adj->qscale;
+    getme_fx sv = 0, sf = 0, se = 0;
     for (int i = 0; i < nv; i++)
-        sv += (getme_ufx)adj->nsum[c[i]];
+        sv += adj->nsum[c[i]];
     for (int k = 0; k < ft->num_faces; k++)
-        sf += f[k] >= 0 ? (getme_ufx)getme__fx_q(q[f[k]]) : 0;
-    getme_ufx qe = (getme_ufx)getme__fx_q(q[e]);
+        sf += f[k] >= 0 ? getme__fx64(q[f[k]], qs) : 0;
+    getme_fx qe = getme__fx64(q[e], qs);
     if (ws->dim == 2) /* sum_e S_e = nv q_E + sf, plus q_E once */
-        return getme__fx_double((getme_fx)(sv - (getme_ufx)(nv - 1) * qe - sf),
-                                GETME_FX_QINV);
+        return getme__fx_double(sv - (nv - 1) * qe - sf, adj->qinv);
     const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
     for (int k = 0; k < getme__edges[t].num_edges; k++)
-        se += (getme_ufx)adj->esum[getme__adj_edge(adj, c, t, k, slot[k])];
-    return getme__fx_double(
-        (getme_fx)(sv - se + (getme_ufx)(ft->num_faces - 1) * qe + sf),
-        GETME_FX_QINV);
+        se += adj->esum[getme__adj_edge(adj, c, t, k, slot[k])];
+    return getme__fx_double(sv - se + (ft->num_faces - 1) * qe + sf,
+                            adj->qinv);
 }
 
 #endif /* GETME_ADJACENCY_H */

@@ -74,10 +74,18 @@ static inline double getme__fx_double(getme_fx n, double inv)
     return (double)n * inv;
 }
 
-/* A quality as a fixed-point term. */
+/* A quality as a fixed-point term at scale 2^90 (q_mean's sums). */
 static inline getme_fx getme__fx_q(double q)
 {
     return getme__fx(q, GETME_FX_QSCALE);
+}
+
+/* trunc(v * scale) for |v * scale| < 2^63: one conversion instruction.
+   The Eq. 9 sums use it (adjacency.h): half the memory of 128 bits, which
+   is what their scattered loads cost. */
+static inline int64_t getme__fx64(double v, double scale)
+{
+    return (int64_t)(v * scale);
 }
 
 /* The smallest power of two >= v (v > 0, finite); 1 for v <= 0. */

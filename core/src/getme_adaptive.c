@@ -47,11 +47,14 @@ static inline double weight(const getme_run *run, int t, int32_t e)
                 ((double)adj->count[e] * q[e]));
 }
 
-/* A node's contribution w * x (3 coordinates) and w, added to its exact
-   fixed-point sums at this iteration's scales (set_scales).  Returns 1 if a
-   coordinate is beyond run->xbound, where the scale's bound would not hold
-   (the term is then not added; the caller redoes the scatter). */
-static inline int add_node(const getme_run *run, int32_t n, double w,
+/* A node's contribution w x (3 coordinates) and w, added to its exact
+   fixed-point sums (set_scales): wf = trunc(w wscale) is the element's
+   weight as an integer, each coordinate becomes trunc(x pscale), and their
+   product is exact in 128 bits, so sum w x and sum w are exact sums of the
+   same integer weights.  Returns 1 if a coordinate is beyond run->xbound,
+   where the bound would not hold (nothing is added; the caller redoes the
+   scatter with a larger bound). */
+static inline int add_node(const getme_run *run, int32_t n, int64_t wf,
                            const double *x)
 {
     double b = run->xbound;
@@ -59,10 +62,10 @@ static inline int add_node(const getme_run *run, int32_t n, double w,
         return 1;
     getme_fx *a = run->facc + 4 * (int64_t)n;
     double ps = run->pscale;
-    a[0] = getme__fx_add(a[0], getme__fx(w * x[0], ps));
-    a[1] = getme__fx_add(a[1], getme__fx(w * x[1], ps));
-    a[2] = getme__fx_add(a[2], getme__fx(w * x[2], ps));
-    a[3] = getme__fx_add(a[3], getme__fx(w, run->wscale));
+    a[0] += (getme_fx)wf * getme__fx64(x[0], ps);
+    a[1] += (getme_fx)wf * getme__fx64(x[1], ps);
+    a[2] += (getme_fx)wf * getme__fx64(x[2], ps);
+    a[3] += wf;
     return 0;
 }
 
@@ -73,7 +76,7 @@ static inline int add_transformed(getme_run *run, int t, int32_t e,
 {
     const getme_ws *ws = run->ws;
     double x[3 * GETME_MAX_NV], y[3 * GETME_MAX_NV];
-    double w = weight(run, t, e);
+    int64_t w = getme__fx64(weight(run, t, e), run->wscale);
     getme__ws_gather(ws, ws->x, t, e, x);
     getme__transform(t, x, sigma, y);
     const int32_t *c = getme__ws_nodes(ws, t, e);
@@ -92,7 +95,7 @@ static inline int add_transformed(getme_run *run, int t, int32_t e,
 static inline int add_untransformed(getme_run *run, int t, int32_t e)
 {
     const getme_ws *ws = run->ws;
-    double w = weight(run, t, e);
+    int64_t w = getme__fx64(weight(run, t, e), run->wscale);
     const int32_t *c = getme__ws_nodes(ws, t, e);
     int ovf = 0;
     for (int i = 0; i < getme__nv[t]; i++) {
@@ -240,19 +243,19 @@ static getme_status update_after(getme_run *run, double qt)
         int32_t e = run->elems[k];
         if (run->q[e] == run->qold[k])
             continue;
-        getme_fx d = getme__fx_sub(getme__fx_q(run->q[e]),
-                                   getme__fx_q(run->qold[k]));
+        uint64_t d = (uint64_t)getme__fx64(run->q[e], adj->qscale) -
+                     (uint64_t)getme__fx64(run->qold[k], adj->qscale);
         int t = getme__ws_type(ws, e);
         const int32_t *c = getme__ws_nodes(ws, t, e);
         for (int i = 0; i < getme__nv[t]; i++)
-            adj->nsum[c[i]] = getme__fx_add(adj->nsum[c[i]], d);
+            adj->nsum[c[i]] = (int64_t)((uint64_t)adj->nsum[c[i]] + d);
         if (ws->dim == 3) {
             const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
             for (int j = 0; j < getme__edges[t].num_edges; j++)
                 if (slot[j] != GETME_NO_SLOT) {
-                    getme_fx *s =
+                    int64_t *s =
                         &adj->esum[getme__adj_edge(adj, c, t, j, slot[j])];
-                    *s = getme__fx_add(*s, d);
+                    *s = (int64_t)((uint64_t)*s + d);
                 }
         }
     }
@@ -301,11 +304,11 @@ static getme_status start_tlist(getme_run *run, double qt)
 
 /* ComputeNewNodes: p-hat = weighted sum / weight sum, for I_T, from the
    exact sums (which are cleared for the next iteration).  The quotient of
-   the two integers' doubles is scaled back by wscale / pscale, a power of
-   two, so the only roundings are the two conversions and the division. */
+   the two integers' doubles is scaled back by 1 / pscale, a power of two,
+   so the only roundings are the two conversions and the division. */
 static void compute_new_nodes(getme_run *run)
 {
-    double back = run->wscale / run->pscale;
+    double back = 1.0 / run->pscale;
 #pragma omp parallel for schedule(static) num_threads(run->ws->nt) \
     if (run->num_nodes > GETME_PAR_MIN)
     for (int32_t k = 0; k < run->num_nodes; k++) {
@@ -329,27 +332,29 @@ static void clear_sums(getme_run *run)
 }
 
 /* This iteration's fixed-point scales (exact.h), from bounds every term
-   obeys:
-     w = sqrt(mean of q over N(E) / q_E) <= sqrt(2 / q_lo) <= W, where
-       q_lo is the lowest quality of a free element (every element that
+   obeys, all powers of two (so the scales are exact):
+     w = sqrt(mean of q over N(E) / q_E) <= sqrt(2 / q_lo) <= W, where q_lo
+       is the lowest quality of a free element (every element that
        contributes has a free node, and q <= 1 up to rounding);
-     |x| < xbound for every node contributed (add_node checks it);
-     a node sums fewer than star_bound terms (its elements).
-   So |sum w x| < star_bound W xbound and |sum w| < star_bound W, and the
-   scales 2^126 / (star_bound W xbound), 2^126 / (star_bound W) keep both
-   below 2^126.  All factors are powers of two, so the scales are exact.
-   Precision: a term's truncation is < 1 / pscale; p-hat = sum w x / sum w
-   with sum w >= n w_lo, w_lo >= sqrt(q_lo), so p-hat's error is below
-   star_bound W xbound 2^-126 / sqrt(q_lo) <= star_bound xbound 2^-124 / q_lo:
-   for star_bound <= 2^12 and q_lo >= 2^-50 that is < 2^-62 xbound, far
-   below the double rounding of a coordinate near xbound (docs/distributed.md
-   gives the full argument). */
+     |x| < xbound for every coordinate contributed (add_node checks it);
+     a node sums fewer than star_bound = 2^b terms (its elements).
+   wscale = 2^(64 - b) / W makes the integer weight wf < 2^(64 - b);
+   pscale = 2^62 / xbound makes a coordinate's integer < 2^62; a product is
+   below 2^(126 - b) and a node's sum of fewer than 2^b of them below 2^126:
+   no overflow in 128 bits (and sum wf < 2^64).
+   Precision: a coordinate's truncation is < 1 / pscale = 2^-62 xbound
+   = 2^-58 X (X = 2^ceil(log2 max |x|)), below a double's 2^-52 X ulp at
+   the mesh's extent; p-hat is a mean with the integer weights, so their
+   truncation (relative < W / (w 2^(64 - b)) <= 2^(b - 62) / q_lo) only
+   perturbs the weights, moving p-hat by at most that fraction of the
+   spread of the points averaged (an element's size), never by X
+   (docs/distributed.md). */
 static void set_scales(getme_run *run, double q_lo)
 {
     double lo = q_lo > 0x1p-600 ? q_lo : 0x1p-600;
     double W = getme__pow2_ceil(sqrt(2.0 / lo) * (1.0 + 0x1p-40));
-    run->wscale = ldexp(0x1p126 / run->star_bound, -ilogb(W));
-    run->pscale = ldexp(run->wscale, -ilogb(run->xbound));
+    run->wscale = 0x1p64 / run->star_bound / W;
+    run->pscale = 0x1p62 / run->xbound;
 }
 
 /* xbound: a power of two above 16 |x| for every coordinate x of the mesh
@@ -371,6 +376,8 @@ static void set_bounds(getme_run *run)
     }
     run->xbound = 16.0 * getme__pow2_ceil(m > 0x1p-500 ? m : 0x1p-500);
     run->star_bound = getme__pow2_ceil((double)big + 1.0);
+    if (run->star_bound < 4.0) /* wf < 2^62: an int64 */
+        run->star_bound = 4.0;
 }
 
 /* Room for the old qualities of run->num_elems elements in run->qold,
@@ -533,7 +540,11 @@ static getme_status alloc_adaptive(getme_run *run)
     const getme_ws *ws = run->ws;
     size_t ne = (size_t)(ws->ne ? ws->ne : 1);
     run->tflag = calloc(ne, 1);
-    run->facc = calloc((size_t)(ws->nn ? ws->nn : 1) * 4, sizeof *run->facc);
+    /* 64-byte aligned: a node's four sums are one cache line. */
+    size_t fbytes = (size_t)(ws->nn ? ws->nn : 1) * 4 * sizeof *run->facc;
+    run->facc = aligned_alloc(64, fbytes);
+    if (run->facc)
+        memset(run->facc, 0, fbytes);
     if (!run->tflag || !run->facc)
         return GETME_ERR_NOMEM;
     if (run->adj->num_irregular == 0)

@@ -29,9 +29,10 @@
    hundreds of elements) takes the slower single-pass path. */
 #define MAX_UNION 1024
 
-static double union_weight(const getme_ws *ws, const double *q, int t,
-                           int32_t e, getme_stamp *st)
+static double union_weight(const getme_ws *ws, const getme_adj *adj,
+                           const double *q, int t, int32_t e, getme_stamp *st)
 {
+    const double qs = adj->qscale;
     const int32_t *c = getme__ws_nodes(ws, t, e);
     int nv = getme__nv[t];
     if (++st->now == 0) { /* wrapped after 2^32 elements: start afresh */
@@ -45,17 +46,17 @@ static double union_weight(const getme_ws *ws, const double *q, int t,
         total += ws->star_ptr[c[i] + 1] - ws->star_ptr[c[i]];
 
     if (total > MAX_UNION) {
-        getme_ufx sum = 0;
+        getme_fx sum = 0;
         int32_t count = 0;
         for (int i = 0; i < nv; i++)
             for (int64_t k = ws->star_ptr[c[i]]; k < ws->star_ptr[c[i] + 1]; k++) {
                 int32_t n = ws->star[k];
                 int fresh = mark[n] != now;
                 mark[n] = now;
-                sum += fresh ? (getme_ufx)getme__fx_q(q[n]) : 0;
+                sum += fresh ? getme__fx64(q[n], qs) : 0;
                 count += fresh;
             }
-        return sqrt(getme__fx_double((getme_fx)sum, GETME_FX_QINV) /
+        return sqrt(getme__fx_double(sum, adj->qinv) /
                     ((double)count * q[e]));
     }
     /* Pass 1: the union's members, each once (branch-free append).
@@ -74,14 +75,14 @@ static double union_weight(const getme_ws *ws, const double *q, int t,
             mark[n] = now;
         }
     }
-    getme_ufx sum = 0;
+    getme_fx sum = 0;
     for (int32_t k = 0; k < count; k++)
-        sum += (getme_ufx)getme__fx_q(q[u[k]]);
-    return sqrt(getme__fx_double((getme_fx)sum, GETME_FX_QINV) /
-                ((double)count * q[e]));
+        sum += getme__fx64(q[u[k]], qs);
+    return sqrt(getme__fx_double(sum, adj->qinv) / ((double)count * q[e]));
 }
 
 double getme__weight_union(const getme_run *run, int t, int32_t e)
 {
-    return union_weight(run->ws, run->q, t, e, &run->stamps[omp_get_thread_num()]);
+    return union_weight(run->ws, run->adj, run->q, t, e,
+                        &run->stamps[omp_get_thread_num()]);
 }
