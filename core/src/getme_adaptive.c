@@ -113,7 +113,7 @@ static inline void transform_block(int t, getme_run *run, int32_t e0,
                                    int *ovf)
 {
     for (int32_t e = e0; e < e1; e++)
-        if (run->ws->free_elem[e]) {
+        if (run->ws->free_elem[e] && getme__owned(run, e)) {
             *ovf |= add_transformed(run, t, e, sigma);
             (*count)++;
         }
@@ -180,6 +180,13 @@ static int32_t scatter_some(getme_run *run, double qt, double sigma)
                 run->nodes[nn++] = c[i];
             }
     }
+    if (run->comm) { /* I_T of the whole mesh: nodes of remote t-elements */
+        getme__dist_node_or(run, run->in_t);
+        nn = 0;
+        for (int32_t i = 0; i < ws->nn; i++)
+            if (run->in_t[i])
+                run->nodes[nn++] = i;
+    }
     for (int32_t k = 0; k < nn; k++) /* the elements around I_T */
         for (int64_t j = ws->star_ptr[run->nodes[k]];
              j < ws->star_ptr[run->nodes[k] + 1]; j++) {
@@ -200,7 +207,7 @@ static int32_t scatter_some(getme_run *run, double qt, double sigma)
     }
     for (int32_t k = 0; k < ne; k++) {
         int32_t e = run->elems[k];
-        if (run->q[e] > qt)
+        if (run->q[e] > qt && getme__owned(run, e))
             ovf |= add_untransformed(run, getme__ws_type(ws, e), e);
     }
     run->overflow |= ovf;
@@ -272,7 +279,7 @@ static getme_status update_after(getme_run *run, double qt)
     }
     for (int32_t k = 0; k < run->num_elems; k++) {
         int32_t e = run->elems[k];
-        if (run->q[e] <= qt && !run->tflag[e]) {
+        if (run->q[e] <= qt && !run->tflag[e] && getme__owned(run, e)) {
             run->tflag[e] = 1;
             run->tlist[n++] = e;
         }
@@ -289,7 +296,8 @@ static getme_status start_tlist(getme_run *run, double qt)
     const getme_ws *ws = run->ws;
     int32_t n = 0;
     for (int32_t e = 0; e < ws->ne; e++) {
-        run->tflag[e] = ws->free_elem[e] && run->q[e] <= qt;
+        run->tflag[e] =
+            ws->free_elem[e] && getme__owned(run, e) && run->q[e] <= qt;
         n += run->tflag[e];
     }
     if (tlist_reserve(run, n) != 0)
@@ -374,8 +382,17 @@ static void set_bounds(getme_run *run)
         int64_t s = ws->star_ptr[i + 1] - ws->star_ptr[i];
         big = s > big ? s : big;
     }
+    double neg[2] = {-m, -(double)big}; /* maxima of the whole mesh */
+    getme__dist_min(run, neg, 2);
+    m = -neg[0];
+    big = (int64_t)-neg[1];
     run->xbound = 16.0 * getme__pow2_ceil(m > 0x1p-500 ? m : 0x1p-500);
     run->star_bound = getme__pow2_ceil((double)big + 1.0);
+    if (run->comm) { /* the Eq. 9 sums' scale from the largest star of the
+                        whole mesh, as getme__adj_build sets it for one */
+        run->adj->qscale = 0x1p61 / run->star_bound;
+        run->adj->qinv = 1.0 / run->adj->qscale;
+    }
     if (run->star_bound < 4.0) /* wf < 2^62: an int64 */
         run->star_bound = 4.0;
 }
@@ -410,13 +427,18 @@ static getme_status iterate(getme_run *run, int mean_stage, double qt,
         run->overflow = 0;
         *num_transformed = mean_stage ? scatter_all(run, sigma)
                                       : scatter_some(run, qt, sigma);
-        if (!run->overflow)
+        if (!getme__dist_any(run, run->overflow))
             break;
         /* A transformed node beyond xbound (never seen in practice): clear
            the sums and start over with room for it; deterministic, since
            the bound and the test are. */
         clear_sums(run);
         run->xbound *= 256.0;
+    }
+    if (run->comm) { /* every copy of a node gets the whole mesh's sums */
+        if (mean_stage)
+            getme__dist_node_or(run, run->in_t);
+        getme__dist_node_sum(run, run->facc, 4);
     }
     compute_new_nodes(run);
     if (!mean_stage) {
@@ -425,6 +447,14 @@ static getme_status iterate(getme_run *run, int mean_stage, double qt,
             run->qold[k] = run->q[run->elems[k]];
     }
     *num_relaxed = getme__relax(run, R, nR);
+    if (run->comm) { /* counts of the whole mesh, each node once */
+        int64_t c[2] = {*num_transformed, 0};
+        for (int32_t k = 0; k < run->num_nodes; k++)
+            c[1] += run->counted[run->nodes[k]] && run->ridx[run->nodes[k]];
+        getme__dist_sum_i64(run, c, 2);
+        *num_transformed = (int32_t)c[0];
+        *num_relaxed = (int32_t)c[1];
+    }
     getme__reset_nodes(run);
     return mean_stage ? GETME_OK : update_after(run, qt);
 }
@@ -487,11 +517,16 @@ static inline uint64_t bits_of(double v)
    patterns sort like their values; a histogram of the top 16 bits, then
    of the next 16 inside the chosen bin, leaves a handful of candidates for
    the quickselect.  Returns -1 if out of memory. */
-double getme__threshold(const getme_run *run, double fraction,
-                        int32_t min_count)
+double getme__threshold(getme_run *run, double fraction, int32_t min_count)
 {
     const getme_ws *ws = run->ws;
-    int32_t n = ws->num_free_elem;
+    int64_t n = ws->num_free_elem;
+    if (run->comm) { /* the free elements of the whole mesh */
+        n = 0;
+        for (int32_t e = 0; e < ws->ne; e++)
+            n += ws->free_elem[e] && run->owned[e];
+        getme__dist_sum_i64(run, &n, 1);
+    }
     if (n == 0)
         return 0.0;
     double pos = fraction * (double)n;
@@ -503,16 +538,21 @@ double getme__threshold(const getme_run *run, double fraction,
         return -1.0;
     uint64_t prefix = 0, mask = 0;
     int64_t in_bin = n;
-    for (int shift = 48; shift >= 32; shift -= 16) {
+    /* Distributed: the histograms are summed over processes, and two more
+       levels pin all 64 bits, so no process needs the candidates. */
+    int last = run->comm ? 0 : 32;
+    for (int shift = 48; shift >= last; shift -= 16) {
         memset(hist, 0, 65536 * sizeof *hist);
         for (int32_t e = 0; e < ws->ne; e++) {
             uint64_t b = bits_of(run->q[e]);
-            if (ws->free_elem[e] && (b & mask) == prefix)
+            if (ws->free_elem[e] && getme__owned(run, e) &&
+                (b & mask) == prefix)
                 hist[(b >> shift) & 0xffff]++;
         }
+        getme__dist_sum_i64(run, hist, 65536);
         int64_t below = 0;
         int bin = 0;
-        while (below + hist[bin] <= k)
+        while (bin < 65535 && below + hist[bin] <= k)
             below += hist[bin++];
         k -= below;
         in_bin = hist[bin];
@@ -520,6 +560,11 @@ double getme__threshold(const getme_run *run, double fraction,
         mask |= (uint64_t)0xffff << shift;
     }
     free(hist);
+    if (run->comm) {
+        double qt;
+        memcpy(&qt, &prefix, sizeof qt);
+        return qt;
+    }
     double *cand = malloc((size_t)in_bin * sizeof *cand);
     if (!cand)
         return -1.0;
@@ -624,7 +669,11 @@ getme_status getme__adaptive(getme_run *run)
                           &ntrans, &nrelax)) != GETME_OK)
             break;
         double prev_mean = q_mean, prev_min = q_min;
-        getme__ws_summary(ws, run->q, &q_mean, &q_min, NULL);
+        getme__summary(run, &q_mean, &q_min, NULL);
+        if (run->comm_failed) {
+            st = GETME_ERR_COMM;
+            break;
+        }
         res->iterations = it;
         if (stage == GETME_STAGE_MEAN)
             res->iterations_mean++;
@@ -636,7 +685,8 @@ getme_status getme__adaptive(getme_run *run)
                 memcpy(best, ws->x, (size_t)ws->nn * 3 * sizeof *best);
         }
         if (getme__report(run, it, stage, res->cycles_min, q_min, q_mean, qt,
-                          ntrans, nrelax)) {
+                          ntrans, nrelax) &&
+            !run->comm) { /* distributed: every process must go on alike */
             res->stop_reason = GETME_STOP_CANCELLED;
             st = GETME_ERR_CANCELLED;
             break;
@@ -684,14 +734,31 @@ getme_status getme__adaptive(getme_run *run)
         /* Fixed nodes are equal in both copies, so this keeps them exact. */
         memcpy(ws->x, best, (size_t)ws->nn * 3 * sizeof *best);
         getme__ws_qualities(ws, run->q);
-        getme__ws_summary(ws, run->q, &q_mean, &q_min, NULL);
+        getme__summary(run, &q_mean, &q_min, NULL);
     }
-    if (st == GETME_OK && p->finish)
+    /* Distributed: getme_smooth_finish() runs it on the gathered mesh. */
+    if (st == GETME_OK && p->finish && !run->comm)
         st = getme__finish(run);
-    getme__ws_summary(ws, run->q, &res->q_mean, &res->q_min_star, &res->q_min);
+    getme__summary(run, &res->q_mean, &res->q_min_star, &res->q_min);
+    if (st == GETME_OK && run->comm_failed)
+        st = GETME_ERR_COMM;
     res->threshold = qt;
 done:
     free(best);
     free_adaptive(run);
+    return st;
+}
+
+getme_status getme__adaptive_finish(getme_run *run)
+{
+    const getme_params *p = run->params;
+    getme_result *res = run->result;
+    run->guard = p->corner_guard;
+    set_corner_floor(run, p->corner_floor > res->corner_sj_initial
+                              ? p->corner_floor
+                              : res->corner_sj_initial);
+    getme_status st = p->finish ? getme__finish(run) : GETME_OK;
+    getme__ws_summary(run->ws, run->q, &res->q_mean, &res->q_min_star,
+                      &res->q_min);
     return st;
 }

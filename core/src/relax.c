@@ -101,9 +101,11 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
        are re-evaluated.  An invalid element always has a node that can
        still step: with all its moving nodes at R's last entry 0 it would
        be back at its old, valid shape. */
-    while (count_invalid(run) > 0) {
+    while (getme__dist_any(run, count_invalid(run) > 0)) {
         int32_t m = nodes_to_step(run, nR);
-        if (m == 0)
+        if (run->comm) /* a node steps if any copy has an invalid element */
+            m = getme__dist_step_list(run, nR);
+        if (!getme__dist_any(run, m > 0))
             break; /* unreachable for a valid input, see above */
         for (int32_t j = 0; j < m; j++) {
             int32_t i = run->list[j];
