@@ -17,6 +17,7 @@
 
 #include <omp.h>
 #include <stdarg.h>
+#include <sys/resource.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -301,6 +302,29 @@ int main(int argc, char **argv)
         goto out;
     }
     double loop_seconds = MPI_Wtime() - ts;
+    if (a.verbose) { /* per rank: the benchmark's numbers (bench/mpi.py) */
+        struct rusage ru;
+        getrusage(RUSAGE_SELF, &ru);
+        int64_t owned = 0;
+        for (int32_t e = 0; e < c.ne; e++)
+            owned += c.owned[e];
+        double mine[9] = {(double)c.ne, (double)owned, (double)c.nn,
+                          c.nb_ptr ? (double)c.nb_ptr[c.num_nb] : 0.0,
+                          loop_seconds, c.comm_seconds,
+                          (double)c.bytes_sent, (double)c.bytes_reduced,
+                          (double)ru.ru_maxrss / 1024.0};
+        double *all = c.rank == 0 ? malloc((size_t)c.size * sizeof mine) : NULL;
+        MPI_Gather(mine, 9, MPI_DOUBLE, all, 9, MPI_DOUBLE, 0, c.comm);
+        for (int r = 0; all && r < c.size; r++) {
+            const double *v = all + 9 * r;
+            info(&a, 0, "Rank %d: %.0f elements (%.0f owned), %.0f nodes "
+                 "(%.0f shared copies), loop %.3f s, comm %.3f s, sent "
+                 "%.3f MiB, reduced %.3f MiB, max RSS %.1f MiB",
+                 r, v[0], v[1], v[2], v[3], v[4], v[5], v[6] / 1048576.0,
+                 v[7] / 1048576.0, v[8]);
+        }
+        free(all);
+    }
 
     /* 4. gather the counted nodes' positions on rank 0 */
     {
