@@ -57,10 +57,8 @@ typedef struct getme_adj {
        so a term is below 2^(62 - b) and a node's or an edge's sum (at most
        2^b - 1 terms) below 2^62: int64 holds it.  The inclusion-exclusion
        of up to 8 node and 12 edge sums is done in 128 bits.  A term's
-       truncation (< 1 / qscale = 2^(b - 61)) is below double's rounding of
-       a sum of 2^b terms averaging more than 2^(2b - 8) / 2^b... in short:
-       for stars up to 2^7 elements and mean qualities above 1/128, no
-       worse than the double sums it replaces (docs/distributed.md). */
+       truncation is below 2^(b - 61) (docs/distributed.md compares it
+       with the double sums this replaced). */
     int64_t *nsum;      /* nn: S_v at the current qualities                */
     int64_t *esum;      /* num_edges: S_e at the current qualities         */
     double qscale, qinv; /* 2^(61 - b) and its inverse                    */
