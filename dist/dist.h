@@ -43,6 +43,7 @@ typedef struct dist_ctx {
     /* rank 0: the partition's interface nodes (held by several ranks) and
        ghost elements (copies, summed over ranks) */
     int64_t interface_nodes, ghost_elements;
+    int exit_code;      /* rank 0's exit code when it gave up (dist_go)    */
 } dist_ctx;
 
 /* comm.c */
@@ -53,11 +54,11 @@ void dist_comm_hooks(dist_ctx *c, getme_comm *hooks);
 /* partition.c: on rank 0, split mesh into size parts (METIS, fixed seed)
    and send each rank its part; every rank receives its own into c.
    Rank 0 first broadcasts whether it can go on (one MPI_Bcast of an int
-   on every rank: dist_go); a rank that failed to read the input calls
-   dist_go(c, 0) instead.  dist_partition_send returns 0, or -1 with the
+   on every rank: dist_go, 0 = go, else the exit code); if it failed to
+   read the input it calls dist_go(c, code) instead.  dist_partition_send returns 0, or -1 with the
    message in err; dist_partition_recv returns 0, -1 on failure, -2 if
    rank 0 gave up (it reports why). */
-int dist_go(dist_ctx *c, int ok);
+int dist_go(dist_ctx *c, int code);
 int dist_partition_send(getme_mesh *mesh, dist_ctx *c, char *err,
                         size_t err_size);
 int dist_partition_recv(dist_ctx *c);

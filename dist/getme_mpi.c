@@ -231,8 +231,8 @@ int main(int argc, char **argv)
         }
         if (ios != GETME_IO_OK) {
             fprintf(stderr, "Error   : %s\n", err);
-            dist_go(&c, 0);
             code = (int)ios;
+            dist_go(&c, code);
             goto out;
         }
         getme_mesh *mesh = getme_doc_mesh(doc);
@@ -252,7 +252,7 @@ int main(int argc, char **argv)
     } else {
         int r = dist_partition_recv(&c);
         if (r == -2) { /* rank 0 could not read: it said why */
-            code = 1;
+            code = c.exit_code;
             goto out;
         }
         if (r != 0)

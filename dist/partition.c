@@ -131,16 +131,19 @@ static int send_part(dist_ctx *c, int r)
     return rc == MPI_SUCCESS ? 0 : -1;
 }
 
-int dist_go(dist_ctx *c, int ok)
+int dist_go(dist_ctx *c, int code)
 {
-    MPI_Bcast(&ok, 1, MPI_INT, 0, c->comm);
-    return ok;
+    MPI_Bcast(&code, 1, MPI_INT, 0, c->comm);
+    return code;
 }
 
 int dist_partition_recv(dist_ctx *c)
 {
-    if (!dist_go(c, 0))
+    int code = dist_go(c, 0);
+    if (code != 0) {
+        c->exit_code = code;
         return -2;
+    }
     int64_t head[5];
     MPI_Comm w = c->comm;
     if (MPI_Recv(head, 5, MPI_INT64_T, 0, TAG_HEAD, w, MPI_STATUS_IGNORE))
@@ -335,7 +338,7 @@ int dist_partition_send(getme_mesh *mesh, dist_ctx *c, char *err,
     c->ghost_elements -= ne;
     /* build and send every other part, then keep rank 0's */
     went = 1;
-    dist_go(c, 1);
+    dist_go(c, 0);
     for (int r = np - 1; r >= 0; r--) {
         for (int32_t k = 0; k < parts[r].nn; k++)
             glocal[parts[r].nodes[k]] = k;
@@ -350,7 +353,7 @@ int dist_partition_send(getme_mesh *mesh, dist_ctx *c, char *err,
     ret = 0;
 out:
     if (!went)
-        dist_go(c, 0);
+        dist_go(c, 1);
     for (int r = 0; parts && r < np; r++)
         free(parts[r].nodes), free(parts[r].elems);
     free(parts), free(eptr), free(eind), free(etype), free(gfixed);

@@ -284,7 +284,8 @@ static getme_status update_after(getme_run *run, double qt)
             run->tlist[n++] = e;
         }
     }
-    qsort(run->tlist, (size_t)n, sizeof *run->tlist, cmp_int32);
+    if (n > 1) /* a part may have none (and no list yet) */
+        qsort(run->tlist, (size_t)n, sizeof *run->tlist, cmp_int32);
     run->num_t = n;
     return GETME_OK;
 }
