@@ -56,7 +56,8 @@ typedef struct getme_adj {
        trunc(q * qscale), qscale = 2^(61 - b) with 2^b > the largest star,
        so a term is below 2^(62 - b) and a node's or an edge's sum (at most
        2^b - 1 terms) below 2^62: int64 holds it.  The inclusion-exclusion
-       of up to 8 node and 12 edge sums is done in 128 bits.  A term's
+       of up to 8 node and 12 edge sums wraps in uint64 (its result fits,
+       getme__adj_nsum).  A term's
        truncation is below 2^(b - 61) (docs/distributed.md compares it
        with the double sums this replaced). */
     int64_t *nsum;      /* nn: S_v at the current qualities                */
@@ -110,20 +111,25 @@ static inline double getme__adj_nsum(const getme_adj *adj,
     const getme_face_table *ft = &getme__faces[t];
     const int32_t *f = getme__adj_faces(adj, ws, t, e);
     int nv = getme__nv[t];
+    /* In wrapping uint64 arithmetic: the sum over N(e) is a sum of
+       non-negative terms (valid qualities, q <= 1 up to rounding), each
+       below 2^(61 - b), over fewer than nv 2^b elements (N(e) is inside
+       the union of nv stars), so below nv 2^61 <= 2^64: the true value is
+       what the wrapped uint64 holds, whatever the partial sums did. */
     const double qs = adj->qscale;
-    getme_fx sv = 0, sf = 0, se = 0;
+    uint64_t sv = 0, sf = 0, se = 0;
     for (int i = 0; i < nv; i++)
-        sv += adj->nsum[c[i]];
+        sv += (uint64_t)adj->nsum[c[i]];
     for (int k = 0; k < ft->num_faces; k++)
-        sf += f[k] >= 0 ? getme__fx64(q[f[k]], qs) : 0;
-    getme_fx qe = getme__fx64(q[e], qs);
+        sf += f[k] >= 0 ? (uint64_t)getme__fx64(q[f[k]], qs) : 0;
+    uint64_t qe = (uint64_t)getme__fx64(q[e], qs);
     if (ws->dim == 2) /* sum_e S_e = nv q_E + sf, plus q_E once */
-        return getme__fx_double(sv - (nv - 1) * qe - sf, adj->qinv);
+        return (double)(sv - (uint64_t)(nv - 1) * qe - sf) * adj->qinv;
     const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
     for (int k = 0; k < getme__edges[t].num_edges; k++)
-        se += adj->esum[getme__adj_edge(adj, c, t, k, slot[k])];
-    return getme__fx_double(sv - se + (ft->num_faces - 1) * qe + sf,
-                            adj->qinv);
+        se += (uint64_t)adj->esum[getme__adj_edge(adj, c, t, k, slot[k])];
+    return (double)(sv - se + (uint64_t)(ft->num_faces - 1) * qe + sf) *
+           adj->qinv;
 }
 
 #endif /* GETME_ADJACENCY_H */

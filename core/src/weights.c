@@ -46,18 +46,17 @@ static double union_weight(const getme_ws *ws, const getme_adj *adj,
         total += ws->star_ptr[c[i] + 1] - ws->star_ptr[c[i]];
 
     if (total > MAX_UNION) {
-        getme_fx sum = 0;
+        uint64_t sum = 0; /* < nv 2^61: see getme__adj_nsum */
         int32_t count = 0;
         for (int i = 0; i < nv; i++)
             for (int64_t k = ws->star_ptr[c[i]]; k < ws->star_ptr[c[i] + 1]; k++) {
                 int32_t n = ws->star[k];
                 int fresh = mark[n] != now;
                 mark[n] = now;
-                sum += fresh ? getme__fx64(q[n], qs) : 0;
+                sum += fresh ? (uint64_t)getme__fx64(q[n], qs) : 0;
                 count += fresh;
             }
-        return sqrt(getme__fx_double(sum, adj->qinv) /
-                    ((double)count * q[e]));
+        return sqrt((double)sum * adj->qinv / ((double)count * q[e]));
     }
     /* Pass 1: the union's members, each once (branch-free append).
        Pass 2: their qualities, summed exactly in fixed point (exact.h), so
@@ -75,10 +74,10 @@ static double union_weight(const getme_ws *ws, const getme_adj *adj,
             mark[n] = now;
         }
     }
-    getme_fx sum = 0;
+    uint64_t sum = 0; /* < nv 2^61: see getme__adj_nsum */
     for (int32_t k = 0; k < count; k++)
-        sum += getme__fx64(q[u[k]], qs);
-    return sqrt(getme__fx_double(sum, adj->qinv) / ((double)count * q[e]));
+        sum += (uint64_t)getme__fx64(q[u[k]], qs);
+    return sqrt((double)sum * adj->qinv / ((double)count * q[e]));
 }
 
 double getme__weight_union(const getme_run *run, int t, int32_t e)
