@@ -639,12 +639,17 @@ getme_status getme__adaptive(getme_run *run)
     getme_result *res = run->result;
     double *best = NULL;
     getme_status st = alloc_adaptive(run);
-    if (st != GETME_OK)
+    if (st == GETME_OK) {
+        best = p->keep_best ? malloc((size_t)ws->nn * 3 * sizeof *best) : NULL;
+        if (p->keep_best && !best)
+            st = GETME_ERR_NOMEM;
+    }
+    /* Distributed: all processes stop if one has no memory (the others
+       would wait for it in the first hook). */
+    if (getme__dist_any(run, st != GETME_OK)) {
+        st = GETME_ERR_NOMEM;
         goto done;
-    st = GETME_ERR_NOMEM;
-    best = p->keep_best ? malloc((size_t)ws->nn * 3 * sizeof *best) : NULL;
-    if (p->keep_best && !best)
-        goto done;
+    }
     lists_all(run);
     set_bounds(run);
     run->guard = p->corner_guard;
