@@ -1,5 +1,5 @@
 /*
- * exact.h -- order-independent exact sums: 128-bit fixed point.
+ * exact.h -- order-independent exact sums in fixed point.
  *
  * Why: a floating-point sum depends on the order of its terms.  GETMe
  * adaptive adds element contributions into nodes (Eq. 9 numerators and
@@ -11,17 +11,20 @@
  * the term alone) and the sum is exact, the total is the same bits for any
  * order, any thread count and any partition of the mesh (docs/distributed.md).
  *
- * Representation: a signed 128-bit integer n standing for n * 2^-s; the
- * scale s belongs to the kind of sum (GETME_FX_Q for qualities, per
- * iteration for GETMe's position sums, getme_adaptive.c).  A term v is
- * stored as trunc(v * 2^s) (towards zero): error < 2^-s per term.
- *
- * Bounds (why nothing overflows): the sum of n terms with |v| <= 2^b has
- * |sum * 2^s| <= n * 2^(b + s), which fits when log2(n) + b + s <= 126
- * (the 127th bit is the sign).  Each user states its b and n in a comment.
- * Sums are kept in unsigned arithmetic (wrap-around is defined, and the
- * bounds keep the true value representable, so the wrap never happens in
- * the final result even if a partial sum of mixed signs would overflow).
+ * Representation: an integer n standing for n * 2^-s, the scale s chosen
+ * per kind of sum from bounds on its terms so that no sum can overflow:
+ *  - q_mean: 128 bits at 2^-90 (getme__fx_q, below);
+ *  - the Eq. 9 quality sums: int64 terms at 2^(61 - b), 2^b above the
+ *    largest star (adjacency.h);
+ *  - GETMe's node sums: 128-bit products of an int64 weight and an int64
+ *    coordinate (getme_adaptive.c, set_scales).
+ * A term v becomes trunc(v * 2^s) (towards zero): error < 2^-s per term.
+ * Each user states its bounds (log2 of the term count + of the largest
+ * term + s <= 126 for 128 bits, <= 62 or 63 for 64) where it sets its
+ * scale; docs/distributed.md collects them with the precision argument.
+ * Sums are kept in unsigned arithmetic where partial sums may wrap
+ * (wrap-around is defined, and the bounds keep the final value
+ * representable).
  */
 #ifndef GETME_EXACT_H
 #define GETME_EXACT_H
@@ -32,12 +35,10 @@
 __extension__ typedef __int128 getme_fx;
 __extension__ typedef unsigned __int128 getme_ufx;
 
-/* Scale of quality sums: q in [-2, 2] (mean ratio <= 1 plus rounding;
-   relaxation's trial values may be negative), at most 2^31 terms (32-bit
-   element indices) plus the inclusion-exclusion's few multiples: 1 + 31 +
-   GETME_FX_Q <= 126 with room to spare.  A term keeps 2^-90 absolute
-   precision: finer than a double's 2^-53 relative precision of any
-   quality above 2^-37, and of any sum of more than one such quality. */
+/* Scale of q_mean's sum: q in [-2, 2] (mean ratio <= 1 plus rounding),
+   at most 2^31 terms (32-bit element indices): 1 + 31 + 90 < 126.  A term
+   keeps 2^-90 absolute precision, finer than a double's 2^-53 relative
+   precision of any quality above 2^-37. */
 #define GETME_FX_Q 90
 #define GETME_FX_QSCALE 0x1p90
 #define GETME_FX_QINV 0x1p-90
@@ -55,17 +56,6 @@ static inline getme_fx getme__fx(double v, double scale)
     int64_t lo = (int64_t)(a - (double)hi * 0x1p63);
     getme_ufx r = ((getme_ufx)(uint64_t)hi << 63) + (getme_ufx)(uint64_t)lo;
     return v < 0.0 ? (getme_fx)(-r) : (getme_fx)r;
-}
-
-/* Wrap-around addition (see above). */
-static inline getme_fx getme__fx_add(getme_fx a, getme_fx b)
-{
-    return (getme_fx)((getme_ufx)a + (getme_ufx)b);
-}
-
-static inline getme_fx getme__fx_sub(getme_fx a, getme_fx b)
-{
-    return (getme_fx)((getme_ufx)a - (getme_ufx)b);
 }
 
 /* n * 2^-s as the nearest double (inv = 2^-s, a power of two: exact).
