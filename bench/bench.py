@@ -25,7 +25,6 @@ it must not, 2 usage, 3 a required tool is missing.
 import argparse
 import os
 import shutil
-import subprocess
 import sys
 import time
 
@@ -68,8 +67,6 @@ def parse_args(argv):
                     help="generated/distorted meshes and run outputs "
                          "(default bench/cache, or $GETME_BENCH_CACHE)")
     ap.add_argument("--getme", help="the getme executable (default: build*/cli/getme, PATH)")
-    ap.add_argument("--getme-runner", choices=("auto", "cli", "ctypes"), default="auto",
-                    help="auto: the CLI if it reads .msh, else libgetme via ctypes")
     ap.add_argument("--seed", type=int, default=1, help="distortion seed")
     ap.add_argument("--distort", choices=("getme", "none"), default="getme",
                     help="'none' benchmarks the generated meshes as they are")
@@ -108,18 +105,9 @@ def parse_args(argv):
     return args
 
 
-def _cli_reads_msh(cli):
-    try:
-        out = subprocess.run([cli, "formats"], capture_output=True, text=True,
-                             timeout=30).stdout
-    except OSError:
-        return False
-    return "msh" in out
-
-
-def find_getme(explicit, runner_kind):
-    """Command prefix that runs getme: the CLI, or (while the CLI cannot read
-    .msh files) bench/getme_ctypes.py on the libgetme next to it."""
+def find_getme(explicit):
+    """Command prefix that runs getme: the CLI given, else the first
+    build*/cli/getme, else getme on the PATH."""
     cli = explicit
     if cli is None:
         builds = sorted(e for e in os.listdir(REPO) if e.startswith("build"))
@@ -128,13 +116,7 @@ def find_getme(explicit, runner_kind):
         cli = found[0] if found else shutil.which("getme")
     if cli is None or not os.access(cli, os.X_OK):
         return None
-    if runner_kind == "cli" or (runner_kind == "auto" and _cli_reads_msh(cli)):
-        return [cli]
-    lib = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(cli))),
-                       "core", "libgetme.so")
-    if not os.path.exists(lib):
-        return None
-    return [runner.PYTHON, os.path.join(HERE, "getme_ctypes.py"), "--lib", lib]
+    return [cli]
 
 
 def distort(ctx, case, src):
@@ -465,7 +447,7 @@ def main(argv=None):
         for case in args.cases:
             meshes.generate(case, args.size, args.cache, log=log)
         return 0
-    getme = find_getme(args.getme, args.getme_runner)
+    getme = find_getme(args.getme)
     needs_getme = args.distort == "getme" or args.sweep or any(
         m.tool == "getme" for c in args.cases for m in selected_methods(args, c))
     if getme is None and needs_getme:

@@ -21,14 +21,10 @@ count and the outputs are compared byte for byte.
 import argparse
 import ctypes as C
 import json
-import os
 import sys
 import time
 
 import numpy as np
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from getme_ctypes import Params, Result  # noqa: E402
 
 TYPES = {"tet": 0, "hex": 1, "prism": 2, "pyramid": 3}
 MAXREP = 8
@@ -62,14 +58,23 @@ def load(path):
     lib.getme_mesh_error.argtypes = [C.c_void_p]
     lib.getme_mesh_get_coords.argtypes = [C.c_void_p, C.c_void_p]
     lib.getme_mesh_quality_stats.argtypes = [C.c_void_p, C.c_int, C.POINTER(Stats)]
-    lib.getme_mesh_untangle.argtypes = [C.c_void_p, C.POINTER(Params),
+    lib.getme_mesh_untangle.argtypes = [C.c_void_p, C.c_void_p,
                                         C.POINTER(UntangleResult)]
-    lib.getme_smooth.argtypes = [C.c_void_p, C.POINTER(Params), C.POINTER(Result)]
-    lib.getme_params_init.argtypes = [C.POINTER(Params)]
+    lib.getme_smooth.argtypes = [C.c_void_p, C.c_void_p, C.c_void_p]
+    # getme_params stays opaque here: a buffer of its size, set by name
+    # through libgetme's parameter table (getme_params_set).
+    lib.getme_params_init.argtypes = [C.c_void_p]
     lib.getme_params_sizeof.restype = C.c_size_t
-    if lib.getme_params_sizeof() != C.sizeof(Params):
-        raise RuntimeError("getme_params layout differs from getme.h's")
+    lib.getme_params_set.argtypes = [C.c_void_p, C.c_char_p, C.c_double]
     return lib
+
+
+def params(lib, num_threads):
+    p = C.create_string_buffer(lib.getme_params_sizeof())
+    lib.getme_params_init(p)
+    if lib.getme_params_set(p, b"num_threads", float(num_threads)) != 0:
+        raise RuntimeError("getme_params_set num_threads failed")
+    return p
 
 
 # ---- meshes ---------------------------------------------------------------
@@ -165,14 +170,12 @@ def run_case(lib, case, args):
     ne = sum(len(c) for _, c in blocks)
     rows, ref = [], None
     for nt in args.threads:
-        p = Params()
-        lib.getme_params_init(C.byref(p))
-        p.num_threads = nt
+        p = params(lib, nt)
         m = build(lib, tpts, blocks)
         before = stats(lib, m)
         ur = UntangleResult()
         t0 = time.perf_counter()
-        st = lib.getme_mesh_untangle(m, C.byref(p), C.byref(ur))
+        st = lib.getme_mesh_untangle(m, p, C.byref(ur))
         wall = time.perf_counter() - t0
         after_u = stats(lib, m)
         x = coords(lib, m, len(tpts))
@@ -181,8 +184,9 @@ def run_case(lib, case, args):
             ref = x
         else:
             same = bool(np.array_equal(ref.view(np.uint64), x.view(np.uint64)))
-        res = Result()
-        sst = lib.getme_smooth(m, C.byref(p), C.byref(res)) if st == 0 else -1
+        t0 = time.perf_counter()
+        sst = lib.getme_smooth(m, p, None) if st == 0 else -1
+        smooth_seconds = time.perf_counter() - t0
         after_s = stats(lib, m) if sst == 0 else None
         lib.getme_mesh_free(m)
         row = {"case": case, "elements": ne, "nodes": len(tpts), "pushed_nodes": pushed,
@@ -195,7 +199,7 @@ def run_case(lib, case, args):
                "smooth_status": sst,
                "q_min_smoothed": after_s.q_min if after_s else None,
                "q_mean_smoothed": after_s.q_mean if after_s else None,
-               "smooth_seconds": res.seconds if after_s else None,
+               "smooth_seconds": smooth_seconds if after_s else None,
                "same_as_1_thread": same}
         rows.append(row)
         print("%-6s %8d el %5d pushed %2d thr: invalid %5d -> %d in %.3f s (%d sweeps, "
@@ -206,7 +210,7 @@ def run_case(lib, case, args):
                   after_u.q_mean,
                   "%.4f" % after_s.q_min if after_s else "-",
                   "%.4f" % after_s.q_mean if after_s else "-",
-                  res.seconds if after_s else 0.0,
+                  smooth_seconds if after_s else 0.0,
                   "" if same is None else ", bit-identical to 1 thread: %s" % same),
               flush=True)
     return rows

@@ -5,7 +5,8 @@
  * 3 cannot read the input, 4 malformed input, 5 unsupported content,
  * 6 invalid (inverted) elements in the input (with --no-untangle), 7 cannot
  * write the output, 8 invalid elements that untangling could not repair.
- * They equal getme_io_status values.
+ * libgetme_formats has status codes of its own: cli_exit_code (exit.c)
+ * maps them.
  */
 #ifndef GETME_CLI_H
 #define GETME_CLI_H
@@ -15,7 +16,21 @@
 
 #include <stdio.h>
 
-enum { EXIT_USAGE = 2 };
+/* Exit codes (README, `getme --help`, tests/cli): never renumber. */
+enum {
+    CLI_EXIT_OK = 0,
+    CLI_EXIT_INTERNAL = 1,
+    EXIT_USAGE = 2,
+    CLI_EXIT_OPEN = 3,
+    CLI_EXIT_PARSE = 4,
+    CLI_EXIT_UNSUPPORTED = 5,
+    CLI_EXIT_INVALID = 6,
+    CLI_EXIT_WRITE = 7,
+    CLI_EXIT_TANGLED = 8
+};
+
+/* The exit code for a libgetme_formats status. */
+int cli_exit_code(getme_formats_status st);
 
 /* Gmsh-style log lines: "Info    : ...", "Warning : ...", "Error   : ...".
    Info and warnings go to stdout (as Gmsh does), errors to stderr. */
@@ -55,6 +70,9 @@ void cli_print_measures(const cli_log *log, const char *title,
 /* Compute and print; on failure warn (the statistics stay empty). */
 void cli_measures_log(const cli_log *log, getme_mesh *mesh, const char *title,
                       cli_measures *m);
+/* Second-order meshes (highorder.c): "Second order (WHEN): N elements,
+   worst node Jacobian ratio R (element ID)"; nothing for a linear mesh. */
+void cli_ho_log(const cli_log *log, getme_doc *doc, const char *when);
 /* Summary and 10-bin histogram of every measure but the mean ratio. */
 void cli_print_measure_histograms(const cli_log *log, const cli_measures *m,
                                   int type);
@@ -74,7 +92,7 @@ int cli_parse_double(const char *opt, const char *s, double *out);
 /* Open a document; on failure print its one-line error, close it and
    return NULL with the exit code in *code.  With allow_invalid, an input
    whose only problem is invalid elements is returned (*code =
-   GETME_IO_ERR_INVALID) so that it can still be reported on.  The
+   CLI_EXIT_INVALID) so that it can still be reported on.  The
    document's warning, if any, is printed through log. */
 getme_doc *cli_open(const char *path, const getme_doc_options *opts,
                     int allow_invalid, int *code, const cli_log *log);

@@ -86,20 +86,20 @@ int cli_distort(int argc, char **argv)
     }
     getme_mesh *mesh = getme_doc_mesh(doc);
     getme_quality_stats s;
-    cli_print_stats(&log, "Quality before", &doc->stats);
+    cli_print_stats(&log, "Quality before", getme_doc_stats(doc));
     if (getme_mesh_distort(mesh, (uint64_t)seed, amount, target, (int)rounds) !=
         GETME_OK) {
         cli_error("%s: %s", input, getme_mesh_error(mesh));
         getme_doc_close(doc);
-        return GETME_IO_ERR_INTERNAL;
+        return CLI_EXIT_INTERNAL;
     }
     getme_mesh_quality_stats(mesh, -1, &s);
     cli_print_stats(&log, "Quality after ", &s);
     cli_guard guard = {0};
     cli_write_guard(&guard, 1);
-    st = getme_doc_write(doc, paths.out);
+    st = cli_exit_code(getme_doc_write(doc, paths.out));
     cli_write_guard(&guard, 0);
-    if (st != (int)GETME_IO_OK)
+    if (st != CLI_EXIT_OK)
         cli_error("%s", getme_doc_error(doc));
     else
         cli_info(&log, "Done writing '%s'", output);

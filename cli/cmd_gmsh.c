@@ -184,7 +184,7 @@ static int open_and_mesh(const gmsh_args *a)
     FILE *f = fopen(a->input, "rb");
     if (!f) {
         cli_error("cannot open '%s': %s", a->input, strerror(errno));
-        return GETME_IO_ERR_OPEN;
+        return CLI_EXIT_OPEN;
     }
     fclose(f);
     if (a->clmax > 0)
@@ -195,7 +195,7 @@ static int open_and_mesh(const gmsh_args *a)
     gmshOpen(a->input, &ierr);
     if (ierr) {
         cli_error("Gmsh could not read '%s'", a->input);
-        return GETME_IO_ERR_PARSE;
+        return CLI_EXIT_PARSE;
     }
     int dim = a->dim;
     if (!dim && !model_has_mesh())
@@ -204,23 +204,23 @@ static int open_and_mesh(const gmsh_args *a)
         gmshModelMeshGenerate(dim, &ierr);
         if (ierr) {
             cli_error("Gmsh could not mesh '%s'", a->input);
-            return GETME_IO_ERR_UNSUPPORTED;
+            return CLI_EXIT_UNSUPPORTED;
         }
     }
-    return GETME_IO_OK;
+    return CLI_EXIT_OK;
 }
 
 static int exit_code(getme_status st, const getme_gmsh_report *rep)
 {
     switch (st) {
     case GETME_OK: return 0;
-    case GETME_ERR_ARGUMENT: return GETME_IO_ERR_USAGE;
+    case GETME_ERR_ARGUMENT: return EXIT_USAGE;
     case GETME_ERR_INVALID_MESH: /* 8 if untangling ran and fell short */
-        return rep->untangle.num_invalid_before ? GETME_IO_ERR_TANGLED
-                                                : GETME_IO_ERR_INVALID;
+        return rep->untangle.num_invalid_before ? CLI_EXIT_TANGLED
+                                                : CLI_EXIT_INVALID;
     case GETME_ERR_STATE:
-    case GETME_ERR_TOPOLOGY: return GETME_IO_ERR_UNSUPPORTED;
-    default: return GETME_IO_ERR_INTERNAL;
+    case GETME_ERR_TOPOLOGY: return CLI_EXIT_UNSUPPORTED;
+    default: return CLI_EXIT_INTERNAL;
     }
 }
 
@@ -259,7 +259,7 @@ static int write_output(const gmsh_args *a, const char *out, const char *name)
     if (getme_io_tmp_path(out, tmp, sizeof tmp) != 0) {
         cli_error("cannot create a temporary file next to '%s': %s", out,
                   strerror(errno));
-        return GETME_IO_ERR_WRITE;
+        return CLI_EXIT_WRITE;
     }
     snprintf(tmp_ext, sizeof tmp_ext, "%s%s", tmp, ext);
     remove(tmp);
@@ -286,7 +286,7 @@ static int write_output(const gmsh_args *a, const char *out, const char *name)
     if (!f || getme_io_commit(final, out) != 0) {
         remove(final);
         cli_error("cannot write '%s'", out);
-        return GETME_IO_ERR_WRITE;
+        return CLI_EXIT_WRITE;
     }
     return 0;
 }
@@ -347,7 +347,7 @@ static int smooth_model(gmsh_args *a, gmsh_result *res)
     int rc = 0;
     if (!opt) {
         cli_error("out of memory");
-        return GETME_IO_ERR_INTERNAL;
+        return CLI_EXIT_INTERNAL;
     }
     getme_gmsh_options_set(opt, "log", 0);
     getme_gmsh_options_set(opt, "fix_interfaces", !so->free_interfaces);
@@ -360,7 +360,7 @@ static int smooth_model(gmsh_args *a, gmsh_result *res)
                                 sizeof msg) != GETME_OK) {
         cli_error("'%s': %s", a->input, msg);
         getme_gmsh_options_free(opt);
-        return GETME_IO_ERR_USAGE;
+        return EXIT_USAGE;
     }
     getme_gmsh_report *rep = &res->rep;
     memset(rep, 0, sizeof *rep);
@@ -412,7 +412,7 @@ static int run(gmsh_args *a)
         cli_error("%s: refusing to overwrite the input; choose another "
                   "file", cli_same_file(a->input, paths.out) ? out
                                                             : a->o.report);
-        return GETME_IO_ERR_USAGE;
+        return EXIT_USAGE;
     }
     int ierr = 0;
     gmshInitialize(0, NULL, 0, &ierr);
@@ -424,7 +424,7 @@ static int run(gmsh_args *a)
     cli_guard guard = {0};
     cli_write_guard(&guard, 1);
     if (rc == 0 ||
-        (rc == GETME_IO_ERR_TANGLED && a->o.allow_invalid)) {
+        (rc == CLI_EXIT_TANGLED && a->o.allow_invalid)) {
         /* --allow-invalid: the partly untangled mesh, exit code kept */
         int wrc = write_output(a, paths.out, out);
         rc = rc ? rc : wrc;
@@ -437,7 +437,7 @@ static int run(gmsh_args *a)
                                              &res.mafter}) != 0) {
         cli_error("%s: cannot write the report: %s", a->o.report,
                   strerror(errno));
-        rc = GETME_IO_ERR_WRITE;
+        rc = CLI_EXIT_WRITE;
     }
     cli_write_guard(&guard, 0);
     if (rc == 0)
@@ -461,9 +461,9 @@ int getme_cli_gmsh(int argc, char **argv)
     a.msh_version = 4.1;
     if (cli_smooth_opts_init(&a.o, argc) != 0) {
         cli_error("out of memory");
-        return GETME_IO_ERR_INTERNAL;
+        return CLI_EXIT_INTERNAL;
     }
-    int rc = parse_args(&a, argc, argv) != 0 ? GETME_IO_ERR_USAGE : run(&a);
+    int rc = parse_args(&a, argc, argv) != 0 ? EXIT_USAGE : run(&a);
     cli_smooth_opts_free(&a.o);
     return rc;
 }

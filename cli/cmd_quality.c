@@ -91,13 +91,13 @@ int cli_quality(int argc, char **argv)
     getme_mesh *mesh = getme_doc_mesh(doc);
     char desc[256];
     cli_describe_mesh(mesh, desc, sizeof desc);
-    cli_info(&log, "%s (%s): %s", input, doc->format->name, desc);
+    cli_info(&log, "%s (%s): %s", input, getme_format_name(getme_doc_format(doc)), desc);
     int types = 0;
     cli_measures measures;
     if (cli_measures_compute(mesh, &measures) != 0) {
         cli_error("%s: %s", input, getme_mesh_error(mesh));
         getme_doc_close(doc);
-        return GETME_IO_ERR_INTERNAL;
+        return CLI_EXIT_INTERNAL;
     }
     for (int t = 0; t < GETME_NUM_TYPES; t++)
         if (getme_mesh_num_elements_of_type(mesh, (getme_elem_type)t)) {
@@ -111,12 +111,12 @@ int cli_quality(int argc, char **argv)
     if (worst > 0 && (cli_worst(doc, (int32_t)worst, 0, &w) != 0 ||
                       cli_worst(doc, (int32_t)worst, GETME_WORST_FREE_ONLY,
                                 &wf) != 0))
-        st = GETME_IO_ERR_INTERNAL;
+        st = CLI_EXIT_INTERNAL;
     cli_print_worst(&log, doc, &w, "");
     cli_print_worst(&log, doc, &wf, " with a free node");
     free(w.items);
     free(wf.items);
-    if (st == GETME_IO_ERR_INVALID)
+    if (st == CLI_EXIT_INVALID)
         cli_error("%s", getme_doc_error(doc));
     getme_doc_close(doc);
     return st;

@@ -95,10 +95,10 @@ static int write_output(const smooth_args *a, const cli_paths *paths,
                         getme_doc *doc, const char *what)
 {
     cli_info(&a->o.log, "Writing %s'%s'...", what, a->output);
-    getme_io_status ios = getme_doc_write(doc, paths->out);
-    if (ios != GETME_IO_OK) {
+    getme_formats_status ios = getme_doc_write(doc, paths->out);
+    if (ios != GETME_FORMATS_OK) {
         cli_error("%s", getme_doc_error(doc));
-        return ios;
+        return cli_exit_code(ios);
     }
     cli_info(&a->o.log, "Done writing '%s'", a->output);
     return 0;
@@ -110,7 +110,7 @@ static int write_output(const smooth_args *a, const cli_paths *paths,
 
 /* Untangle an input with invalid elements: one warning line with the
    counts; the elements that stay invalid named by their file ids.
-   Returns 0, GETME_IO_ERR_TANGLED or GETME_IO_ERR_INTERNAL. */
+   Returns 0, CLI_EXIT_TANGLED or CLI_EXIT_INTERNAL. */
 static int untangle(smooth_args *a, getme_doc *doc, getme_untangle_result *ur)
 {
     getme_mesh *mesh = getme_doc_mesh(doc);
@@ -121,7 +121,7 @@ static int untangle(smooth_args *a, getme_doc *doc, getme_untangle_result *ur)
     getme_status st = getme_mesh_untangle(mesh, &a->o.params, ur);
     if (st != GETME_OK && st != GETME_ERR_INVALID_MESH) {
         cli_error("%s: %s", a->input, getme_mesh_error(mesh));
-        return GETME_IO_ERR_INTERNAL;
+        return CLI_EXIT_INTERNAL;
     }
     cli_untangle_warning(&a->o.log, ur);
     long long after = (long long)ur->num_invalid_after;
@@ -146,7 +146,7 @@ static int untangle(smooth_args *a, getme_doc *doc, getme_untangle_result *ur)
               a->o.allow_invalid ? "writing the partly untangled mesh as asked"
                                  : "no output written (--allow-invalid writes "
                                    "the partly untangled mesh)");
-    return GETME_IO_ERR_TANGLED;
+    return CLI_EXIT_TANGLED;
 }
 
 static int run(smooth_args *a)
@@ -174,21 +174,22 @@ static int run(smooth_args *a)
     char desc[256];
     cli_describe_mesh(mesh, desc, sizeof desc);
     cli_info(log, "Done reading '%s' (%s, %.2f s): %s", a->input,
-             doc->format->name, omp_get_wtime() - t0, desc);
-    if (doc->info[0])
-        cli_info(log, "%s", doc->info);
+             getme_format_name(getme_doc_format(doc)), omp_get_wtime() - t0, desc);
+    if (getme_doc_info(doc)[0])
+        cli_info(log, "%s", getme_doc_info(doc));
 
-    getme_quality_stats before = doc->stats, after;
+    getme_quality_stats before = *getme_doc_stats(doc), after;
     cli_print_stats(log, "Quality before", &before);
     cli_measures mbefore, mafter;
     cli_measures_log(log, mesh, "Measures before", &mbefore);
+    cli_ho_log(log, doc, "before");
     cli_worst_list worst = {0}, worst_free = {0};
     cli_guard guard = {0};
     getme_untangle_result ur;
     memset(&ur, 0, sizeof ur);
     code = 0;
     if (before.num_invalid > 0 && (code = untangle(a, doc, &ur)) != 0) {
-        if (code == GETME_IO_ERR_TANGLED && so->allow_invalid) {
+        if (code == CLI_EXIT_TANGLED && so->allow_invalid) {
             cli_write_guard(&guard, 1);
             write_output(a, &paths, doc, "partly untangled, not smoothed, ");
             cli_write_guard(&guard, 0);
@@ -203,14 +204,16 @@ static int run(smooth_args *a)
     res.untangle_seconds = ur.seconds;
     if (st != GETME_OK) {
         cli_error("%s: %s", a->input, getme_mesh_error(mesh));
-        code = st == GETME_ERR_INVALID_MESH ? GETME_IO_ERR_INVALID
-                                            : GETME_IO_ERR_INTERNAL;
+        code = st == GETME_ERR_INVALID_MESH ? CLI_EXIT_INVALID
+               : st == GETME_ERR_TOPOLOGY   ? CLI_EXIT_UNSUPPORTED
+                                            : CLI_EXIT_INTERNAL;
         goto out;
     }
     cli_smooth_done(so, &res);
     getme_mesh_quality_stats(mesh, -1, &after);
     cli_print_stats(log, "Quality after ", &after);
     cli_measures_log(log, mesh, "Measures after ", &mafter);
+    cli_ho_log(log, doc, "after");
     if (res.corner_sj_initial < 1.0 || res.corner_sj < 1.0)
         cli_info(log, "Worst corner scaled Jacobian (hex, prism, pyramid, "
                       "quad): %.4f before, %.4f after",
@@ -218,7 +221,7 @@ static int run(smooth_args *a)
     if (cli_worst(doc, (int32_t)a->worst, 0, &worst) != 0 ||
         cli_worst(doc, (int32_t)a->worst, GETME_WORST_FREE_ONLY,
                   &worst_free) != 0) {
-        code = GETME_IO_ERR_INTERNAL;
+        code = CLI_EXIT_INTERNAL;
         goto out;
     }
     int fixed_worst = after.num_free > 0 && after.q_min < after.q_min_star;
@@ -251,10 +254,10 @@ static int run(smooth_args *a)
         if (so->report &&
             cli_write_report(paths.rep, a->input, a->output, &so->params,
                              &counts, &before, &after, &res, &so->history,
-                             doc->format->name, &extra) != 0) {
+                             getme_format_name(getme_doc_format(doc)), &extra) != 0) {
             cli_error("%s: cannot write the report: %s", so->report,
                       strerror(errno));
-            code = GETME_IO_ERR_WRITE;
+            code = CLI_EXIT_WRITE;
         }
     }
     cli_write_guard(&guard, 0);

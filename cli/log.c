@@ -3,6 +3,10 @@
  */
 #include "cli.h"
 
+#ifdef GETME_HAVE_CLI_GMSH
+#include "getme_gmsh.h"
+#endif
+
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
@@ -122,16 +126,27 @@ getme_doc *cli_open(const char *path, const getme_doc_options *opts,
                     int allow_invalid, int *code, const cli_log *log)
 {
     getme_doc *doc = NULL;
-    getme_io_status st = getme_doc_open(&doc, path, opts);
-    *code = st;
+    getme_doc_options with_gmsh;
+    if (opts)
+        with_gmsh = *opts;
+    else
+        getme_doc_options_init(&with_gmsh);
+#ifdef GETME_HAVE_CLI_GMSH
+    /* MSH files the native reader declines: read through the Gmsh SDK */
+    const getme_format *adapters[] = {getme_gmsh_format(), NULL};
+    with_gmsh.adapters = adapters;
+#endif
+    getme_formats_status st = getme_doc_open(&doc, path, &with_gmsh);
+    *code = cli_exit_code(st);
     /* allow_invalid: inverted elements found in a complete mesh (to be
        untangled or reported on); not elements an adapter refused as
        degenerate (a node twice), which no node move repairs */
-    if (st == GETME_IO_OK ||
-        (allow_invalid && st == GETME_IO_ERR_INVALID && doc->mesh &&
-         doc->stats.num_invalid > 0)) {
-        if (doc->warning[0])
-            cli_warning(log, "%s", doc->warning);
+    if (st == GETME_FORMATS_OK ||
+        (allow_invalid && st == GETME_FORMATS_ERR_INVALID &&
+         getme_doc_mesh(doc) && getme_doc_stats(doc) &&
+         getme_doc_stats(doc)->num_invalid > 0)) {
+        if (getme_doc_warning(doc)[0])
+            cli_warning(log, "%s", getme_doc_warning(doc));
         return doc;
     }
     cli_error("%s", getme_doc_error(doc));

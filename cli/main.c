@@ -4,6 +4,10 @@
 #define _POSIX_C_SOURCE 200809L
 #include "cli.h"
 
+#ifdef GETME_HAVE_CLI_GMSH
+#include "getme_gmsh.h"
+#endif
+
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -33,11 +37,20 @@ static const char HELP[] =
     "(--no-untangle), 7 cannot write output, 8 invalid elements that could\n"
     "not be untangled\n";
 
+static void list_format(const getme_format *f)
+{
+    printf("%-6s %s\n", getme_format_name(f), getme_format_description(f));
+}
+
+/* The built-in adapters, then the one the Gmsh plugin adds (cli_open). */
 static int list_formats(void)
 {
     const getme_format *const *f = getme_formats();
     for (int i = 0; f[i]; i++)
-        printf("%-6s %s\n", f[i]->name, f[i]->description);
+        list_format(f[i]);
+#ifdef GETME_HAVE_CLI_GMSH
+    list_format(getme_gmsh_format());
+#endif
     return 0;
 }
 
@@ -86,7 +99,7 @@ int main(int argc, char **argv)
         return getme_cli_gmsh(argc - 1, argv + 1);
 #else
         cli_error("this getme was built without the Gmsh plugin");
-        return GETME_IO_ERR_UNSUPPORTED;
+        return CLI_EXIT_UNSUPPORTED;
 #endif
     }
     cli_error("unknown command '%s' (see getme --help)", cmd);

@@ -61,11 +61,11 @@ static int check_target(const char *what, const char *path, char *resolved,
                         size_t size)
 {
     char msg[1200];
-    getme_io_status st =
+    getme_formats_status st =
         getme_io_output_path(path, resolved, size, msg, sizeof msg);
-    if (st != GETME_IO_OK)
+    if (st != GETME_FORMATS_OK)
         cli_error("%s %s", what, msg);
-    return (int)st;
+    return cli_exit_code(st);
 }
 
 int cli_check_paths(cli_paths *p)
@@ -81,7 +81,8 @@ int cli_check_paths(cli_paths *p)
     if (p->output && format && !getme_format_has_extension(format, p->output)) {
         cli_error("output %s: the input is a %s file, so the output must be "
                   "one too (%s); getme does not convert formats",
-                  p->output, format->name, format->extensions);
+                  p->output, getme_format_name(format),
+                  getme_format_extensions(format));
         return EXIT_USAGE;
     }
     if (p->output && cli_same_file(p->input, p->out)) {

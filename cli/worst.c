@@ -10,7 +10,7 @@
    its 1-based position when the adapter keeps none. */
 long long cli_element_tag(const getme_doc *doc, int32_t e)
 {
-    return doc->elem_ids ? (long long)doc->elem_ids[e] : (long long)e + 1;
+    return (long long)getme_doc_element_id(doc, e);
 }
 
 int cli_worst(getme_doc *doc, int32_t max_count, unsigned flags,
@@ -27,7 +27,7 @@ int cli_worst(getme_doc *doc, int32_t max_count, unsigned flags,
     if (getme_mesh_worst_elements(mesh, max_count, flags, w->items,
                                   &w->count) !=
         GETME_OK) {
-        cli_error("%s: %s", doc->path, getme_mesh_error(mesh));
+        cli_error("%s: %s", getme_doc_path(doc), getme_mesh_error(mesh));
         free(w->items);
         w->items = NULL;
         return -1;

@@ -11,9 +11,13 @@
  * with one error line from rank 0 and no output.
  *
  * Exit codes: 0 ok, 1 a rank failed (smoothing, communication), 2 usage,
- * 3-8 as `getme smooth` (reading and writing, getme_io_status).
+ * 3-8 as `getme smooth` (reading and writing, exit_code below).
  */
 #include "dist.h"
+
+#ifdef GETME_HAVE_GMSH
+#include "getme_gmsh.h"
+#endif
 
 #include <omp.h>
 #include <stdarg.h>
@@ -21,6 +25,24 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* getme smooth's exit codes for libgetme_formats' statuses (cli.h). */
+static int exit_code(getme_formats_status st)
+{
+    switch (st) {
+    case GETME_FORMATS_OK: return 0;
+    case GETME_FORMATS_ERR_OPEN: return 3;
+    case GETME_FORMATS_ERR_PARSE: return 4;
+    case GETME_FORMATS_ERR_UNSUPPORTED: return 5;
+    case GETME_FORMATS_ERR_INVALID: return 6;
+    case GETME_FORMATS_ERR_WRITE: return 7;
+    case GETME_FORMATS_ERR_ARGUMENT: return 2;
+    case GETME_FORMATS_ERR_INTERNAL: return 1;
+    }
+    return 1;
+}
+
+enum { EXIT_TANGLED = 8 };
 
 typedef struct args {
     const char *input, *output;
@@ -197,47 +219,55 @@ int main(int argc, char **argv)
     if (c.rank == 0) {
         getme_doc_options opts;
         getme_doc_options_init(&opts);
+#ifdef GETME_HAVE_GMSH
+        /* MSH files the native reader declines: through the Gmsh SDK, as
+           getme smooth reads them */
+        const getme_format *adapters[] = {getme_gmsh_format(), NULL};
+        opts.adapters = adapters;
+#endif
         info(&a, 0, "Reading '%s' on rank 0 of %d...", a.input, c.size);
-        getme_io_status ios = GETME_IO_OK;
+        int ios = 0; /* the exit code */
         const getme_format *f = getme_format_for(a.input);
         if (!f) {
             snprintf(err, sizeof err, "%s: unknown format", a.input);
-            ios = GETME_IO_ERR_USAGE;
+            ios = 2;
         } else if (!getme_format_has_extension(f, a.output)) {
             snprintf(err, sizeof err, "%s: the output needs the input's "
-                     "format and extension (%s)", a.output, f->extensions);
-            ios = GETME_IO_ERR_USAGE;
+                     "format and extension (%s)", a.output,
+                     getme_format_extensions(f));
+            ios = 2;
         } else if (getme_io_same_file(a.input, a.output)) {
             snprintf(err, sizeof err, "%s: the output may not be the input",
                      a.output);
-            ios = GETME_IO_ERR_USAGE;
-        } else if ((ios = getme_doc_open(&doc, a.input, &opts)) ==
-                   GETME_IO_ERR_INVALID) {
+            ios = 2;
+        } else if ((ios = exit_code(getme_doc_open(&doc, a.input, &opts))) ==
+                   6 && getme_doc_mesh(doc)) {
             /* invalid elements: untangled as getme smooth does */
-            ios = GETME_IO_OK;
+            ios = 0;
             getme_untangle_result ur;
             getme_status st = getme_mesh_untangle(getme_doc_mesh(doc),
                                                   &params, &ur);
             if (st != GETME_OK) {
                 snprintf(err, sizeof err, "%s: %s", a.input,
                          getme_mesh_error(getme_doc_mesh(doc)));
-                ios = GETME_IO_ERR_TANGLED;
+                ios = EXIT_TANGLED;
             } else {
                 info(&a, 0, "Untangled %lld invalid elements",
                      (long long)ur.num_invalid_before);
             }
-        } else if (ios != GETME_IO_OK) {
+        } else if (ios != 0) {
             snprintf(err, sizeof err, "%s", getme_doc_error(doc));
         }
-        if (ios != GETME_IO_OK) {
+        if (ios != 0) {
             fprintf(stderr, "Error   : %s\n", err);
-            code = (int)ios;
+            code = ios;
             dist_go(&c, code);
             goto out;
         }
         getme_mesh *mesh = getme_doc_mesh(doc);
         info(&a, 0, "Done reading '%s' (%s): %d elements, %d nodes (%d fixed)",
-             a.input, doc->format->name, (int)getme_mesh_num_elements(mesh),
+             a.input, getme_format_name(getme_doc_format(doc)),
+             (int)getme_mesh_num_elements(mesh),
              (int)getme_mesh_num_nodes(mesh), (int)getme_mesh_num_fixed(mesh));
         print_quality(&a, 0, "Quality before", mesh);
         double tp = MPI_Wtime();
@@ -418,10 +448,10 @@ int main(int argc, char **argv)
                  MPI_Wtime() - tf);
             print_quality(&a, 0, "Quality after ", mesh);
             info(&a, 0, "Writing '%s'...", a.output);
-            getme_io_status ios = getme_doc_write(doc, a.output);
-            if (ios != GETME_IO_OK) {
+            getme_formats_status ws = getme_doc_write(doc, a.output);
+            if (ws != GETME_FORMATS_OK) {
                 fprintf(stderr, "Error   : %s\n", getme_doc_error(doc));
-                code = (int)ios;
+                code = exit_code(ws);
             } else {
                 info(&a, 0, "Done writing '%s' (%.2f s in all)", a.output,
                      MPI_Wtime() - t0);

@@ -24,7 +24,7 @@ import tempfile
 GETME_MPI, GETME, MPIEXEC, SRC = sys.argv[1:5]
 SANITIZED = "--sanitized" in sys.argv[5:]
 sys.path.insert(0, os.path.join(SRC, "bench"))
-sys.path.insert(0, os.path.join(SRC, "tests", "cli"))
+sys.path.insert(0, os.path.join(SRC, "tests", "support"))
 import meshes  # noqa: E402
 from checks import Checks  # noqa: E402
 

@@ -3,7 +3,7 @@
  * adapter, checking the mesh it built, temp-file-and-rename writing.
  */
 #define _XOPEN_SOURCE 700
-#include "getme_formats.h"
+#include "adapter.h"
 
 #include <errno.h>
 #include <stdarg.h>
@@ -19,14 +19,10 @@
 #include <unistd.h>
 
 static const getme_format *const FORMATS[] = {
-#ifdef GETME_HAVE_FORMAT_MSH
-    &getme_format_msh,
-#endif
-#ifdef GETME_HAVE_FORMAT_INP
-    &getme_format_inp,
-#endif
+    &getme__format_msh,
+    &getme__format_inp,
 #ifdef GETME_HAVE_FORMAT_CGNS
-    &getme_format_cgns,
+    &getme__format_cgns,
 #endif
     NULL};
 
@@ -38,6 +34,36 @@ const getme_format *getme_format_for(const char *path)
         if (FORMATS[i]->probe(path))
             return FORMATS[i];
     return NULL;
+}
+
+const char *getme_format_name(const getme_format *format)
+{
+    return format ? format->name : "";
+}
+
+const char *getme_format_description(const getme_format *format)
+{
+    return format ? format->description : "";
+}
+
+const char *getme_format_extensions(const getme_format *format)
+{
+    return format && format->extensions ? format->extensions : "";
+}
+
+const char *getme_formats_status_string(getme_formats_status st)
+{
+    switch (st) {
+    case GETME_FORMATS_OK: return "ok";
+    case GETME_FORMATS_ERR_OPEN: return "cannot open the input";
+    case GETME_FORMATS_ERR_PARSE: return "malformed input";
+    case GETME_FORMATS_ERR_UNSUPPORTED: return "unsupported content";
+    case GETME_FORMATS_ERR_INVALID: return "invalid elements";
+    case GETME_FORMATS_ERR_WRITE: return "cannot write the output";
+    case GETME_FORMATS_ERR_ARGUMENT: return "bad argument";
+    case GETME_FORMATS_ERR_INTERNAL: return "internal error";
+    }
+    return "unknown status";
 }
 
 void getme_doc_options_init(getme_doc_options *opts)
@@ -57,6 +83,26 @@ getme_io_status getme_doc_fail(getme_doc *doc, getme_io_status status,
     return status;
 }
 
+void getme_doc_set_info(getme_doc *doc, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(doc->info, sizeof doc->info, fmt, ap);
+    va_end(ap);
+}
+
+void getme_doc_set_mesh(getme_doc *doc, getme_mesh *mesh, int64_t *elem_ids)
+{
+    getme_mesh_free(doc->mesh);
+    free(doc->elem_ids);
+    doc->mesh = mesh;
+    doc->elem_ids = elem_ids;
+}
+
+void getme_doc_set_impl(getme_doc *doc, void *impl) { doc->impl = impl; }
+
+void *getme_doc_impl(const getme_doc *doc) { return doc ? doc->impl : NULL; }
+
 const char *getme_doc_error(const getme_doc *doc)
 {
     return doc ? doc->error : "out of memory";
@@ -71,6 +117,21 @@ const char *getme_doc_warning(const getme_doc *doc)
 
 getme_mesh *getme_doc_mesh(getme_doc *doc) { return doc ? doc->mesh : NULL; }
 
+const getme_format *getme_doc_format(const getme_doc *doc)
+{
+    return doc ? doc->format : NULL;
+}
+
+const char *getme_doc_path(const getme_doc *doc)
+{
+    return doc && doc->path ? doc->path : "";
+}
+
+const getme_quality_stats *getme_doc_stats(const getme_doc *doc)
+{
+    return doc && doc->have_stats ? &doc->stats : NULL;
+}
+
 int64_t getme_doc_element_id(const getme_doc *doc, int32_t e)
 {
     return doc->elem_ids ? doc->elem_ids[e] : (int64_t)e + 1;
@@ -83,6 +144,7 @@ static getme_io_status check_valid(getme_doc *doc)
     if (getme_mesh_quality_stats(doc->mesh, -1, sp) != GETME_OK)
         return getme_doc_fail(doc, GETME_IO_ERR_INTERNAL, "%s: out of memory",
                               doc->path);
+    doc->have_stats = 1;
     if (sp->num_invalid == 0)
         return GETME_IO_OK;
     char list[256] = "";
@@ -98,6 +160,54 @@ static getme_io_status check_valid(getme_doc *doc)
                           doc->path, (long long)sp->num_invalid,
                           sp->num_invalid == 1 ? "" : "s", list,
                           sp->num_invalid > sp->num_reported_invalid ? ", ..." : "");
+}
+
+/* Forget what a declining adapter left in the document. */
+static void reset(getme_doc *doc)
+{
+    if (doc->format && doc->format->close)
+        doc->format->close(doc);
+    getme_doc_set_mesh(doc, NULL, NULL);
+    doc->impl = NULL;
+    doc->format = NULL;
+    doc->info[0] = doc->warning[0] = 0;
+}
+
+/* The built-in adapters, then the caller's, in order: the first that takes
+   the path and does not decline the file opens it. */
+static getme_io_status open_with_adapters(getme_doc *doc,
+                                          const getme_doc_options *opts)
+{
+    const getme_format *const *extra = opts->adapters;
+    int declined = 0;
+    for (int k = 0;; k++) {
+        const getme_format *f = NULL;
+        int nb = (int)(sizeof FORMATS / sizeof *FORMATS) - 1;
+        if (k < nb)
+            f = FORMATS[k];
+        else if (extra && extra[k - nb])
+            f = extra[k - nb];
+        else
+            break;
+        if (!f->probe(doc->path))
+            continue;
+        doc->format = f;
+        getme_io_status st = f->open(doc, opts);
+        if (st != GETME_FORMATS_DECLINED)
+            return st;
+        reset(doc);
+        declined = 1;
+    }
+    if (declined) /* the message of the last adapter that declined */
+        return GETME_IO_ERR_UNSUPPORTED;
+    char names[128] = "";
+    size_t len = 0;
+    for (int i = 0; FORMATS[i] && len < sizeof names; i++)
+        len += (size_t)snprintf(names + len, sizeof names - len, "%s%s",
+                                i ? ", " : "", FORMATS[i]->name);
+    return getme_doc_fail(doc, GETME_IO_ERR_UNSUPPORTED,
+                          "%s: unknown file format (supported: %s)",
+                          doc->path, names);
 }
 
 getme_io_status getme_doc_open(getme_doc **out, const char *path,
@@ -125,18 +235,7 @@ getme_io_status getme_doc_open(getme_doc **out, const char *path,
     if (access(path, R_OK) != 0)
         return getme_doc_fail(doc, GETME_IO_ERR_OPEN, "%s: %s", path,
                               strerror(errno));
-    doc->format = getme_format_for(path);
-    if (!doc->format) {
-        char names[128] = "";
-        size_t len = 0;
-        for (int i = 0; FORMATS[i] && len < sizeof names; i++)
-            len += (size_t)snprintf(names + len, sizeof names - len, "%s%s",
-                                    i ? ", " : "", FORMATS[i]->name);
-        return getme_doc_fail(doc, GETME_IO_ERR_UNSUPPORTED,
-                              "%s: unknown file format (supported: %s)", path,
-                              names);
-    }
-    getme_io_status st = doc->format->open(doc, opts);
+    getme_io_status st = open_with_adapters(doc, opts);
     if (st != GETME_IO_OK)
         return st;
     if (!doc->mesh)

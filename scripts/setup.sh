@@ -3,7 +3,8 @@
 #   bash scripts/setup.sh demo   install what is missing, build, smooth the
 #                                bundled example mesh, print quality before/after
 #   bash scripts/setup.sh test   install what is missing, build, run all tests
-#                                (normal build, then ASan+UBSan build)
+#                                (normal build, ASan+UBSan build, then a
+#                                core-only build: no Gmsh, CGNS, Python)
 #   bash scripts/setup.sh build  install what is missing and build only
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -54,6 +55,10 @@ case "$mode" in
     # built with ASan: they run in the release build only (label python).
     ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
       ctest --test-dir build-asan --output-on-failure -j "$jobs" -LE 'python|nosan'
+    build build-core -DGETME_WERROR=ON -DGETME_WITH_GMSH=OFF \
+      -DGETME_WITH_CGNS=OFF -DGETME_WITH_PYTHON=OFF
+    echo "Info    : running the test suite of the core-only build (no Gmsh, CGNS, Python)"
+    ctest --test-dir build-core --output-on-failure -j "$jobs"
     ;;
   *)
     echo "usage: bash scripts/setup.sh demo|test|build" >&2; exit 2 ;;

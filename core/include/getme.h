@@ -174,6 +174,72 @@ GETME_API getme_status getme_mesh_get_coords(const getme_mesh *mesh,
 GETME_API getme_status getme_mesh_set_coords(getme_mesh *mesh,
                                              const double *coords);
 
+/* ---- second-order elements (docs/highorder.md) ------------------------- */
+
+/* Second-order element types.  Node order is Gmsh's (MSH types 11, 17, 12,
+   18, 13, 9, 16, 10): the corners first, in the linear type's order, then
+   the mid-edge nodes, then face and body nodes.  Second-order pyramids
+   (Gmsh 19, 14) are not supported: their shape functions are rational. */
+typedef enum getme_ho_type {
+    GETME_TET10 = 0,
+    GETME_HEX20 = 1,
+    GETME_HEX27 = 2,
+    GETME_PRISM15 = 3,
+    GETME_PRISM18 = 4,
+    GETME_TRI6 = 5,
+    GETME_QUAD8 = 6,
+    GETME_QUAD9 = 7,
+    GETME_NUM_HO_TYPES = 8
+} getme_ho_type;
+
+/* Nodes per element (10, 20, 27, 15, 18, 6, 8, 9); 0 for an unknown type. */
+GETME_API int getme_ho_type_num_nodes(getme_ho_type type);
+/* The linear type of its corners (GETME_TET for GETME_TET10 ...), -1 if
+   unknown. */
+GETME_API int getme_ho_type_linear(getme_ho_type type);
+/* Lower-case name: "tet10", "hex20", ... */
+GETME_API const char *getme_ho_type_name(getme_ho_type type);
+
+/*
+ * Append count second-order elements: conn holds count * num_nodes(type)
+ * node indices in Gmsh's order.  The corners become ordinary linear
+ * elements (numbered and counted like getme_mesh_add_elements(), which is
+ * called with the first corners of each element); the other nodes are
+ * dependent: the smoother moves the corners and places the dependent nodes
+ * from them (straight-sided elements stay straight-sided, curved ones keep
+ * their curvature, docs/highorder.md), and every element must keep a
+ * positive Jacobian determinant at all its nodes.  A dependent node is
+ * fixed (never moves, bit for bit) when it is fixed itself (fix_nodes,
+ * fixed mask) or when all corners of its edge or face are fixed.  Fails
+ * with GETME_ERR_TOPOLOGY on indices out of range or repeated; a dependent
+ * node shared inconsistently or used as a corner is reported by
+ * getme_smooth().
+ */
+GETME_API getme_status getme_mesh_add_elements_ho(getme_mesh *mesh,
+                                                  getme_ho_type type,
+                                                  int32_t count,
+                                                  const int32_t *conn,
+                                                  const int32_t *region);
+/* Number of second-order elements added. */
+GETME_API int32_t getme_mesh_num_elements_ho(const getme_mesh *mesh);
+
+/*
+ * Second-order validity of element e (caller's index) at the current
+ * coordinates: the smallest Jacobian determinant over its nodes divided by
+ * the largest, into *ratio (1 for a linear element or a straight-sided
+ * parallelepiped; <= 0 means invalid).  Uses the dependent nodes' current
+ * coordinates as they are.
+ */
+GETME_API getme_status getme_mesh_element_jacobian_ratio(getme_mesh *mesh,
+                                                         int32_t e,
+                                                         double *ratio);
+/* The smallest getme_mesh_element_jacobian_ratio() over the second-order
+   elements into *ratio (1 if there are none) and that element's index into
+   *element (-1 if none; the smallest index on ties). */
+GETME_API getme_status getme_mesh_jacobian_ratio_min(getme_mesh *mesh,
+                                                     double *ratio,
+                                                     int32_t *element);
+
 /* ---- fixed nodes -------------------------------------------------------- */
 
 /* Flags for getme_mesh_fix_boundary(). */

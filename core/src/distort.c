@@ -87,6 +87,10 @@ getme_status getme_mesh_distort(getme_mesh *mesh, uint64_t seed, double amount,
     getme_status st = getme__ws_build(&ws, mesh, 0, 1);
     if (st != GETME_OK)
         return getme__fail(mesh, st, "out of memory");
+    if ((st = getme__ho_attach(&ws, mesh)) != GETME_OK) {
+        getme__ws_free(&ws);
+        return st;
+    }
     double *q = malloc((size_t)(ws.ne ? ws.ne : 1) * sizeof *q);
     if (!q) {
         getme__ws_free(&ws);

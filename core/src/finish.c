@@ -141,6 +141,7 @@ getme_status getme__finish(getme_run *run)
     if (getme__patch_init(&p, 8 * ws->max_star) != GETME_OK)
         return GETME_ERR_NOMEM;
     p.x = ws->x;
+    p.ws = ws;
     p.guard = run->guard;
     p.floor = run->corner_floor;
     double q_mean, q_min;

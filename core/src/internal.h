@@ -118,6 +118,7 @@ struct getme_mesh {
     getme_block *blocks;
     int num_blocks, cap_blocks;
     int mirror;       /* planar meshes: 1 if all elements are clockwise */
+    struct getme_ho_mesh *ho; /* second-order elements (highorder.h), or NULL */
     char error[512];  /* message of the last failure */
 };
 

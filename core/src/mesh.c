@@ -3,7 +3,7 @@
  * mask, error message.  Everything the caller passes is copied once into
  * flat arrays; nothing is allocated per node or element.
  */
-#include "internal.h"
+#include "highorder.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -87,6 +87,7 @@ void getme_mesh_free(getme_mesh *mesh)
         free(mesh->blocks[b].region);
     }
     free(mesh->blocks);
+    getme__ho_mesh_free(mesh->ho);
     free(mesh->coords);
     free(mesh->fixed);
     free(mesh);

@@ -2,6 +2,7 @@
  * patch.c -- local max-min optimisation of a few nodes (patch.h).
  */
 #include "patch.h"
+#include "workspace.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -71,7 +72,10 @@ static double elem_q(const getme_patch *p, int32_t i, double *sj)
     }
     if (p->guard && getme__has_corners(t))
         *sj = getme__corner_sj(t, x);
-    return getme__quality(t, x);
+    double q = getme__quality(t, x);
+    if (q > 0.0 && p->ws && p->ws->ho && !getme__ho_valid(p->ws, p->x, p->id[i]))
+        return 0.0; /* second order: det J > 0 at every node */
+    return q;
 }
 
 double getme__patch_eval(getme_patch *p)

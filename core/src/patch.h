@@ -49,6 +49,8 @@ typedef struct getme_patch {
     double *q;       /* quality at the accepted coordinates               */
     double *sj;      /* worst corner at the start of the optimisation     */
     double *qt;      /* scratch: trial qualities                          */
+    const struct getme_ws *ws; /* finishing step: x is ws->x and ids are
+                        workspace elements, checked at second-order nodes */
 } getme_patch;
 
 /* Room for cap elements; GETME_OK or GETME_ERR_NOMEM. */

@@ -32,6 +32,8 @@ static inline double trial_quality(const getme_run *run, int32_t e)
     int t = getme__ws_type(ws, e);
     getme__ws_gather(ws, run->xnew, t, e, x);
     double q = getme__quality(t, x);
+    if (q > 0.0 && ws->ho && !getme__ho_valid(ws, run->xnew, e))
+        return 0.0; /* second order: det J > 0 at every node */
     if (!run->guard || !getme__has_corners(t) || !(q > 0.0) ||
         q >= run->guard_skip_q[t])
         return q;

@@ -144,12 +144,19 @@ static getme_status check_valid(getme_mesh *mesh, const getme_ws *ws,
             bad++;
     if (bad == 0)
         return GETME_OK;
-    /* Report in the caller's numbering, smallest indices first. */
-    for (int32_t k = 0; k < ws->ne && nfirst < GETME_MAX_REPORTED_INVALID; k++) {
-        double x[3 * GETME_MAX_NV];
-        int t = getme__gather(mesh, k, x);
-        if (!(getme__quality(t, x) > 0.0))
-            first[nfirst++] = k;
+    /* Report in the caller's numbering, smallest indices first (kept
+       sorted by insertion; q also counts second-order validity). */
+    for (int32_t e = 0; e < ws->ne; e++) {
+        if (q[e] > 0.0)
+            continue;
+        int32_t k = ws->elem_orig[e];
+        int i = nfirst < GETME_MAX_REPORTED_INVALID ? nfirst++ : nfirst;
+        if (i == GETME_MAX_REPORTED_INVALID && !(k < first[i - 1]))
+            continue;
+        i = i < GETME_MAX_REPORTED_INVALID ? i : i - 1;
+        for (; i > 0 && first[i - 1] > k; i--)
+            first[i] = first[i - 1];
+        first[i] = k;
     }
     char list[160] = "";
     size_t len = 0;
@@ -199,7 +206,10 @@ getme_status getme__start(getme_mesh *mesh, const getme_params **params,
     getme_status st = getme__ws_build(ws, mesh, (*params)->renumber, nt);
     if (st != GETME_OK)
         return getme__fail(mesh, st, "out of memory building the workspace");
-    return GETME_OK;
+    /* second-order elements: dependent nodes (message on the mesh) */
+    if ((st = getme__ho_attach(ws, mesh)) != GETME_OK)
+        getme__ws_free(ws);
+    return st;
 }
 
 getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,

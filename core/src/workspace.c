@@ -31,6 +31,7 @@ void getme__ws_free(getme_ws *ws)
     free(ws->block_start);
     free(ws->colour_ptr);
     free(ws->colour_blocks);
+    getme__ho_free(ws->ho);
     memset(ws, 0, sizeof *ws);
 }
 
@@ -366,6 +367,7 @@ void getme__ws_store(const getme_ws *ws, getme_mesh *mesh)
         p[1] = ysign * ws->x[3 * (int64_t)i + 1];
         p[2] = ws->x[3 * (int64_t)i + 2];
     }
+    getme__ho_store(ws, mesh);
 }
 
 void getme__ws_qualities(const getme_ws *ws, double *q)

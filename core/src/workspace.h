@@ -17,7 +17,7 @@
 #ifndef GETME_WORKSPACE_H
 #define GETME_WORKSPACE_H
 
-#include "internal.h"
+#include "highorder.h"
 
 #include <stdint.h>
 
@@ -48,6 +48,7 @@ typedef struct getme_ws {
     int32_t *colour_blocks;
     int serial_colour;    /* colour index whose blocks must run one by one
                              (colour overflow), or -1                        */
+    getme_ho_ws *ho;      /* second-order elements' dependent nodes, or NULL */
 } getme_ws;
 
 /* Build the workspace; renumber: 1 for locality ordering, 0 keeps the
@@ -103,7 +104,8 @@ static inline double getme__ws_quality(const getme_ws *ws,
     double x[3 * GETME_MAX_NV];
     int t = getme__ws_type(ws, e);
     getme__ws_gather(ws, coords, t, e, x);
-    return getme__quality(t, x);
+    double q = getme__quality(t, x);
+    return q > 0.0 && ws->ho && !getme__ho_valid(ws, coords, e) ? 0.0 : q;
 }
 
 /* ---- faces (faces.c) ---------------------------------------------------- */

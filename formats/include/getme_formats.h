@@ -6,7 +6,7 @@
  * and writes back a copy in which only node coordinates differ.
  *
  *   getme_doc *doc;
- *   if (getme_doc_open(&doc, "part.inp", &opts) != GETME_IO_OK) {
+ *   if (getme_doc_open(&doc, "part.inp", &opts) != GETME_FORMATS_OK) {
  *       fprintf(stderr, "Error   : %s\n", getme_doc_error(doc)); ...
  *   }
  *   getme_smooth(getme_doc_mesh(doc), &params, &result);
@@ -18,6 +18,14 @@
  * getme_io_commit).  Errors are one line naming the file and, where there is
  * one, the line number (INP), the CGNS node path, or the element/node id as
  * written in the file.
+ *
+ * The document and the adapters are opaque; what an adapter implements is
+ * in getme_formats_adapter.h (the Gmsh plugin provides one: MSH files the
+ * native reader declines, read through the Gmsh SDK; see
+ * getme_doc_options.adapters).  Built-in adapters: MSH (native), INP, and
+ * CGNS when built with GETME_WITH_CGNS.  Status codes are this library's
+ * own (getme_formats_status); the getme command maps them to its exit
+ * codes (cli/exit.c).
  */
 #ifndef GETME_FORMATS_H
 #define GETME_FORMATS_H
@@ -31,19 +39,32 @@
 extern "C" {
 #endif
 
-/* Error categories; the CLI turns them into its exit codes (README). */
-typedef enum getme_io_status {
-    GETME_IO_OK = 0,
-    GETME_IO_ERR_OPEN = 3,        /* missing / unreadable file                */
-    GETME_IO_ERR_PARSE = 4,       /* malformed content                        */
-    GETME_IO_ERR_UNSUPPORTED = 5, /* element type or feature not supported    */
-    GETME_IO_ERR_INVALID = 6,     /* the mesh has invalid (inverted) elements */
-    GETME_IO_ERR_WRITE = 7,       /* output could not be written              */
-    GETME_IO_ERR_TANGLED = 8,     /* invalid elements that untangling could not
-                                     repair (named by their file ids)         */
-    GETME_IO_ERR_USAGE = 2,       /* bad option, unknown set name...          */
-    GETME_IO_ERR_INTERNAL = 1     /* out of memory, library failure           */
-} getme_io_status;
+#if defined(__GNUC__)
+#define GETME_FORMATS_API __attribute__((visibility("default")))
+#else
+#define GETME_FORMATS_API
+#endif
+
+/* What went wrong, by category. */
+typedef enum getme_formats_status {
+    GETME_FORMATS_OK = 0,
+    GETME_FORMATS_ERR_OPEN,        /* missing / unreadable file                */
+    GETME_FORMATS_ERR_PARSE,       /* malformed content                        */
+    GETME_FORMATS_ERR_UNSUPPORTED, /* element type or feature not supported    */
+    GETME_FORMATS_ERR_INVALID,     /* the mesh has invalid (inverted or
+                                      degenerate) elements                     */
+    GETME_FORMATS_ERR_WRITE,       /* output could not be written              */
+    GETME_FORMATS_ERR_ARGUMENT,    /* bad option, unknown set name, refused
+                                      output path...                           */
+    GETME_FORMATS_ERR_INTERNAL     /* out of memory, library failure           */
+} getme_formats_status;
+
+/* "ok", "cannot open", ... (a static string; "unknown status" if st is
+   none of the above). */
+GETME_FORMATS_API const char *getme_formats_status_string(getme_formats_status st);
+
+typedef struct getme_format getme_format; /* one adapter (opaque) */
+typedef struct getme_doc getme_doc;       /* one open document (opaque) */
 
 typedef struct getme_doc_options {
     int fix_skin;        /* 1 (default): fix nodes on the mesh skin           */
@@ -58,124 +79,101 @@ typedef struct getme_doc_options {
     const char *const *free_sets;
     int verbose;         /* 0 quiet; adapters never print, this only lets
                             them keep more detail in getme_doc_info()        */
+    /* More adapters, NULL-terminated (may be NULL): tried after the
+       built-in ones, and when a built-in adapter declines a file it takes
+       (the native MSH reader declines MSH 4.0, parametric nodes...).  The
+       getme command passes getme_gmsh_format() of libgetme_gmsh here. */
+    const getme_format *const *adapters;
 } getme_doc_options;
 
-/* Fill options with the defaults (fix skin and interfaces, no names). */
-void getme_doc_options_init(getme_doc_options *opts);
+/* Fill options with the defaults (fix skin and interfaces, no names, no
+   extra adapters). */
+GETME_FORMATS_API void getme_doc_options_init(getme_doc_options *opts);
 
-typedef struct getme_doc getme_doc;
-
-/* One adapter. */
-typedef struct getme_format {
-    const char *name;        /* "msh", "inp", "cgns"                          */
-    const char *description; /* "Gmsh MSH 2.2/4.1 (via the Gmsh SDK)" ...    */
-    /* 1 if this adapter takes the file (by extension and/or magic bytes). */
-    int (*probe)(const char *path);
-    /* Read doc->path; build doc->mesh with fixed nodes set; keep private
-       state in doc->impl.  On failure set the message with getme_doc_fail()
-       and return its status. */
-    getme_io_status (*open)(getme_doc *doc, const getme_doc_options *opts);
-    /* Write the document with the current coordinates of doc->mesh to
-       out_path (through a temporary file + rename). */
-    getme_io_status (*write)(getme_doc *doc, const char *out_path);
-    /* Free doc->impl. */
-    void (*close)(getme_doc *doc);
-    /* Extensions of the format, space-separated, with the dot (".inp"):
-       an output must end with one of them (getme_format_has_extension). */
-    const char *extensions;
-    /* The i-th file (i >= 1) the document was read from besides doc->path
-       (INP *INCLUDE files), NULL past the last; NULL if there are none. */
-    const char *(*file)(const getme_doc *doc, size_t i);
-} getme_format;
-
-struct getme_doc {
-    const getme_format *format;
-    char *path;          /* input path (owned)                               */
-    getme_mesh *mesh;    /* the mesh to smooth (owned)                       */
-    void *impl;          /* adapter private state                            */
-    /* element ids as written in the file, per global element index (may be
-       NULL); used in messages about invalid elements                       */
-    int64_t *elem_ids;
-    getme_quality_stats stats; /* all elements as read (set by
-                            getme_doc_open, which needs them for its validity
-                            check; callers need not compute them again)      */
-    char info[1024];     /* one line the CLI may log: zones, sets, fixed...  */
-    char error[1024];    /* the last error, one line                         */
-    char warning[1024];  /* input accepted with a caveat (the CLI prints it
-                            as a warning), one line; empty if none           */
-};
-
-/* The registered adapters, NULL-terminated. */
-const getme_format *const *getme_formats(void);
-/* The adapter for a path (probe order: by extension first), or NULL. */
-const getme_format *getme_format_for(const char *path);
+/* The built-in adapters, NULL-terminated. */
+GETME_FORMATS_API const getme_format *const *getme_formats(void);
+/* The built-in adapter for a path (probe order: by extension first), or
+   NULL. */
+GETME_FORMATS_API const getme_format *getme_format_for(const char *path);
+/* "msh", "inp", "cgns". */
+GETME_FORMATS_API const char *getme_format_name(const getme_format *format);
+/* One line: "Abaqus / CalculiX INP ...". */
+GETME_FORMATS_API const char *
+getme_format_description(const getme_format *format);
+/* Its extensions, space-separated, with the dot: ".inp .INP"... */
+GETME_FORMATS_API const char *
+getme_format_extensions(const getme_format *format);
+/* 1 if path ends with one of format's extensions (case-insensitive). */
+GETME_FORMATS_API int getme_format_has_extension(const getme_format *format,
+                                                 const char *path);
 
 /*
  * Open a document; on failure *doc is still set (so getme_doc_error() can be
  * read) and must be closed.  Checks that the mesh is valid: an input with
- * invalid elements gives GETME_IO_ERR_INVALID with how many and the first
- * few file ids.
+ * invalid elements gives GETME_FORMATS_ERR_INVALID with how many and the
+ * first few file ids; the mesh stays readable (getme_doc_mesh) so that a
+ * caller may untangle it.
  */
-getme_io_status getme_doc_open(getme_doc **doc, const char *path,
-                               const getme_doc_options *opts);
-/* Write the document to out_path: refused (GETME_IO_ERR_USAGE) if out_path
-   is one of the files read (by device and inode) or is not a regular file
-   (see getme_io_output_path: a symbolic link is followed). */
-getme_io_status getme_doc_write(getme_doc *doc, const char *out_path);
+GETME_FORMATS_API getme_formats_status
+getme_doc_open(getme_doc **doc, const char *path, const getme_doc_options *opts);
+/* Write the document to out_path: refused (GETME_FORMATS_ERR_ARGUMENT) if
+   out_path is one of the files read (by device and inode) or is not a
+   regular file (see getme_io_output_path: a symbolic link is followed). */
+GETME_FORMATS_API getme_formats_status getme_doc_write(getme_doc *doc,
+                                                       const char *out_path);
+GETME_FORMATS_API void getme_doc_close(getme_doc *doc);
+/* The mesh to smooth (owned by the document); NULL before it was built. */
+GETME_FORMATS_API getme_mesh *getme_doc_mesh(getme_doc *doc);
+/* The adapter that opened the document (NULL if none took the file). */
+GETME_FORMATS_API const getme_format *getme_doc_format(const getme_doc *doc);
+/* The input path as given. */
+GETME_FORMATS_API const char *getme_doc_path(const getme_doc *doc);
+/* Quality of all elements as read (getme_doc_open computes them for its
+   validity check; callers need not compute them again); NULL before. */
+GETME_FORMATS_API const getme_quality_stats *
+getme_doc_stats(const getme_doc *doc);
+/* The last error, one line naming the file. */
+GETME_FORMATS_API const char *getme_doc_error(const getme_doc *doc);
+/* One line a program may log: zones, sets, fixed nodes... ("" if none). */
+GETME_FORMATS_API const char *getme_doc_info(const getme_doc *doc);
+/* Input accepted with a caveat, one line; "" if none. */
+GETME_FORMATS_API const char *getme_doc_warning(const getme_doc *doc);
 /* The files the document was read from: 0 is the input, then the files it
    includes (INP *INCLUDE), in the order they were read. */
-size_t getme_doc_num_files(const getme_doc *doc);
-const char *getme_doc_file(const getme_doc *doc, size_t i);
-/* 1 if path ends with one of format's extensions (case-insensitive). */
-int getme_format_has_extension(const getme_format *format, const char *path);
-void getme_doc_close(getme_doc *doc);
-getme_mesh *getme_doc_mesh(getme_doc *doc);
-const char *getme_doc_error(const getme_doc *doc);
-const char *getme_doc_info(const getme_doc *doc);
-const char *getme_doc_warning(const getme_doc *doc);
-
+GETME_FORMATS_API size_t getme_doc_num_files(const getme_doc *doc);
+GETME_FORMATS_API const char *getme_doc_file(const getme_doc *doc, size_t i);
 /* The id of mesh element e as written in the file (1-based position if
    the format has no ids). */
-int64_t getme_doc_element_id(const getme_doc *doc, int32_t e);
+GETME_FORMATS_API int64_t getme_doc_element_id(const getme_doc *doc, int32_t e);
 
-/* Set doc->error (printf style) and return status. */
-getme_io_status getme_doc_fail(getme_doc *doc, getme_io_status status,
-                               const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-
-/* ---- helpers for adapters ----------------------------------------------- */
+/* ---- safe writing (used by the adapters and by programs) --------------- */
 
 /* Create an empty file with a unique name next to out_path
-   ("<dir>/.<name>.getme-tmp.<pid>.<n>") and put its path into buf; the adapter
-   overwrites it.  Returns 0, or -1 (buf too small, directory not writable:
-   errno tells). */
-int getme_io_tmp_path(const char *out_path, char *buf, size_t size);
+   ("<dir>/.<name>.getme-tmp.<pid>.<n>") and put its path into buf; the
+   caller overwrites it.  Returns 0, or -1 (buf too small, directory not
+   writable: errno tells). */
+GETME_FORMATS_API int getme_io_tmp_path(const char *out_path, char *buf,
+                                        size_t size);
 /* Rename tmp to out (same directory); on failure remove tmp. 0 or -1.
    Refuses (errno EEXIST) when out exists and is not a regular file: a
    device, FIFO, directory or symbolic link is never replaced.
-   Adapters that fail after getme_io_tmp_path must remove(tmp) themselves. */
-int getme_io_commit(const char *tmp, const char *out);
+   Callers that fail after getme_io_tmp_path must remove(tmp) themselves. */
+GETME_FORMATS_API int getme_io_commit(const char *tmp, const char *out);
 /* Where out_path may be written, checked before anything is read or
    written: the path to write goes to buf (out_path itself, or for a
    symbolic link the file it points to: the link is followed and stays).
-   GETME_IO_ERR_USAGE if out_path exists and is not a regular file
+   GETME_FORMATS_ERR_ARGUMENT if out_path exists and is not a regular file
    (character or block device, FIFO, socket, directory) or is a link to a
-   missing file; GETME_IO_ERR_WRITE if its directory is missing or not
+   missing file; GETME_FORMATS_ERR_WRITE if its directory is missing or not
    writable.  msg gets the one-line reason, naming out_path. */
-getme_io_status getme_io_output_path(const char *out_path, char *buf,
-                                     size_t size, char *msg, size_t msg_size);
+GETME_FORMATS_API getme_formats_status
+getme_io_output_path(const char *out_path, char *buf, size_t size, char *msg,
+                     size_t msg_size);
 /* The directory part of path ("." if none, "/" for "/x"), into buf. */
-void getme_io_dirname(const char *path, char *buf, size_t size);
+GETME_FORMATS_API void getme_io_dirname(const char *path, char *buf,
+                                        size_t size);
 /* 1 if a and b name the same existing file (used to refuse -o == input). */
-int getme_io_same_file(const char *a, const char *b);
-
-/* The adapters (each in its own file). */
-extern const getme_format getme_format_msh;  /* msh_format.c  */
-extern const getme_format getme_format_inp;  /* inp_format.c  */
-extern const getme_format getme_format_cgns; /* cgns_format.c */
+GETME_FORMATS_API int getme_io_same_file(const char *a, const char *b);
 
 #ifdef __cplusplus
 }

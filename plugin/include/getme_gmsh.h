@@ -223,7 +223,7 @@ GETME_GMSH_API const char *
 getme_gmsh_report_message(const getme_gmsh_report *report);
 
 /* ------------------------------------------------------------------------ */
-/* Model extraction (used by the MSH file adapter; usable on its own)        */
+/* Model extraction (the Python package's getme.gmsh uses it)               */
 /* ------------------------------------------------------------------------ */
 
 typedef struct getme_gmsh_model getme_gmsh_model;
@@ -238,23 +238,8 @@ GETME_GMSH_API getme_status getme_gmsh_model_read(
     const getme_gmsh_options *options, char *message, size_t message_size);
 GETME_GMSH_API void getme_gmsh_model_free(getme_gmsh_model *model);
 
-/* The mesh (owned by the model until taken; then the caller frees it). */
+/* The mesh (owned by the model). */
 GETME_GMSH_API getme_mesh *getme_gmsh_model_mesh(getme_gmsh_model *model);
-GETME_GMSH_API getme_mesh *getme_gmsh_model_take_mesh(getme_gmsh_model *model);
-
-GETME_GMSH_API int getme_gmsh_model_dim(const getme_gmsh_model *model);
-GETME_GMSH_API int getme_gmsh_model_num_entities(const getme_gmsh_model *model);
-GETME_GMSH_API int32_t getme_gmsh_model_num_nodes(const getme_gmsh_model *model);
-GETME_GMSH_API int32_t
-getme_gmsh_model_num_elements(const getme_gmsh_model *model);
-/* Gmsh node tag of mesh node i / element tag of mesh element e. */
-GETME_GMSH_API const size_t *
-getme_gmsh_model_node_tags(const getme_gmsh_model *model);
-GETME_GMSH_API const size_t *
-getme_gmsh_model_element_tags(const getme_gmsh_model *model);
-/* Describe mesh element e for messages: "tetrahedron 1234 in volume 2". */
-GETME_GMSH_API void getme_gmsh_model_describe_element(
-    const getme_gmsh_model *model, int32_t e, char *buf, size_t size);
 
 /*
  * Write coordinates back into the current Gmsh model: coords holds 3 doubles
@@ -265,6 +250,27 @@ GETME_GMSH_API void getme_gmsh_model_describe_element(
 GETME_GMSH_API getme_status getme_gmsh_model_apply(
     const getme_gmsh_model *model, const double *coords, int32_t *num_moved,
     char *message, size_t message_size);
+
+/* ------------------------------------------------------------------------ */
+/* MSH files through the Gmsh SDK                                           */
+/* ------------------------------------------------------------------------ */
+
+/*
+ * An adapter for libgetme_formats (getme_formats.h): the MSH files its
+ * native reader declines (MSH 4.0, parametric nodes, partitioned meshes,
+ * planar meshes outside z = const...) read by Gmsh's own reader, the model
+ * handed to the same model builder, and written back by Gmsh (MSH 4) or as
+ * a copy of the input with new coordinates (MSH 2.2).  Pass it in
+ * getme_doc_options.adapters, as the getme command does:
+ *
+ *   const getme_format *extra[] = {getme_gmsh_format(), NULL};
+ *   opts.adapters = extra;
+ *
+ * It initializes Gmsh if nobody did (silently: General.Terminal = 0), opens
+ * each document as its own Gmsh model and removes that model on close.
+ */
+struct getme_format;
+GETME_GMSH_API const struct getme_format *getme_gmsh_format(void);
 
 #ifdef __cplusplus
 }

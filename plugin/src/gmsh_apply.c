@@ -26,12 +26,14 @@ getme_status getme_gmsh_model_apply(const getme_gmsh_model *m,
         st = gg_fail(&msg, GETME_ERR_STATE, "Gmsh is not initialized");
     for (int32_t i = 0; st == GETME_OK && i < m->num_nodes; i++) {
         const double *p = coords + 3 * (size_t)i;
-        if (m->fixed[i] ||
-            memcmp(p, m->coords0 + 3 * (size_t)i, 3 * sizeof *p) == 0)
+        /* fixed nodes never move; second-order mid-nodes are "fixed" in
+           the mask (no linear element uses them) but move with their
+           corners, so the test is whether the node moved */
+        if (memcmp(p, m->coords0 + 3 * (size_t)i, 3 * sizeof *p) == 0)
             continue;
         double xyz[3];
         int ierr = 0;
-        gg_frame_to_global(&m->frame, p, xyz);
+        getme__frame_to_global(&m->frame, p, xyz);
         gmshModelMeshSetNode(m->node_tags[i], xyz, 3, NULL, 0, &ierr);
         if (ierr) {
             char err[256];

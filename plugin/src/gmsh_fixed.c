@@ -16,12 +16,10 @@
 #include <string.h>
 
 getme_status gg_fix_classified(const getme_gmsh_model *model,
-                               const gg_nodemap *local, uint8_t *fixed,
+                               const getme__nodemap *all, uint8_t *flags,
                                gg_msg *msg)
 {
-    uint8_t *own = calloc(model->num_nodes ? (size_t)model->num_nodes : 1, 1);
-    if (!own)
-        return gg_fail(msg, GETME_ERR_NOMEM, "Out of memory");
+    (void)msg;
     for (int e = 0; e < model->num_entities; e++) {
         size_t *tags = NULL, nt = 0, nc = 0, np = 0;
         double *coord = NULL, *param = NULL;
@@ -30,18 +28,14 @@ getme_status gg_fix_classified(const getme_gmsh_model *model,
                               model->entities[2 * e],
                               model->entities[2 * e + 1], 0, 0, &ierr);
         for (size_t i = 0; !ierr && i < nt; i++) {
-            int32_t k = gg_nodemap_find(local, tags[i]);
+            int32_t k = getme__nodemap_find(all, tags[i]);
             if (k >= 0)
-                own[k] = 1;
+                flags[k] |= GETME__NODE_OWN;
         }
         gmshFree(tags);
         gmshFree(coord);
         gmshFree(param);
     }
-    for (int32_t i = 0; i < model->num_nodes; i++)
-        if (!own[i])
-            fixed[i] = 1;
-    free(own);
     return GETME_OK;
 }
 
@@ -89,8 +83,8 @@ static void describe_groups(const int *dt, size_t n, char *buf, size_t size)
         snprintf(buf, size, "the model has no physical groups");
 }
 
-static void fix_group_nodes(int dim, int tag, const gg_nodemap *local,
-                            uint8_t *fixed)
+static void fix_group_nodes(int dim, int tag, const getme__nodemap *all,
+                            uint8_t *flags)
 {
     size_t *tags = NULL, nt = 0, nc = 0;
     double *coord = NULL;
@@ -98,9 +92,9 @@ static void fix_group_nodes(int dim, int tag, const gg_nodemap *local,
     gmshModelMeshGetNodesForPhysicalGroup(dim, tag, &tags, &nt, &coord, &nc,
                                           &ierr);
     for (size_t i = 0; !ierr && i < nt; i++) {
-        int32_t k = gg_nodemap_find(local, tags[i]);
+        int32_t k = getme__nodemap_find(all, tags[i]);
         if (k >= 0)
-            fixed[k] = 1;
+            flags[k] |= GETME__NODE_FIXGRP;
     }
     gmshFree(tags);
     gmshFree(coord);
@@ -108,7 +102,7 @@ static void fix_group_nodes(int dim, int tag, const gg_nodemap *local,
 
 /* Fix the groups matching one user word; 0 if none matched. */
 static int fix_one(const char *word, const int *dt, size_t n,
-                   const gg_nodemap *local, uint8_t *fixed)
+                   const getme__nodemap *all, uint8_t *flags)
 {
     int dim, tag, used = 0, found = 0;
     int by_tag = sscanf(word, "%d:%d%n", &dim, &tag, &used) == 2 &&
@@ -117,8 +111,8 @@ static int fix_one(const char *word, const int *dt, size_t n,
         int match = by_tag ? (dt[i] == dim && dt[i + 1] == tag)
                            : group_name_is(dt[i], dt[i + 1], word);
         if (match) {
-            if (fixed)
-                fix_group_nodes(dt[i], dt[i + 1], local, fixed);
+            if (flags)
+                fix_group_nodes(dt[i], dt[i + 1], all, flags);
             found++;
         }
     }
@@ -126,7 +120,7 @@ static int fix_one(const char *word, const int *dt, size_t n,
 }
 
 getme_status gg_fix_groups(const getme_gmsh_options *opt,
-                           const gg_nodemap *local, uint8_t *fixed,
+                           const getme__nodemap *all, uint8_t *flags,
                            gg_msg *msg)
 {
     if (!opt || opt->num_fix == 0)
@@ -136,7 +130,7 @@ getme_status gg_fix_groups(const getme_gmsh_options *opt,
     list_groups(&dt, &n);
     getme_status st = GETME_OK;
     for (int g = 0; g < opt->num_fix && st == GETME_OK; g++) {
-        if (fix_one(opt->fix[g], dt, n, local, fixed))
+        if (fix_one(opt->fix[g], dt, n, all, flags))
             continue;
         char known[300];
         describe_groups(dt, n, known, sizeof known);

@@ -9,6 +9,7 @@
 #define GETME_GMSH_INTERNAL_H
 
 #include "getme_gmsh.h"
+#include "model.h"
 
 #include <stddef.h>
 #include <stdint.h>
@@ -54,12 +55,6 @@ const char *gg_dim_word(int dim);
 const char *gg_dim_Word(int dim);
 /* Gmsh's last error as a string (static fallback if none). */
 void gg_gmsh_last_error(char *buf, size_t size);
-/* getme type of a linear Gmsh element type, or -1. */
-int gg_getme_type(int gmsh_type);
-/* Readable Gmsh element type name: "tetrahedron", "10-node tetrahedron". */
-void gg_gmsh_type_name(int gmsh_type, char *buf, size_t size);
-/* Order (1, 2, ...) of a Gmsh element type, 0 if unknown. */
-int gg_gmsh_type_order(int gmsh_type);
 
 /* ---- entity selection (gmsh_select.c) ----------------------------------- */
 
@@ -70,50 +65,12 @@ getme_status gg_select_entities(const int *dim_tags, size_t dim_tags_n,
                                 int **pairs, int *count, int *dim,
                                 gg_msg *msg);
 
-/* ---- node tag -> index map (gmsh_nodemap.c) ----------------------------- */
+/* ---- physical groups of entities (gmsh_regions.c) ---------------------- */
 
-typedef struct gg_nodemap {
-    size_t max_tag;
-    int32_t *dense;     /* max_tag + 1 entries, -1 = absent; or NULL */
-    size_t *sorted_tag; /* sorted tags (sparse numbering), with...       */
-    int32_t *sorted_idx;/* ... their indices                              */
-    size_t n;
-} gg_nodemap;
-
-getme_status gg_nodemap_build(gg_nodemap *map, const size_t *tags, size_t n,
-                              gg_msg *msg);
-/* Index of tag, -1 if absent. */
-int32_t gg_nodemap_find(const gg_nodemap *map, size_t tag);
-void gg_nodemap_free(gg_nodemap *map);
-
-/* ---- physical-group regions (gmsh_regions.c) ---------------------------- */
-
-/* Region id per selected entity: entities with the same non-empty set of
-   physical groups share an id; an entity in no physical group gets its own
-   id.  regions has count entries. */
-getme_status gg_entity_regions(const int *pairs, int count, int32_t *regions,
-                               gg_msg *msg);
-
-/* ---- planar frame (gmsh_planar.c) --------------------------------------- */
-
-typedef struct gg_frame {
-    int rotated;        /* 0: identity (all nodes share one z) */
-    double origin[3];
-    double axis[3][3];  /* rows: e1, e2, normal */
-} gg_frame;
-
-/* Choose the frame of a planar mesh (xyz: n nodes; blocks with their
-   local connectivity conn[b]) and check that every surface is planar and
-   that all lie in one plane.  Then rewrite xyz in the frame and reverse the
-   node order of the elements of every surface whose majority is clockwise
-   there, so that valid elements are counter-clockwise. */
-struct gg_block;
-getme_status gg_planar_prepare(gg_frame *frame, double *xyz, int32_t n,
-                               const struct gg_block *blocks, int nb,
-                               int32_t *const *conn, gg_msg *msg);
-/* Local (frame) coordinates of one node back to model coordinates. */
-void gg_frame_to_global(const gg_frame *frame, const double *local,
-                        double *global);
+/* Each selected entity's physical tags (*phys[i]: gmsh-allocated, may be
+   NULL; *phys and *num_phys: count entries, malloc'd). */
+getme_status gg_entity_phys(const int *pairs, int count, int ***phys,
+                            size_t **num_phys, gg_msg *msg);
 
 /* ---- the model (gmsh_model.c) ------------------------------------------- */
 
@@ -137,20 +94,28 @@ struct getme_gmsh_model {
     size_t *elem_tags;  /* num_elements */
     gg_block *blocks;
     int num_blocks;
-    gg_frame frame;
+    getme__frame frame;
     getme_mesh *mesh;
 };
 
 /* ---- fixed nodes (gmsh_fixed.c) ----------------------------------------- */
 
-/* Mark in fixed[] (model->num_nodes entries, pre-zeroed) the nodes not
-   classified on the selected entities, and those of the named groups. */
+/* Flag (per node of the model, all: tag -> index) the nodes classified on
+   the selected entities (GETME__NODE_OWN), and those of the named groups
+   (GETME__NODE_FIXGRP); the builder fixes all but the first kind. */
 getme_status gg_fix_classified(const getme_gmsh_model *model,
-                               const gg_nodemap *local, uint8_t *fixed,
+                               const getme__nodemap *all, uint8_t *flags,
                                gg_msg *msg);
 getme_status gg_fix_groups(const getme_gmsh_options *opt,
-                           const gg_nodemap *local, uint8_t *fixed,
+                           const getme__nodemap *all, uint8_t *flags,
                            gg_msg *msg);
+
+/* ---- model accessors (gmsh_model_access.c) ------------------------------ */
+
+getme_mesh *gg_model_take_mesh(getme_gmsh_model *model);
+/* Describe mesh element e for messages: "tetrahedron 1234 in volume 2". */
+void gg_describe_element(const getme_gmsh_model *model, int32_t e, char *buf,
+                         size_t size);
 
 /* ---- logging (gmsh_log.c) ----------------------------------------------- */
 

@@ -1,10 +1,12 @@
 /*
  * gmsh_model.c -- read the current Gmsh model into a getme_mesh.
  *
- * One pass over the selected entities: their elements (per entity and
- * element type, as Gmsh stores them) become blocks of one getme_mesh, the
- * nodes they use become its nodes (in Gmsh's node order), and each element
- * keeps its Gmsh tag for messages.  Nothing in the model is modified here.
+ * Gmsh gives us the selected entities, their elements per element type, all
+ * nodes in its own order, the nodes classified on each entity and those of
+ * each physical group.  That is what the native MSH reader finds in a file,
+ * and both hand it to the one model builder (formats/model), which numbers
+ * the nodes, fixes, orients and builds the mesh.  Each element keeps its
+ * Gmsh tag for messages.  Nothing in the model is modified here.
  */
 #include "gmsh_internal.h"
 
@@ -14,28 +16,34 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Everything Gmsh gave us about all nodes, plus our working arrays. */
+/* Everything Gmsh gave us about all nodes, plus the builder's input. */
 typedef struct gg_read {
     size_t *gtags;     /* all nodes of the model (gmsh-allocated) */
     double *gcoords;
     size_t gn;
-    gg_nodemap gmap;   /* tag -> index into gtags */
-    uint8_t *used;     /* gn: used by a selected element */
-    int32_t **conn;    /* per block: global, then local node indices */
-    int cap_blocks;
-    int32_t *entity_region;
+    getme__nodemap gmap; /* tag -> index into gtags */
+    uint8_t *flags;    /* GETME__NODE_* per node of gtags */
+    getme__model_block *blocks;
+    size_t num_blocks, cap_blocks;
+    int **phys;        /* per entity, gmsh-allocated */
+    size_t *num_phys;
 } gg_read;
 
-static void read_free(gg_read *r, int nb)
+static void read_free(gg_read *r, int num_entities)
 {
     gmshFree(r->gtags);
     gmshFree(r->gcoords);
-    gg_nodemap_free(&r->gmap);
-    free(r->used);
-    for (int b = 0; r->conn && b < nb; b++)
-        free(r->conn[b]);
-    free(r->conn);
-    free(r->entity_region);
+    getme__nodemap_free(&r->gmap);
+    free(r->flags);
+    for (size_t b = 0; r->blocks && b < r->num_blocks; b++) {
+        free(r->blocks[b].conn);
+        free(r->blocks[b].ids);
+    }
+    free(r->blocks);
+    for (int e = 0; r->phys && e < num_entities; e++)
+        gmshFree(r->phys[e]);
+    free(r->phys);
+    free(r->num_phys);
 }
 
 static getme_status read_all_nodes(gg_read *r, gg_msg *msg)
@@ -48,99 +56,77 @@ static getme_status read_all_nodes(gg_read *r, gg_msg *msg)
     gmshFree(param);
     if (ierr || nc != 3 * r->gn)
         return gg_fail(msg, GETME_ERR_STATE, "Could not read the mesh nodes");
-    r->used = calloc(r->gn ? r->gn : 1, 1);
-    if (!r->used)
+    if (r->gn > (size_t)INT32_MAX)
+        return gg_fail(msg, GETME_ERR_ARGUMENT,
+                       "%zu nodes: more than 2^31-1 are not supported", r->gn);
+    r->flags = calloc(r->gn ? r->gn : 1, 1);
+    if (!r->flags)
         return gg_fail(msg, GETME_ERR_NOMEM, "Out of memory");
-    return gg_nodemap_build(&r->gmap, r->gtags, r->gn, msg);
+    uint64_t repeated = 0;
+    getme_status st = getme__nodemap_build(&r->gmap, (const uint64_t *)r->gtags,
+                                           r->gn, &repeated);
+    if (st == GETME_ERR_ARGUMENT)
+        return gg_fail(msg, GETME_ERR_STATE, "Node %llu appears twice",
+                       (unsigned long long)repeated);
+    return st == GETME_OK ? GETME_OK
+                          : gg_fail(msg, GETME_ERR_NOMEM, "Out of memory");
 }
 
-static getme_status type_error(int dim, int tag, int gmsh_type, gg_msg *msg)
+static getme_status grow_blocks(gg_read *r, gg_msg *msg)
 {
-    char name[96];
-    gg_gmsh_type_name(gmsh_type, name, sizeof name);
-    if (gg_gmsh_type_order(gmsh_type) > 1)
-        return gg_fail(msg, GETME_ERR_TOPOLOGY,
-                       "%s %d has second-order elements (%s): GETMe "
-                       "smooths linear elements only (set the element "
-                       "order to 1 first)",
-                       gg_dim_Word(dim), tag, name);
-    return gg_fail(msg, GETME_ERR_TOPOLOGY,
-                   "%s %d has elements of a type GETMe cannot smooth (%s); "
-                   "supported: %s",
-                   gg_dim_Word(dim), tag, name,
-                   dim == 3 ? "tetrahedra, hexahedra, prisms, pyramids"
-                            : "triangles, quadrangles");
-}
-
-static getme_status grow_blocks(getme_gmsh_model *m, gg_read *r, gg_msg *msg)
-{
-    if (m->num_blocks < r->cap_blocks)
+    if (r->num_blocks < r->cap_blocks)
         return GETME_OK;
-    int cap = r->cap_blocks ? 2 * r->cap_blocks : 8;
-    gg_block *nb = realloc(m->blocks, (size_t)cap * sizeof *nb);
-    if (nb)
-        m->blocks = nb;
-    int32_t **nc = realloc(r->conn, (size_t)cap * sizeof *nc);
-    if (nc)
-        r->conn = nc;
-    if (!nb || !nc)
+    size_t cap = r->cap_blocks ? 2 * r->cap_blocks : 8;
+    getme__model_block *nb = realloc(r->blocks, cap * sizeof *nb);
+    if (!nb)
         return gg_fail(msg, GETME_ERR_NOMEM, "Out of memory");
+    r->blocks = nb;
     r->cap_blocks = cap;
     return GETME_OK;
 }
 
-/* Append one (entity, type) block: Gmsh node tags -> global indices. */
-static getme_status add_block(getme_gmsh_model *m, gg_read *r, int dim,
-                              int tag, int gmsh_type, const size_t *etags,
-                              size_t ne, const size_t *ntags, gg_msg *msg)
+/* Append one (entity, type) block: Gmsh node tags -> indices of gtags.  A
+   type GETMe cannot smooth is kept without connectivity: the builder
+   names it. */
+static getme_status add_block(gg_read *r, int dim, int tag, int gmsh_type,
+                              const size_t *etags, size_t ne,
+                              const size_t *ntags, gg_msg *msg)
 {
-    int type = gg_getme_type(gmsh_type);
-    if (type < 0 || getme_type_dim((getme_elem_type)type) != dim)
-        return type_error(dim, tag, gmsh_type, msg);
-    if (ne > (size_t)(INT32_MAX - m->num_elements))
-        return gg_fail(msg, GETME_ERR_ARGUMENT,
-                       "More than 2^31-1 elements are not supported");
-    getme_status st = grow_blocks(m, r, msg);
+    getme_status st = grow_blocks(r, msg);
     if (st != GETME_OK)
         return st;
-    int nv = getme_type_num_nodes((getme_elem_type)type);
-    int32_t *conn = malloc((ne ? ne : 1) * (size_t)nv * sizeof *conn);
-    size_t *et = realloc(m->elem_tags,
-                         ((size_t)m->num_elements + ne) * sizeof *et);
-    if (et)
-        m->elem_tags = et;
-    if (!conn || !et) {
-        free(conn);
+    getme__model_block *b = &r->blocks[r->num_blocks++];
+    memset(b, 0, sizeof *b);
+    b->tag = tag;
+    b->type = gmsh_type;
+    int type = getme__msh_type_corners(gmsh_type, dim);
+    if (type < 0 || getme_type_dim((getme_elem_type)type) != dim)
+        return GETME_OK;
+    if (ne > (size_t)INT32_MAX)
+        return gg_fail(msg, GETME_ERR_ARGUMENT,
+                       "More than 2^31-1 elements are not supported");
+    int nv = getme__msh_type_nodes(gmsh_type, NULL);
+    b->conn = malloc((ne ? ne : 1) * (size_t)nv * sizeof *b->conn);
+    b->ids = malloc((ne ? ne : 1) * sizeof *b->ids);
+    if (!b->conn || !b->ids)
         return gg_fail(msg, GETME_ERR_NOMEM, "Out of memory");
-    }
+    b->count = (int32_t)ne;
     for (size_t i = 0; i < ne * (size_t)nv; i++) {
-        int32_t g = gg_nodemap_find(&r->gmap, ntags[i]);
-        if (g < 0) {
-            free(conn);
+        int32_t g = getme__nodemap_find(&r->gmap, ntags[i]);
+        if (g < 0)
             return gg_fail(msg, GETME_ERR_TOPOLOGY,
                            "Element %zu of %s %d uses node %zu, which does "
                            "not exist",
                            etags[i / (size_t)nv], gg_dim_word(dim), tag,
                            ntags[i]);
-        }
-        conn[i] = g;
-        r->used[g] = 1;
+        b->conn[i] = g;
     }
-    memcpy(m->elem_tags + m->num_elements, etags, ne * sizeof *etags);
-    gg_block *b = &m->blocks[m->num_blocks];
-    b->gmsh_type = gmsh_type;
-    b->type = type;
-    b->dim = dim;
-    b->tag = tag;
-    b->first = m->num_elements;
-    b->count = (int32_t)ne;
-    r->conn[m->num_blocks++] = conn;
-    m->num_elements += (int32_t)ne;
+    for (size_t i = 0; i < ne; i++)
+        b->ids[i] = (int64_t)etags[i];
     return GETME_OK;
 }
 
-static getme_status read_entity(getme_gmsh_model *m, gg_read *r, int dim,
-                                int tag, gg_msg *msg)
+static getme_status read_entity(gg_read *r, int dim, int tag, gg_msg *msg)
 {
     int *types = NULL, ierr = 0;
     size_t ntypes = 0, **etags = NULL, *etags_n = NULL, etags_nn = 0;
@@ -153,7 +139,7 @@ static getme_status read_entity(getme_gmsh_model *m, gg_read *r, int dim,
                            : GETME_OK;
     for (size_t t = 0; t < ntypes && st == GETME_OK; t++)
         if (etags_n[t])
-            st = add_block(m, r, dim, tag, types[t], etags[t], etags_n[t],
+            st = add_block(r, dim, tag, types[t], etags[t], etags_n[t],
                            ntags[t], msg);
     for (size_t t = 0; t < ntypes; t++) {
         gmshFree(etags ? etags[t] : NULL);
@@ -167,116 +153,88 @@ static getme_status read_entity(getme_gmsh_model *m, gg_read *r, int dim,
     return st;
 }
 
-/* Number the used nodes 0.. in Gmsh's order; rewrite block connectivity. */
-static getme_status compact_nodes(getme_gmsh_model *m, gg_read *r,
-                                  gg_msg *msg)
+/* The blocks' summary kept for messages (gg_describe_element). */
+static getme_status keep_blocks(getme_gmsh_model *m, const gg_read *r,
+                                gg_msg *msg)
 {
-    int32_t *loc = malloc((r->gn ? r->gn : 1) * sizeof *loc);
-    if (!loc)
+    m->blocks = malloc((r->num_blocks ? r->num_blocks : 1) * sizeof *m->blocks);
+    if (!m->blocks)
         return gg_fail(msg, GETME_ERR_NOMEM, "Out of memory");
-    int32_t n = 0;
-    for (size_t g = 0; g < r->gn; g++)
-        loc[g] = r->used[g] ? n++ : -1;
-    m->num_nodes = n;
-    m->node_tags = malloc((n ? (size_t)n : 1) * sizeof *m->node_tags);
-    m->coords0 = malloc((n ? (size_t)n : 1) * 3 * sizeof *m->coords0);
-    m->fixed = calloc(n ? (size_t)n : 1, 1);
-    if (!m->node_tags || !m->coords0 || !m->fixed) {
-        free(loc);
-        return gg_fail(msg, GETME_ERR_NOMEM, "Out of memory");
+    int32_t first = 0;
+    for (size_t b = 0; b < r->num_blocks; b++) {
+        const getme__model_block *rb = &r->blocks[b];
+        m->blocks[b] = (gg_block){rb->type, getme__msh_type_corners(rb->type, m->dim),
+                                  m->dim, rb->tag, first, rb->count};
+        first += rb->count;
     }
-    for (size_t g = 0; g < r->gn; g++)
-        if (loc[g] >= 0) {
-            m->node_tags[loc[g]] = r->gtags[g];
-            memcpy(m->coords0 + 3 * (size_t)loc[g], r->gcoords + 3 * g,
-                   3 * sizeof(double));
-        }
-    for (int b = 0; b < m->num_blocks; b++) {
-        size_t len = (size_t)m->blocks[b].count *
-                     (size_t)getme_type_num_nodes(m->blocks[b].type);
-        for (size_t i = 0; i < len; i++)
-            r->conn[b][i] = loc[r->conn[b][i]];
-    }
-    free(loc);
+    m->num_blocks = (int)r->num_blocks;
     return GETME_OK;
 }
 
-static int entity_index(const getme_gmsh_model *m, int tag)
+/* What the builder made becomes the model's. */
+static getme_status take_output(getme_gmsh_model *m, getme__model_out *out,
+                                const gg_read *r, gg_msg *msg)
 {
-    for (int e = 0; e < m->num_entities; e++)
-        if (m->entities[2 * e + 1] == tag)
-            return e;
-    return 0;
+    m->num_nodes = out->num_nodes;
+    m->num_elements = out->num_elements;
+    m->node_tags = malloc((m->num_nodes ? (size_t)m->num_nodes : 1) *
+                          sizeof *m->node_tags);
+    m->elem_tags = malloc((m->num_elements ? (size_t)m->num_elements : 1) *
+                          sizeof *m->elem_tags);
+    if (!m->node_tags || !m->elem_tags)
+        return gg_fail(msg, GETME_ERR_NOMEM, "Out of memory");
+    for (size_t g = 0; g < r->gn; g++)
+        if (out->loc[g] >= 0)
+            m->node_tags[out->loc[g]] = r->gtags[g];
+    for (int32_t e = 0; e < m->num_elements; e++)
+        m->elem_tags[e] = (size_t)out->elem_ids[e];
+    m->coords0 = out->xyz;
+    m->fixed = out->fixed;
+    m->mesh = out->mesh;
+    m->frame = out->frame;
+    out->xyz = NULL;
+    out->fixed = NULL;
+    out->mesh = NULL;
+    /* the mask after skin and interfaces, for getme_gmsh_model_apply */
+    getme_status st = getme_mesh_get_fixed_mask(m->mesh, m->fixed);
+    return st == GETME_OK ? GETME_OK
+                          : gg_fail(msg, st, "%s", getme_mesh_error(m->mesh));
 }
 
-/* First element of a block that has a node twice, -1 if none. */
-static int32_t repeated_node(const int32_t *conn, int32_t count, int nv)
+static getme_status build(getme_gmsh_model *m, gg_read *r,
+                          const getme_gmsh_options *opt, gg_msg *msg)
 {
-    for (int32_t e = 0; e < count; e++)
-        for (int i = 1; i < nv; i++)
-            for (int j = 0; j < i; j++)
-                if (conn[(size_t)e * nv + i] == conn[(size_t)e * nv + j])
-                    return e;
-    return -1;
-}
-
-static getme_status build_mesh(getme_gmsh_model *m, gg_read *r, gg_msg *msg)
-{
-    getme_status st = getme_mesh_create(&m->mesh, m->dim, m->num_nodes,
-                                        m->coords0);
-    if (st != GETME_OK)
-        return gg_fail(msg, st, "Could not create the mesh: %s",
-                       getme_status_string(st));
-    for (int b = 0; b < m->num_blocks && st == GETME_OK; b++) {
-        const gg_block *blk = &m->blocks[b];
-        int32_t *region = malloc((blk->count ? (size_t)blk->count : 1) *
-                                 sizeof *region);
-        if (!region)
-            return gg_fail(msg, GETME_ERR_NOMEM, "Out of memory");
-        int32_t id = r->entity_region[entity_index(m, blk->tag)];
-        for (int32_t i = 0; i < blk->count; i++)
-            region[i] = id;
-        int32_t bad = repeated_node(r->conn[b], blk->count,
-                                    getme_type_num_nodes(blk->type));
-        if (bad >= 0) {
-            free(region);
-            return gg_fail(msg, GETME_ERR_INVALID_MESH,
-                           "element %zu is degenerate: a node appears twice "
-                           "in it; getme smooths valid meshes only",
-                           m->elem_tags[blk->first + bad]);
-        }
-        st = getme_mesh_add_elements(m->mesh, (getme_elem_type)blk->type,
-                                     blk->count, r->conn[b], region);
-        free(region);
+    getme__node_range all = {0, r->gn};
+    getme__model_in in = {
+        .dim = m->dim,
+        .num_nodes = r->gn,
+        .xyz = r->gcoords,
+        .flags = r->flags,
+        .ranges = &all,
+        .num_ranges = 1,
+        .blocks = r->blocks,
+        .num_blocks = r->num_blocks,
+        .num_entities = (size_t)m->num_entities,
+        .phys = r->phys,
+        .num_phys = r->num_phys,
+        .z_plane_only = 0,
+        .fix_flags = (opt->fix_skin ? GETME_FIX_SKIN : 0u) |
+                     (opt->fix_interfaces ? GETME_FIX_INTERFACES : 0u)};
+    getme__model_out out;
+    getme_status st = getme__model_number(&in, &out);
+    if (st == GETME_OK)
+        st = keep_blocks(m, r, msg);
+    else
+        gg_fail(msg, st, "%s", out.msg);
+    if (st == GETME_OK) {
+        st = getme__model_finish(&in, &out);
         if (st != GETME_OK)
-            gg_fail(msg, st, "%s", getme_mesh_error(m->mesh));
+            gg_fail(msg, st, "%s", out.msg);
     }
+    if (st == GETME_OK)
+        st = take_output(m, &out, r, msg);
+    getme__model_out_free(&out);
     return st;
-}
-
-static getme_status mark_fixed(getme_gmsh_model *m,
-                               const getme_gmsh_options *opt, gg_msg *msg)
-{
-    gg_nodemap local;
-    getme_status st = gg_nodemap_build(&local, m->node_tags,
-                                       (size_t)m->num_nodes, msg);
-    if (st == GETME_OK)
-        st = gg_fix_classified(m, &local, m->fixed, msg);
-    if (st == GETME_OK)
-        st = gg_fix_groups(opt, &local, m->fixed, msg);
-    gg_nodemap_free(&local);
-    if (st != GETME_OK)
-        return st;
-    unsigned flags = (opt->fix_skin ? GETME_FIX_SKIN : 0u) |
-                     (opt->fix_interfaces ? GETME_FIX_INTERFACES : 0u);
-    st = getme_mesh_set_fixed_mask(m->mesh, m->fixed);
-    if (st == GETME_OK && flags)
-        st = getme_mesh_fix_boundary(m->mesh, flags, NULL);
-    if (st == GETME_OK)
-        st = getme_mesh_get_fixed_mask(m->mesh, m->fixed);
-    if (st != GETME_OK)
-        return gg_fail(msg, st, "%s", getme_mesh_error(m->mesh));
-    return GETME_OK;
 }
 
 static getme_status read_model(getme_gmsh_model *m, gg_read *r,
@@ -288,24 +246,16 @@ static getme_status read_model(getme_gmsh_model *m, gg_read *r,
     if (st == GETME_OK)
         st = read_all_nodes(r, msg);
     for (int e = 0; e < m->num_entities && st == GETME_OK; e++)
-        st = read_entity(m, r, m->dim, m->entities[2 * e + 1], msg);
+        st = read_entity(r, m->dim, m->entities[2 * e + 1], msg);
     if (st == GETME_OK)
-        st = compact_nodes(m, r, msg);
-    if (st == GETME_OK && m->dim == 2)
-        st = gg_planar_prepare(&m->frame, m->coords0, m->num_nodes,
-                               m->blocks, m->num_blocks, r->conn, msg);
-    if (st == GETME_OK) {
-        r->entity_region = malloc((size_t)m->num_entities *
-                                  sizeof *r->entity_region);
-        st = r->entity_region
-                 ? gg_entity_regions(m->entities, m->num_entities,
-                                     r->entity_region, msg)
-                 : gg_fail(msg, GETME_ERR_NOMEM, "Out of memory");
-    }
+        st = gg_fix_classified(m, &r->gmap, r->flags, msg);
     if (st == GETME_OK)
-        st = build_mesh(m, r, msg);
+        st = gg_fix_groups(opt, &r->gmap, r->flags, msg);
     if (st == GETME_OK)
-        st = mark_fixed(m, opt, msg);
+        st = gg_entity_phys(m->entities, m->num_entities, &r->phys,
+                            &r->num_phys, msg);
+    if (st == GETME_OK)
+        st = build(m, r, opt, msg);
     return st;
 }
 
@@ -335,7 +285,7 @@ getme_status getme_gmsh_model_read(getme_gmsh_model **model,
         gg_read r;
         memset(&r, 0, sizeof r);
         st = read_model(m, &r, dim_tags, dim_tags_n, options, &msg);
-        read_free(&r, m->num_blocks);
+        read_free(&r, m->num_entities);
     }
     if (st != GETME_OK) {
         getme_gmsh_model_free(m);

@@ -1,6 +1,6 @@
 /*
- * gmsh_model_access.c -- read-only accessors of a getme_gmsh_model and the
- * element descriptions used in messages.
+ * gmsh_model_access.c -- the mesh of a getme_gmsh_model and the element
+ * descriptions used in messages.
  */
 #include "gmsh_internal.h"
 
@@ -11,40 +11,13 @@ getme_mesh *getme_gmsh_model_mesh(getme_gmsh_model *m)
     return m ? m->mesh : NULL;
 }
 
-getme_mesh *getme_gmsh_model_take_mesh(getme_gmsh_model *m)
+getme_mesh *gg_model_take_mesh(getme_gmsh_model *m)
 {
     if (!m)
         return NULL;
     getme_mesh *mesh = m->mesh;
     m->mesh = NULL;
     return mesh;
-}
-
-int getme_gmsh_model_dim(const getme_gmsh_model *m) { return m ? m->dim : 0; }
-
-int getme_gmsh_model_num_entities(const getme_gmsh_model *m)
-{
-    return m ? m->num_entities : 0;
-}
-
-int32_t getme_gmsh_model_num_nodes(const getme_gmsh_model *m)
-{
-    return m ? m->num_nodes : 0;
-}
-
-int32_t getme_gmsh_model_num_elements(const getme_gmsh_model *m)
-{
-    return m ? m->num_elements : 0;
-}
-
-const size_t *getme_gmsh_model_node_tags(const getme_gmsh_model *m)
-{
-    return m ? m->node_tags : NULL;
-}
-
-const size_t *getme_gmsh_model_element_tags(const getme_gmsh_model *m)
-{
-    return m ? m->elem_tags : NULL;
 }
 
 /* Block holding element e (blocks are in element order): bisection. */
@@ -61,8 +34,8 @@ static const gg_block *find_block(const getme_gmsh_model *m, int32_t e)
     return m->num_blocks ? &m->blocks[lo] : NULL;
 }
 
-void getme_gmsh_model_describe_element(const getme_gmsh_model *m, int32_t e,
-                                       char *buf, size_t size)
+void gg_describe_element(const getme_gmsh_model *m, int32_t e, char *buf,
+                         size_t size)
 {
     if (!buf || !size)
         return;

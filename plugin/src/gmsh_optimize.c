@@ -94,7 +94,7 @@ static void name_elements(const gg_run *run, char *text, size_t size,
     char one[128];
     int used = snprintf(text, size, "%s: ", head);
     for (int i = 0; i < n && used < (int)size; i++) {
-        getme_gmsh_model_describe_element(run->model, list[i], one,
+        gg_describe_element(run->model, list[i], one,
                                           sizeof one);
         used += snprintf(text + used, size - (size_t)used, "%s%s",
                          i ? ", " : "", one);
@@ -245,8 +245,8 @@ static getme_status check_model(gg_run *run)
     getme_status st;
     getme_mesh *mesh = getme_gmsh_model_mesh(run->model);
     getme_gmsh_report *r = run->rep;
-    r->dim = getme_gmsh_model_dim(run->model);
-    r->num_entities = getme_gmsh_model_num_entities(run->model);
+    r->dim = run->model->dim;
+    r->num_entities = run->model->num_entities;
     r->num_nodes = getme_mesh_num_nodes(mesh);
     r->num_elements = getme_mesh_num_elements(mesh);
     r->num_fixed = getme_mesh_num_fixed(mesh);
@@ -264,7 +264,7 @@ static getme_status fill_worst(gg_run *run)
 {
     getme_mesh *mesh = getme_gmsh_model_mesh(run->model);
     getme_gmsh_report *r = run->rep;
-    const size_t *tags = getme_gmsh_model_element_tags(run->model);
+    const size_t *tags = run->model->elem_tags;
     getme_status st = getme_mesh_worst_elements(mesh, run->opt->worst, 0,
                                                 r->worst, &r->num_worst);
     if (st == GETME_OK)
@@ -342,7 +342,7 @@ static getme_status topology_first(gg_run *run, const int *dim_tags,
     size_t *before = malloc((size_t)ne * sizeof *before);
     if (!before)
         return fail(run, GETME_ERR_NOMEM, "out of memory");
-    memcpy(before, getme_gmsh_model_element_tags(run->model),
+    memcpy(before, run->model->elem_tags,
            (size_t)ne * sizeof *before);
     qsort(before, (size_t)ne, sizeof *before, cmp_size);
     getme_gmsh_model_free(run->model);
@@ -359,8 +359,8 @@ static getme_status topology_first(gg_run *run, const int *dim_tags,
                                                    run->opt, text,
                                                    sizeof text);
     if (st == GETME_OK) {
-        int32_t na = getme_gmsh_model_num_elements(run->model), gone = ne;
-        const size_t *after = getme_gmsh_model_element_tags(run->model);
+        int32_t na = run->model->num_elements, gone = ne;
+        const size_t *after = run->model->elem_tags;
         for (int32_t i = 0; i < na; i++)
             gone -= bsearch(&after[i], before, (size_t)ne, sizeof *before,
                             cmp_size) != NULL;
@@ -451,8 +451,8 @@ getme_status getme_gmsh_quality(const int *dim_tags, size_t dim_tags_n,
         return st;
     }
     getme_mesh *mesh = getme_gmsh_model_mesh(run.model);
-    run.rep->dim = getme_gmsh_model_dim(run.model);
-    run.rep->num_entities = getme_gmsh_model_num_entities(run.model);
+    run.rep->dim = run.model->dim;
+    run.rep->num_entities = run.model->num_entities;
     run.rep->num_nodes = getme_mesh_num_nodes(mesh);
     run.rep->num_elements = getme_mesh_num_elements(mesh);
     run.rep->num_fixed = getme_mesh_num_fixed(mesh);

@@ -6,7 +6,8 @@
  *   cgns_tool smooth IN OUT [--fix NAME]... [--free NAME]...
  *   cgns_tool fixture OUT          the meshio-style tet file (Base/Zone1/
  *                                  GridElements), interior jittered
- * Errors: one "Error   : ..." line on stderr, exit status = getme_io_status.
+ * Errors: one "Error   : ..." line on stderr, exit status = the getme
+ * command's exit code for the status (3 open, 4 parse, 2 argument...).
  */
 #include "cgns_fixture.h"
 #include "getme_formats.h"
@@ -15,18 +16,24 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int fail(getme_doc *doc, getme_io_status st)
+static int fail(getme_doc *doc, getme_formats_status st)
 {
+    /* the CLI's exit codes (cli/exit.c), which the tests know */
+    static const int code[] = {
+        [GETME_FORMATS_OK] = 0,          [GETME_FORMATS_ERR_OPEN] = 3,
+        [GETME_FORMATS_ERR_PARSE] = 4,   [GETME_FORMATS_ERR_UNSUPPORTED] = 5,
+        [GETME_FORMATS_ERR_INVALID] = 6, [GETME_FORMATS_ERR_WRITE] = 7,
+        [GETME_FORMATS_ERR_ARGUMENT] = 2, [GETME_FORMATS_ERR_INTERNAL] = 1};
     fprintf(stderr, "Error   : %s\n", getme_doc_error(doc));
     getme_doc_close(doc);
-    return (int)st;
+    return (unsigned)st < sizeof code / sizeof *code ? code[st] : 1;
 }
 
 static int dump(const char *in)
 {
     getme_doc *doc;
-    getme_io_status st = getme_doc_open(&doc, in, NULL);
-    if (st != GETME_IO_OK)
+    getme_formats_status st = getme_doc_open(&doc, in, NULL);
+    if (st != GETME_FORMATS_OK)
         return fail(doc, st);
     getme_mesh *m = getme_doc_mesh(doc);
     int32_t ne = getme_mesh_num_elements(m);
@@ -38,7 +45,7 @@ static int dump(const char *in)
         printf("type %s %d\n", getme_type_name((getme_elem_type)t),
                getme_mesh_num_elements_of_type(m, (getme_elem_type)t));
     for (int32_t e = 0; e < ne; e++)
-        printf("q %lld %.17g\n", (long long)doc->elem_ids[e], q[e]);
+        printf("q %lld %.17g\n", (long long)getme_doc_element_id(doc, e), q[e]);
     printf("info %s\n", getme_doc_info(doc));
     free(q);
     getme_doc_close(doc);
@@ -59,8 +66,8 @@ static int smooth(int argc, char **argv)
     }
     o.fix = fix;
     o.free_sets = freed;
-    getme_io_status st = getme_doc_open(&doc, argv[2], &o);
-    if (st != GETME_IO_OK)
+    getme_formats_status st = getme_doc_open(&doc, argv[2], &o);
+    if (st != GETME_FORMATS_OK)
         return fail(doc, st);
     getme_result r;
     if (getme_smooth(getme_doc_mesh(doc), NULL, &r) != GETME_OK) {
@@ -71,7 +78,7 @@ static int smooth(int argc, char **argv)
     printf("q_min* %.6f -> %.6f, q_mean %.6f -> %.6f\n", r.q_min_star_initial,
            r.q_min_star, r.q_mean_initial, r.q_mean);
     st = getme_doc_write(doc, argv[3]);
-    if (st != GETME_IO_OK)
+    if (st != GETME_FORMATS_OK)
         return fail(doc, st);
     getme_doc_close(doc);
     return 0;

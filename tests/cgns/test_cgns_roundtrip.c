@@ -184,9 +184,9 @@ static void roundtrip(const char *name, int file_type, int single, int old)
     char *before = slurp(in, &n_before);
 
     getme_doc *doc;
-    getme_io_status st = getme_doc_open(&doc, in, NULL);
-    CHECK_EQ_INT(st, GETME_IO_OK);
-    if (st != GETME_IO_OK) {
+    getme_formats_status st = getme_doc_open(&doc, in, NULL);
+    CHECK_EQ_INT(st, GETME_FORMATS_OK);
+    if (st != GETME_FORMATS_OK) {
         fprintf(stderr, "%s\n", getme_doc_error(doc));
         getme_doc_close(doc);
         free(before);
@@ -202,7 +202,7 @@ static void roundtrip(const char *name, int file_type, int single, int old)
     CHECK_EQ_INT(getme_smooth(m, NULL, &res), GETME_OK);
     CHECK(res.q_mean > res.q_mean_initial + 0.01);
     CHECK(res.q_min_star > res.q_min_star_initial);
-    CHECK_EQ_INT(getme_doc_write(doc, out), GETME_IO_OK);
+    CHECK_EQ_INT(getme_doc_write(doc, out), GETME_FORMATS_OK);
     getme_doc_close(doc);
     struct stat sb;
     CHECK(stat(out, &sb) == 0 && (sb.st_mode & 0777) == 0640);
@@ -252,8 +252,8 @@ static void roundtrip(const char *name, int file_type, int single, int old)
 
     /* the read-back has the quality the smoother reported */
     st = getme_doc_open(&doc, out, NULL);
-    CHECK_EQ_INT(st, GETME_IO_OK);
-    if (st == GETME_IO_OK) {
+    CHECK_EQ_INT(st, GETME_FORMATS_OK);
+    if (st == GETME_FORMATS_OK) {
         getme_quality_stats s;
         getme_mesh_quality_stats(getme_doc_mesh(doc), -1, &s);
         CHECK_NEAR(s.q_mean, res.q_mean, single ? 1e-5 : 1e-12);
@@ -324,7 +324,7 @@ static void rounding_repair(void)
     cg_close(fn);
 
     getme_doc *doc;
-    CHECK_EQ_INT(getme_doc_open(&doc, in, NULL), GETME_IO_OK);
+    CHECK_EQ_INT(getme_doc_open(&doc, in, NULL), GETME_FORMATS_OK);
     getme_mesh *m = getme_doc_mesh(doc);
     double xyz[3 * FIX_NODES], orig[3 * FIX_NODES];
     getme_mesh_get_coords(m, xyz);
@@ -370,7 +370,7 @@ static void rounding_repair(void)
     free(data);
     CHECK(found);
     CHECK_EQ_INT(getme_mesh_set_coords(m, xyz), GETME_OK);
-    CHECK_EQ_INT(getme_doc_write(doc, out), GETME_IO_OK);
+    CHECK_EQ_INT(getme_doc_write(doc, out), GETME_FORMATS_OK);
     CHECK(strstr(getme_doc_info(doc), "; 1 nodes kept at their input position") != NULL);
     getme_doc_close(doc);
     double back[3 * FIX_NODES];
@@ -386,11 +386,11 @@ static void roundtrip_2d(void)
     snprintf(out, sizeof out, "%s/plane-smooth.cgns", dir);
     CHECK_EQ_INT(fixture_write_2d(in), 0);
     getme_doc *doc;
-    CHECK_EQ_INT(getme_doc_open(&doc, in, NULL), GETME_IO_OK);
+    CHECK_EQ_INT(getme_doc_open(&doc, in, NULL), GETME_FORMATS_OK);
     getme_result res;
     CHECK_EQ_INT(getme_smooth(getme_doc_mesh(doc), NULL, &res), GETME_OK);
     CHECK(res.q_mean > res.q_mean_initial);
-    CHECK_EQ_INT(getme_doc_write(doc, out), GETME_IO_OK);
+    CHECK_EQ_INT(getme_doc_write(doc, out), GETME_FORMATS_OK);
     getme_doc_close(doc);
     snprintf(cmd, sizeof cmd, "cgnsdiff -d '%s' '%s' 2>&1", in, out);
     char *diff = run(cmd);
@@ -412,10 +412,10 @@ static void write_errors(void)
     snprintf(in, sizeof in, "%s/w.cgns", dir);
     fixture_write(in, &o);
     getme_doc *doc;
-    CHECK_EQ_INT(getme_doc_open(&doc, in, NULL), GETME_IO_OK);
-    CHECK_EQ_INT(getme_doc_write(doc, in), GETME_IO_ERR_USAGE);
+    CHECK_EQ_INT(getme_doc_open(&doc, in, NULL), GETME_FORMATS_OK);
+    CHECK_EQ_INT(getme_doc_write(doc, in), GETME_FORMATS_ERR_ARGUMENT);
     snprintf(bad, sizeof bad, "%s/no/such/dir/out.cgns", dir);
-    CHECK_EQ_INT(getme_doc_write(doc, bad), GETME_IO_ERR_WRITE);
+    CHECK_EQ_INT(getme_doc_write(doc, bad), GETME_FORMATS_ERR_WRITE);
     CHECK(strstr(getme_doc_error(doc), "out.cgns: cannot create a temporary "
                                        "file next to it: No such file") != NULL);
     /* the input changed since it was read: refuse */
@@ -425,7 +425,7 @@ static void write_errors(void)
         fclose(f);
     }
     snprintf(bad, sizeof bad, "%s/changed.cgns", dir);
-    CHECK_EQ_INT(getme_doc_write(doc, bad), GETME_IO_ERR_WRITE);
+    CHECK_EQ_INT(getme_doc_write(doc, bad), GETME_FORMATS_ERR_WRITE);
     CHECK(strstr(getme_doc_error(doc), "changed since it was read") != NULL);
     CHECK(access(bad, F_OK) != 0);
     getme_doc_close(doc);

@@ -23,8 +23,7 @@ import numpy as np
 
 GETME, WORK, CASE = sys.argv[1], sys.argv[2], sys.argv[3]
 os.makedirs(WORK, exist_ok=True)
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from checks import Checks  # noqa: E402
+from checks import Checks  # tests/support (PYTHONPATH set by ctest)
 
 T = Checks(GETME)
 check, run = T.check, T.run
@@ -32,10 +31,8 @@ check, run = T.check, T.run
 
 # ---- independent mean ratio: bench/quality.py (numpy, docs/design.md §1, -----
 # written apart from libgetme and checked against it by the bench_quality test)
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "bench"))
-from quality import element_quality  # noqa: E402
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from gmsh_helpers import structured_hex_volume, two_unit_boxes  # noqa: E402
+from quality import element_quality  # bench/ (PYTHONPATH set by ctest)
+from gmsh_helpers import structured_hex_volume, two_unit_boxes  # tests/support
 
 
 GMSH_TYPES = {4: "tet", 5: "hex", 6: "prism", 7: "pyramid", 2: "tri", 3: "quad"}

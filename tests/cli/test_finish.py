@@ -28,10 +28,9 @@ import numpy as np
 GETME, WORK = sys.argv[1], sys.argv[2]
 HERE = os.path.dirname(os.path.abspath(__file__))
 DATA = os.path.join(HERE, "..", "data", "locked-ring.msh")
-sys.path.insert(0, os.path.join(HERE, "..", "..", "bench"))
-sys.path.insert(0, HERE)
-from checks import Checks  # noqa: E402
-from quality import element_quality  # noqa: E402
+# tests/support and bench/ are on PYTHONPATH (set by ctest)
+from checks import Checks
+from quality import element_quality
 
 os.makedirs(WORK, exist_ok=True)
 T = Checks(GETME)

@@ -29,8 +29,7 @@ import gmsh
 GETME, WORK, CASE = sys.argv[1], os.path.abspath(sys.argv[2]), sys.argv[3]
 shutil.rmtree(WORK, ignore_errors=True)
 os.makedirs(WORK)
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from checks import Checks  # noqa: E402
+from checks import Checks  # tests/support (PYTHONPATH set by ctest)
 
 T = Checks(GETME)
 check = T.check

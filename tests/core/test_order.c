@@ -9,7 +9,7 @@
  */
 #include "check.h"
 #include "getme.h"
-#include "support/gen_mesh.h"
+#include "gen_mesh.h"
 
 #include <stdint.h>
 #include <stdlib.h>

@@ -6,7 +6,7 @@
  */
 #include "check.h"
 #include "getme.h"
-#include "support/gen_mesh.h"
+#include "gen_mesh.h"
 
 #include <stdlib.h>
 #include <string.h>

@@ -14,7 +14,7 @@
 #define N 6
 #include "check.h"
 #include "getme.h"
-#include "support/gen_mesh.h"
+#include "gen_mesh.h"
 
 #include <stdlib.h>
 #include <string.h>

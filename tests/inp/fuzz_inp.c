@@ -25,7 +25,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     fwrite(data, 1, size, f);
     fclose(f);
     getme_doc *doc;
-    if (getme_doc_open(&doc, in, NULL) == GETME_IO_OK)
+    if (getme_doc_open(&doc, in, NULL) == GETME_FORMATS_OK)
         getme_doc_write(doc, out);
     getme_doc_close(doc);
     remove(out);

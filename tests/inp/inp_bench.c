@@ -29,9 +29,9 @@ int main(int argc, char **argv)
     getme_doc_options_init(&o);
     double t0 = now();
     getme_doc *doc;
-    getme_io_status st = getme_doc_open(&doc, argv[1], &o);
+    getme_formats_status st = getme_doc_open(&doc, argv[1], &o);
     double t1 = now();
-    if (st != GETME_IO_OK) {
+    if (st != GETME_FORMATS_OK) {
         fprintf(stderr, "Error   : %s\n", getme_doc_error(doc));
         getme_doc_close(doc);
         return (int)st;
@@ -51,7 +51,7 @@ int main(int argc, char **argv)
     double t2 = now();
     st = getme_doc_write(doc, argv[2]);
     double t3 = now();
-    if (st != GETME_IO_OK)
+    if (st != GETME_FORMATS_OK)
         fprintf(stderr, "Error   : %s\n", getme_doc_error(doc));
     printf("Info    : %s\nInfo    : read %.2f s, write %.2f s\n",
            getme_doc_info(doc), t1 - t0, t3 - t2);

@@ -85,7 +85,7 @@ static inline char *get_file(const char *path, size_t *n)
 }
 
 /* Open with default options plus extra fixed sets and interface flag. */
-static inline getme_io_status open_deck(getme_doc **doc, const char *name,
+static inline getme_formats_status open_deck(getme_doc **doc, const char *name,
                                  int fix_interfaces, int nfix,
                                  const char *const *fix)
 {

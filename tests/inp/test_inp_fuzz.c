@@ -7,6 +7,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "check.h"
+#include "fuzz_check.h"
 #include "inp_test_util.h"
 
 static const char *const seeds[] = {
@@ -105,22 +106,9 @@ int main(int argc, char **argv)
         put_file("fuzz.inp", buf, n);
         const char *fix[] = {"All"};
         getme_doc *doc;
-        getme_io_status st = open_deck(&doc, "fuzz.inp", (int)(it & 1),
+        getme_formats_status st = open_deck(&doc, "fuzz.inp", (int)(it & 1),
                                        (int)(it % 3 == 0), fix);
-        if (st == GETME_IO_OK) {
-            opened++;
-            getme_io_status ws = getme_doc_write(doc, tpath("fuzz-out.inp"));
-            CHECK(ws == GETME_IO_OK || getme_doc_error(doc)[0] != '\0');
-        } else {
-            failed++;
-            const char *msg = getme_doc_error(doc);
-            if (!msg[0])
-                fprintf(stderr, "iteration %d: status %d without message\n",
-                        it, (int)st);
-            CHECK(msg[0] != '\0');
-            CHECK(strchr(msg, '\n') == NULL);
-        }
-        getme_doc_close(doc);
+        fuzz_outcome(doc, st, tpath("fuzz-out.inp"), it, &opened, &failed);
     }
     printf("fuzz: %d inputs, %d opened and written, %d refused with a "
            "message\n", iters, opened, failed);

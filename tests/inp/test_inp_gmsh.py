@@ -230,11 +230,13 @@ def test_smooth(name):
 
 
 def test_errors():
-    bad = os.path.join(WORK, "c3d10.inp")
+    # C3D10/C3D15/C3D20 are smoothed (tests/highorder); C3D13 is not
+    bad = os.path.join(WORK, "c3d13.inp")
     with open(bad, "w") as f:
-        f.write("*NODE\n1,0,0,0\n*ELEMENT, TYPE=C3D10\n1,1,1,1,1,1,1,1,1,1,1\n")
+        f.write("*NODE\n1,0,0,0\n*ELEMENT, TYPE=C3D13\n"
+                "1,1,1,1,1,1,1,1,1,1,1,1,1,1\n")
     r = run("smooth", bad, "-o", os.path.join(WORK, "x.inp"), expect=5)
-    check("c3d10.inp:3: element type C3D10 is second order" in r.stderr,
+    check("c3d13.inp:3: element type C3D13 is second order" in r.stderr,
           "second-order message names file, line and type: " + r.stderr)
     check(not os.path.exists(os.path.join(WORK, "x.inp")), "no output")
     r = run("smooth", os.path.join(WORK, "tets.inp"), "-o",

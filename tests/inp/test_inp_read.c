@@ -61,11 +61,11 @@ static void hex_deck(const char *name)
 }
 
 static int32_t fixed_count(const char *name, int ifaces, int nfix,
-                           const char *const *fix, getme_io_status *st)
+                           const char *const *fix, getme_formats_status *st)
 {
     getme_doc *doc;
     *st = open_deck(&doc, name, ifaces, nfix, fix);
-    int32_t n = *st == GETME_IO_OK ? getme_mesh_num_fixed(getme_doc_mesh(doc))
+    int32_t n = *st == GETME_FORMATS_OK ? getme_mesh_num_fixed(getme_doc_mesh(doc))
                                    : -1;
     if (*st)
         fprintf(stderr, "open: %s\n", getme_doc_error(doc));
@@ -77,7 +77,7 @@ static void test_hex_counts(void)
 {
     hex_deck("hex.inp");
     getme_doc *doc;
-    CHECK_EQ_INT(open_deck(&doc, "hex.inp", 1, 0, NULL), GETME_IO_OK);
+    CHECK_EQ_INT(open_deck(&doc, "hex.inp", 1, 0, NULL), GETME_FORMATS_OK);
     getme_mesh *m = getme_doc_mesh(doc);
     CHECK_EQ_INT(getme_mesh_dim(m), 3);
     CHECK_EQ_INT(getme_mesh_num_nodes(m), 64);
@@ -85,11 +85,11 @@ static void test_hex_counts(void)
     CHECK_EQ_INT(getme_mesh_num_elements_of_type(m, GETME_HEX), 27);
     /* 56 skin + 4 on the section interface x = 1 + 2 beam nodes. */
     CHECK_EQ_INT(getme_mesh_num_fixed(m), 62);
-    CHECK(doc->elem_ids && doc->elem_ids[0] == 1000 && doc->elem_ids[26] == 1078);
+    CHECK(getme_doc_element_id(doc, 0) == 1000 && getme_doc_element_id(doc, 26) == 1078);
     CHECK(strstr(getme_doc_info(doc), "64 nodes") != NULL);
     getme_doc_close(doc);
 
-    getme_io_status st;
+    getme_formats_status st;
     CHECK_EQ_INT(fixed_count("hex.inp", 0, 0, NULL, &st), 58);
     const char *center[] = {"center"};
     CHECK_EQ_INT(fixed_count("hex.inp", 0, 1, center, &st), 59);
@@ -104,7 +104,7 @@ static void test_hex_counts(void)
     const char *all[] = {"allnodes"};
     CHECK_EQ_INT(fixed_count("hex.inp", 0, 1, all, &st), 64);
     const char *bad[] = {"NoSuchSet"};
-    CHECK_EQ_INT(open_deck(&doc, "hex.inp", 1, 1, bad), GETME_IO_ERR_USAGE);
+    CHECK_EQ_INT(open_deck(&doc, "hex.inp", 1, 1, bad), GETME_FORMATS_ERR_ARGUMENT);
     CHECK(strstr(getme_doc_error(doc), "NoSuchSet") != NULL);
     CHECK(strstr(getme_doc_error(doc), "Layer0") != NULL);
     getme_doc_close(doc);
@@ -131,7 +131,7 @@ static int diff_lines(const char *a, const char *b, char *line, size_t sz)
 static void test_hex_write(void)
 {
     getme_doc *doc;
-    CHECK_EQ_INT(open_deck(&doc, "hex.inp", 1, 0, NULL), GETME_IO_OK);
+    CHECK_EQ_INT(open_deck(&doc, "hex.inp", 1, 0, NULL), GETME_FORMATS_OK);
     getme_mesh *m = getme_doc_mesh(doc);
     double *x = malloc(64 * 3 * sizeof *x);
     getme_mesh_get_coords(m, x);
@@ -139,8 +139,8 @@ static void test_hex_write(void)
     x[3 * free_node] = 2.1;
     x[3 * free_node + 2] = 7.0 / 3.0;
     getme_mesh_set_coords(m, x);
-    CHECK_EQ_INT(getme_doc_write(doc, tpath("hex-out.inp")), GETME_IO_OK);
-    CHECK_EQ_INT(getme_doc_write(doc, tpath("hex.inp")), GETME_IO_ERR_USAGE);
+    CHECK_EQ_INT(getme_doc_write(doc, tpath("hex-out.inp")), GETME_FORMATS_OK);
+    CHECK_EQ_INT(getme_doc_write(doc, tpath("hex.inp")), GETME_FORMATS_ERR_ARGUMENT);
     getme_doc_close(doc);
 
     char *in = get_file(tpath("hex.inp"), NULL);
@@ -155,7 +155,7 @@ static void test_hex_write(void)
     free(out);
 
     /* Re-reading the output gives exactly the coordinates written. */
-    CHECK_EQ_INT(open_deck(&doc, "hex-out.inp", 1, 0, NULL), GETME_IO_OK);
+    CHECK_EQ_INT(open_deck(&doc, "hex-out.inp", 1, 0, NULL), GETME_FORMATS_OK);
     const double *y = getme_mesh_coords(getme_doc_mesh(doc));
     CHECK(memcmp(x, y, 64 * 3 * sizeof *x) == 0);
     getme_doc_close(doc);
@@ -165,7 +165,7 @@ static void test_hex_write(void)
 static void test_hex_smooth(void)
 {
     getme_doc *doc;
-    CHECK_EQ_INT(open_deck(&doc, "hex.inp", 0, 0, NULL), GETME_IO_OK);
+    CHECK_EQ_INT(open_deck(&doc, "hex.inp", 0, 0, NULL), GETME_FORMATS_OK);
     getme_mesh *m = getme_doc_mesh(doc);
     /* Distort the 6 free nodes, smooth, write: fixed nodes keep their
        text, the moved ones are the only lines that differ. */
@@ -176,7 +176,7 @@ static void test_hex_smooth(void)
     uint8_t fixed[64];
     getme_mesh_get_coords(m, x);
     getme_mesh_get_fixed_mask(m, fixed);
-    CHECK_EQ_INT(getme_doc_write(doc, tpath("hex-smooth.inp")), GETME_IO_OK);
+    CHECK_EQ_INT(getme_doc_write(doc, tpath("hex-smooth.inp")), GETME_FORMATS_OK);
     getme_doc_close(doc);
     char *in = get_file(tpath("hex.inp"), NULL);
     char *out = get_file(tpath("hex-smooth.inp"), NULL);
@@ -185,7 +185,7 @@ static void test_hex_smooth(void)
         nfree += !fixed[i];
     CHECK_EQ_INT(nfree, 6);
     CHECK(diff_lines(in, out, NULL, 0) <= 6);
-    CHECK_EQ_INT(open_deck(&doc, "hex-smooth.inp", 0, 0, NULL), GETME_IO_OK);
+    CHECK_EQ_INT(open_deck(&doc, "hex-smooth.inp", 0, 0, NULL), GETME_FORMATS_OK);
     CHECK(memcmp(x, getme_mesh_coords(getme_doc_mesh(doc)),
                  64 * 3 * sizeof *x) == 0);
     getme_quality_stats s;
@@ -255,7 +255,7 @@ static void test_parts(void)
     mkdir(sub, 0777);
     parts_deck();
     getme_doc *doc;
-    CHECK_EQ_INT(open_deck(&doc, "parts.inp", 1, 0, NULL), GETME_IO_OK);
+    CHECK_EQ_INT(open_deck(&doc, "parts.inp", 1, 0, NULL), GETME_FORMATS_OK);
     fprintf(stderr, "%s\n", getme_doc_error(doc));
     getme_mesh *m = getme_doc_mesh(doc);
     CHECK_EQ_INT(getme_mesh_num_nodes(m), 31);
@@ -266,7 +266,7 @@ static void test_parts(void)
     x[3 * 13 + 1] = 1.25; /* the centre, in block_nodes.inp */
     x[3 * 20 + 0] = 7.5;  /* a (fixed) node in block_nodes2.inp */
     getme_mesh_set_coords(m, x);
-    CHECK_EQ_INT(getme_doc_write(doc, tpath("out/res.inp")), GETME_IO_OK);
+    CHECK_EQ_INT(getme_doc_write(doc, tpath("out/res.inp")), GETME_FORMATS_OK);
     getme_doc_close(doc);
 
     char *main = get_file(tpath("out/res.inp"), NULL);
@@ -283,12 +283,12 @@ static void test_parts(void)
     free(n1);
     free(n2);
     free(mat);
-    CHECK_EQ_INT(open_deck(&doc, "out/res.inp", 1, 0, NULL), GETME_IO_OK);
+    CHECK_EQ_INT(open_deck(&doc, "out/res.inp", 1, 0, NULL), GETME_FORMATS_OK);
     CHECK(memcmp(x, getme_mesh_coords(getme_doc_mesh(doc)), 31 * 3 * 8) == 0);
     getme_doc_close(doc);
     free(x);
 
-    getme_io_status st;
+    getme_formats_status st;
     const char *corner[] = {"corner"};
     CHECK_EQ_INT(fixed_count("parts.inp", 1, 1, corner, &st), 31);
     const char *qual[] = {"Block.All"};
@@ -313,7 +313,7 @@ static void test_planar(void)
     put_file("plane.inp", b, n);
     free(b);
     getme_doc *doc;
-    CHECK_EQ_INT(open_deck(&doc, "plane.inp", 1, 0, NULL), GETME_IO_OK);
+    CHECK_EQ_INT(open_deck(&doc, "plane.inp", 1, 0, NULL), GETME_FORMATS_OK);
     getme_mesh *m = getme_doc_mesh(doc);
     CHECK_EQ_INT(getme_mesh_dim(m), 2);
     CHECK_EQ_INT(getme_mesh_num_elements_of_type(m, GETME_QUAD), 9);
@@ -322,7 +322,7 @@ static void test_planar(void)
     getme_mesh_get_coords(m, x);
     x[3 * 9 + 1] = 2.25; /* node 10, interior */
     getme_mesh_set_coords(m, x);
-    CHECK_EQ_INT(getme_doc_write(doc, tpath("plane-out.inp")), GETME_IO_OK);
+    CHECK_EQ_INT(getme_doc_write(doc, tpath("plane-out.inp")), GETME_FORMATS_OK);
     getme_doc_close(doc);
     char *out = get_file(tpath("plane-out.inp"), NULL);
     CHECK(out && memcmp(out, "\xEF\xBB\xBF*NODE\n1, 0., 0., 2.5\n", 21) == 0);

@@ -5,12 +5,13 @@
  *    nodes, element ids; a moved node is written back and nothing else
  *    changes (binary: same size, only its 24 bytes);
  *  - errors: every truncation of both files, bad $MeshFormat, a missing
- *    node, second-order tets, unknown --fix name: status and one line
+ *    node, third-order tets, unknown --fix name: status and one line
  *    naming the file (and the line for ASCII);
  *  - mutation fuzzing: thousands of mutants open or fail with a message.
  */
 #define _POSIX_C_SOURCE 200809L
 #include "check.h"
+#include "fuzz_check.h"
 
 #include "getme_formats.h"
 
@@ -204,7 +205,7 @@ static void binary22_seed(bytes *b)
     b_str(b, "\n$EndElements\n");
 }
 
-static getme_io_status open_file(getme_doc **doc, const char *name,
+static getme_formats_status open_file(getme_doc **doc, const char *name,
                                  int nfix, const char *const *fix)
 {
     getme_doc_options o;
@@ -222,9 +223,9 @@ static void check_seed(const char *name, const void *data, size_t n,
 {
     put_file(name, data, n);
     getme_doc *doc;
-    getme_io_status st = open_file(&doc, name, 0, NULL);
-    CHECK_EQ_INT(st, GETME_IO_OK);
-    if (st != GETME_IO_OK) {
+    getme_formats_status st = open_file(&doc, name, 0, NULL);
+    CHECK_EQ_INT(st, GETME_FORMATS_OK);
+    if (st != GETME_FORMATS_OK) {
         fprintf(stderr, "%s\n", getme_doc_error(doc));
         getme_doc_close(doc);
         return;
@@ -233,8 +234,8 @@ static void check_seed(const char *name, const void *data, size_t n,
     CHECK_EQ_INT(getme_mesh_num_elements(m), 2);
     CHECK_EQ_INT(getme_mesh_num_nodes(m), 5);
     CHECK_EQ_INT(getme_mesh_num_fixed(m), 5);
-    CHECK_EQ_INT(doc->elem_ids[0], 2);
-    CHECK_EQ_INT(doc->elem_ids[1], 3);
+    CHECK_EQ_INT(getme_doc_element_id(doc, 0), 2);
+    CHECK_EQ_INT(getme_doc_element_id(doc, 1), 3);
     CHECK(strstr(getme_doc_info(doc), "2 volumes") != NULL);
     /* move node 5 (mesh index 4: Gmsh order puts it last) and write */
     double xyz[15];
@@ -243,7 +244,7 @@ static void check_seed(const char *name, const void *data, size_t n,
     xyz[12] = 0.9;
     xyz[14] = 1.0 / 3.0;
     getme_mesh_set_coords(m, xyz);
-    CHECK_EQ_INT(getme_doc_write(doc, tpath("out.msh")), GETME_IO_OK);
+    CHECK_EQ_INT(getme_doc_write(doc, tpath("out.msh")), GETME_FORMATS_OK);
     getme_doc_close(doc);
     static char out[8192];
     size_t no = get_file("out.msh", out, sizeof out);
@@ -259,7 +260,7 @@ static void check_seed(const char *name, const void *data, size_t n,
         CHECK(tail && strcmp(tail, strstr((const char *)data, "$EndNodes")) == 0);
     }
     /* the output reads back with the new coordinates */
-    CHECK_EQ_INT(open_file(&doc, "out.msh", 0, NULL), GETME_IO_OK);
+    CHECK_EQ_INT(open_file(&doc, "out.msh", 0, NULL), GETME_FORMATS_OK);
     if (getme_doc_mesh(doc)) {
         const double *x = getme_mesh_coords(getme_doc_mesh(doc));
         CHECK(x[12] == 0.9 && x[14] == 1.0 / 3.0);
@@ -270,12 +271,12 @@ static void check_seed(const char *name, const void *data, size_t n,
 /* ---- errors ------------------------------------------------------------- */
 
 static void expect(const char *name, const void *data, size_t n,
-                   getme_io_status want, const char *text, int nfix,
+                   getme_formats_status want, const char *text, int nfix,
                    const char *const *fix)
 {
     put_file(name, data, n);
     getme_doc *doc;
-    getme_io_status st = open_file(&doc, name, nfix, fix);
+    getme_formats_status st = open_file(&doc, name, nfix, fix);
     const char *msg = getme_doc_error(doc);
     CHECK_EQ_INT(st, want);
     CHECK(strstr(msg, tpath(name)) != NULL);
@@ -304,16 +305,16 @@ static void truncations(const char *name, const void *data, size_t end,
     for (size_t k = 0; k < end; k++) {
         put_file(name, data, k);
         getme_doc *doc;
-        getme_io_status st = open_file(&doc, name, 0, NULL);
+        getme_formats_status st = open_file(&doc, name, 0, NULL);
         const char *msg = getme_doc_error(doc);
         /* a cut between two sections leaves a valid file without a mesh */
-        int empty = st == GETME_IO_ERR_UNSUPPORTED &&
+        int empty = st == GETME_FORMATS_ERR_UNSUPPORTED &&
                     strstr(msg, "No volume or surface mesh") != NULL;
-        CHECK(st == GETME_IO_ERR_PARSE || empty ||
-              (k < 20 && st == GETME_IO_ERR_UNSUPPORTED));
+        CHECK(st == GETME_FORMATS_ERR_PARSE || empty ||
+              (k < 20 && st == GETME_FORMATS_ERR_UNSUPPORTED));
         CHECK(strstr(msg, tpath(name)) != NULL && !strchr(msg, '\n'));
         CHECK(!ascii || empty || strstr(msg, "line ") != NULL);
-        if (st != GETME_IO_ERR_PARSE && k >= 20 && !empty)
+        if (st != GETME_FORMATS_ERR_PARSE && k >= 20 && !empty)
             fprintf(stderr, "%s cut at %zu: %d %s\n", name, k, (int)st, msg);
         getme_doc_close(doc);
     }
@@ -332,28 +333,30 @@ static void check_errors(const bytes *bin)
     char buf[4096];
     snprintf(buf, sizeof buf, "%s", ascii_seed);
     replace(buf, "4.1 0 8", "4.1 0 x");
-    expect("fmt.msh", buf, strlen(buf), GETME_IO_ERR_PARSE, "line 2", 0,
+    expect("fmt.msh", buf, strlen(buf), GETME_FORMATS_ERR_PARSE, "line 2", 0,
            NULL);
     snprintf(buf, sizeof buf, "%s", ascii_seed);
     replace(buf, "3 2 3 4 5", "3 2 3 4 77");
-    expect("missing.msh", buf, strlen(buf), GETME_IO_ERR_PARSE,
+    expect("missing.msh", buf, strlen(buf), GETME_FORMATS_ERR_PARSE,
            "line 38: element 3 uses node 77", 0, NULL);
     snprintf(buf, sizeof buf, "%s", ascii_seed);
-    replace(buf, "3 1 4 1\n2 1 2 3 4\n", "3 1 11 1\n2 1 2 3 4 1 2 3 4 5 5\n");
-    expect("order2.msh", buf, strlen(buf), GETME_IO_ERR_UNSUPPORTED,
-           "Volume 1 has second-order elements (10-node tetrahedron)", 0,
+    /* order 3 (second order is smoothed: tests/highorder) */
+    replace(buf, "3 1 4 1\n2 1 2 3 4\n",
+            "3 1 29 1\n2 1 2 3 4 1 2 3 4 1 2 3 4 1 2 3 4 1 2 3 4\n");
+    expect("order3.msh", buf, strlen(buf), GETME_FORMATS_ERR_UNSUPPORTED,
+           "Volume 1 has elements of order 3 (20-node tetrahedron)", 0,
            NULL);
     const char *fix[] = {"a", "nosuch"};
-    expect("fix.msh", ascii_seed, na, GETME_IO_ERR_USAGE,
+    expect("fix.msh", ascii_seed, na, GETME_FORMATS_ERR_ARGUMENT,
            "Unknown physical group 'nosuch' to fix (\"a\" (3:7), \"b\" (3:8))",
            2, fix);
     bytes b2 = *bin;
     b2.d[strlen("$MeshFormat\n4.1 1 ")] = '4';
-    expect("size4.msh", b2.d, b2.n, GETME_IO_ERR_UNSUPPORTED, "data size 4",
+    expect("size4.msh", b2.d, b2.n, GETME_FORMATS_ERR_UNSUPPORTED, "data size 4",
            0, NULL);
     snprintf(buf, sizeof buf, "%s", ascii_seed);
     replace(buf, "3 1 0 1\n4", "3 1 1 1\n4");
-    expect("param.msh", buf, strlen(buf), GETME_IO_ERR_UNSUPPORTED,
+    expect("param.msh", buf, strlen(buf), GETME_FORMATS_ERR_UNSUPPORTED,
            "native", 0, NULL);
 }
 
@@ -440,21 +443,8 @@ static void fuzz(const bytes *bin, const bytes *bin22, int iters)
         put_file("fuzz.msh", buf, n);
         const char *fix[] = {it % 3 ? "a" : "3:8"};
         getme_doc *doc;
-        getme_io_status st = open_file(&doc, "fuzz.msh", it % 5 == 0, fix);
-        if (st == GETME_IO_OK) {
-            opened++;
-            getme_io_status ws = getme_doc_write(doc, tpath("fuzz-out.msh"));
-            CHECK(ws == GETME_IO_OK || getme_doc_error(doc)[0] != '\0');
-        } else {
-            failed++;
-            const char *msg = getme_doc_error(doc);
-            if (!msg[0])
-                fprintf(stderr, "iteration %d: status %d without message\n",
-                        it, (int)st);
-            CHECK(msg[0] != '\0');
-            CHECK(strchr(msg, '\n') == NULL);
-        }
-        getme_doc_close(doc);
+        getme_formats_status st = open_file(&doc, "fuzz.msh", it % 5 == 0, fix);
+        fuzz_outcome(doc, st, tpath("fuzz-out.msh"), it, &opened, &failed);
     }
     printf("fuzz: %d inputs, %d opened and written, %d refused with a "
            "message\n",

@@ -10,6 +10,8 @@
 
 #include <gmshc.h>
 
+#include "gmsh_boxes.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -139,24 +141,7 @@ static void build_model(void)
 {
     int ierr = 0, out_n = 0;
     (void)out_n;
-    gmshModelAdd("two_materials", &ierr);
-    int b1 = gmshModelOccAddBox(0, 0, 0, 1, 1, 1, -1, &ierr);
-    int b2 = gmshModelOccAddBox(1, 0, 0, 1, 1, 1, -1, &ierr);
-    int obj[2] = {3, b1}, tool[2] = {3, b2}, *o = NULL, **m = NULL;
-    size_t on = 0, *mn = NULL, mnn = 0;
-    gmshModelOccFragment(obj, 2, tool, 2, &o, &on, &m, &mn, &mnn, -1, 1, 1,
-                         &ierr);
-    for (size_t i = 0; i < mnn; i++)
-        gmshFree(m[i]);
-    gmshFree(m);
-    gmshFree(mn);
-    gmshFree(o);
-    gmshModelOccSynchronize(&ierr);
-    int v1 = 1, v2 = 2;
-    gmshModelAddPhysicalGroup(3, &v1, 1, 1, &ierr);
-    gmshModelSetPhysicalName(3, 1, "steel", &ierr);
-    gmshModelAddPhysicalGroup(3, &v2, 1, 2, &ierr);
-    gmshModelSetPhysicalName(3, 2, "alu", &ierr);
+    two_material_boxes("two_materials", 0);
     int *faces = NULL;
     size_t nf = 0;
     gmshModelGetEntitiesInBoundingBox(-0.01, -0.01, -0.01, 0.01, 1.01, 1.01,
@@ -407,8 +392,8 @@ static void test_bad_uses(void)
     CHECK(strstr(rep.message, "\"clamp\" (2:10)") != NULL);
     getme_gmsh_options_free(opt);
 
-    gmshModelMeshSetOrder(2, &ierr);
-    expect_refused(NULL, 0, GETME_ERR_TOPOLOGY, "second-order");
+    gmshModelMeshSetOrder(3, &ierr); /* order 2 is smoothed (tests/highorder) */
+    expect_refused(NULL, 0, GETME_ERR_TOPOLOGY, "order 3");
     gmshModelMeshSetOrder(1, &ierr);
 
     /* An entity without elements: a new volume added after meshing. */

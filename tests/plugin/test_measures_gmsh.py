@@ -35,8 +35,7 @@ import numpy as np
 
 import getme
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from gmsh_helpers import structured_hex_volume, two_unit_boxes  # noqa: E402
+from gmsh_helpers import structured_hex_volume, two_unit_boxes  # tests/support
 
 FAILS = []
 PASSED = [0]

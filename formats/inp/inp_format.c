@@ -1,5 +1,5 @@
 /*
- * inp_format.c -- the Abaqus INP adapter (getme_format_inp): probe, open,
+ * inp_format.c -- the Abaqus INP adapter (getme__format_inp): probe, open,
  * write, close.  The work is in inp_reader.c, inp_build.c, inp_writer.c;
  * docs/inp.md is the user's description.
  */
@@ -67,7 +67,7 @@ static void inp_close(getme_doc *doc)
     doc->impl = NULL;
 }
 
-const getme_format getme_format_inp = {
+const getme_format getme__format_inp = {
     "inp",
     "Abaqus / CalculiX input deck (*NODE, *ELEMENT, sets, parts, *INCLUDE)",
     inp_probe,

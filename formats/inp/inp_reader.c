@@ -548,7 +548,8 @@ static getme_io_status kw_element(reader *rd)
     if (rd->kind == INP_KIND_SOLID2)
         return fail(rd, GETME_IO_ERR_UNSUPPORTED,
                     "element type %s is second order (%d nodes): getme smooths "
-                    "linear elements only (C3D4, C3D5, C3D6, C3D8, CPS3, CPS4...)",
+                    "linear elements (C3D4, C3D5, C3D6, C3D8, CPS3, CPS4...) "
+                    "and C3D10, C3D15, C3D20",
                     up, rd->nv);
     if (rd->kind == INP_KIND_PLANAR2 && rd->d->planar2_line == 0) {
         rd->d->planar2_file = rd->file;

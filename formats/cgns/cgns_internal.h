@@ -16,7 +16,7 @@
 #ifndef GETME_CGNS_INTERNAL_H
 #define GETME_CGNS_INTERNAL_H
 
-#include "getme_formats.h"
+#include "adapter.h"
 
 #include <cgnslib.h>
 #include <stddef.h>
@@ -161,6 +161,13 @@ const char *cgns_error(void);
 int cgns_type_dim(cgns_elem_t type);
 /* The getme type of a supported linear CGNS type, or -1. */
 int cgns_getme_type(cgns_elem_t type);
+/* Second-order volume types (cgns_highorder.c): the getme_ho_type or -1;
+   Gmsh's node k of the type is CGNS node order[k]. */
+int cgns_ho_type(cgns_elem_t type);
+const int8_t *cgns_ho_order(int ho_type);
+/* What an element becomes in the mesh: a getme_elem_type, CGNS_HO + a
+   getme_ho_type, or -1 (cgns_sections.c). */
+#define CGNS_HO 100
 
 /* The sections of one zone, kept in memory while the zone is read so that
    BCs can refer to element numbers. */

@@ -1,5 +1,5 @@
 /*
- * gmsh_planar.c -- planar surface meshes: the plane, the frame, the
+ * planar.c -- planar surface meshes: the plane, the frame, the
  * orientation.
  *
  * libgetme smooths planar meshes in the xy plane.  A Gmsh surface mesh may
@@ -15,9 +15,10 @@
  * elements of clockwise surfaces are handed over with reversed node order
  * (this only changes our copy, never the Gmsh model).
  */
-#include "gmsh_internal.h"
+#include "model.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 /* Relative tolerance for "on the plane": Gmsh's own geometric tolerance is
@@ -74,7 +75,7 @@ static double diagonal(const double *xyz, int32_t n)
     return n ? norm3(d) : 0.0;
 }
 
-static int all_same_z(const double *xyz, int32_t n)
+int getme__all_same_z(const double *xyz, int32_t n)
 {
     for (int32_t i = 1; i < n; i++)
         if (xyz[3 * i + 2] != xyz[2])
@@ -83,24 +84,25 @@ static int all_same_z(const double *xyz, int32_t n)
 }
 
 /* Blocks [b0, b1) belong to one entity (they are read entity by entity). */
-static int entity_end(const gg_block *blocks, int nb, int b0)
+static size_t entity_end(const getme__model_block *blocks, size_t nb,
+                         size_t b0)
 {
-    int b1 = b0 + 1;
+    size_t b1 = b0 + 1;
     while (b1 < nb && blocks[b1].tag == blocks[b0].tag)
         b1++;
     return b1;
 }
 
 /* Unit normal of one surface: element normals summed with a common sign. */
-static int surface_normal(const double *xyz, const gg_block *blocks, int b0,
-                          int b1, int32_t *const *conn, double *nrm)
+static int surface_normal(const double *xyz, const getme__model_block *blocks, size_t b0,
+                          size_t b1, double *nrm)
 {
     double ref[3] = {0, 0, 0}, e[3];
     nrm[0] = nrm[1] = nrm[2] = 0;
-    for (int b = b0; b < b1; b++) {
-        int nv = blocks[b].type == GETME_TRI ? 3 : 4;
+    for (size_t b = b0; b < b1; b++) {
+        int nv = blocks[b].type == 2 ? 3 : 4;
         for (int32_t i = 0; i < blocks[b].count; i++) {
-            element_normal(xyz, conn[b] + (size_t)nv * i, nv, e);
+            element_normal(xyz, blocks[b].conn + (size_t)nv * i, nv, e);
             if (norm3(ref) == 0)
                 memcpy(ref, e, sizeof ref);
             double s = dot3(e, ref) < 0 ? -1.0 : 1.0;
@@ -117,42 +119,46 @@ static int surface_normal(const double *xyz, const gg_block *blocks, int b0,
 }
 
 /* Largest distance of the surface's nodes to the plane (p0, nrm). */
-static double plane_distance(const double *xyz, const gg_block *blocks,
-                             int b0, int b1, int32_t *const *conn,
+static double plane_distance(const double *xyz, const getme__model_block *blocks,
+                             size_t b0, size_t b1,
                              const double *p0, const double *nrm)
 {
     double worst = 0, d[3];
-    for (int b = b0; b < b1; b++) {
-        int nv = blocks[b].type == GETME_TRI ? 3 : 4;
+    for (size_t b = b0; b < b1; b++) {
+        int nv = blocks[b].type == 2 ? 3 : 4;
         for (int64_t i = 0; i < (int64_t)blocks[b].count * nv; i++) {
-            sub3(xyz + 3 * conn[b][i], p0, d);
+            sub3(xyz + 3 * blocks[b].conn[i], p0, d);
             worst = fmax(worst, fabs(dot3(d, nrm)));
         }
     }
     return worst;
 }
 
-static getme_status fit_plane(gg_frame *f, const double *xyz, int32_t n,
-                              const gg_block *blocks, int nb,
-                              int32_t *const *conn, gg_msg *msg)
+static getme_status fit_plane(getme__frame *f, const double *xyz, int32_t n,
+                              const getme__model_block *blocks, size_t nb,
+                              char *msg, size_t size)
 {
     double tol = PLANE_TOL * diagonal(xyz, n), nrm[3], first[3] = {0, 0, 0};
-    const double *p0 = xyz + 3 * conn[0][0];
+    const double *p0 = xyz + 3 * blocks[0].conn[0];
     int first_tag = blocks[0].tag;
-    for (int b0 = 0; b0 < nb; b0 = entity_end(blocks, nb, b0)) {
-        int b1 = entity_end(blocks, nb, b0), tag = blocks[b0].tag;
-        const double *q0 = xyz + 3 * conn[b0][0];
-        if (!surface_normal(xyz, blocks, b0, b1, conn, nrm))
-            return gg_fail(msg, GETME_ERR_INVALID_MESH,
-                           "Surface %d has a degenerate mesh (zero area)",
-                           tag);
-        double d = plane_distance(xyz, blocks, b0, b1, conn, q0, nrm);
-        if (d > tol)
-            return gg_fail(msg, GETME_ERR_TOPOLOGY,
-                           "Surface %d is not planar (a node lies %.3g from "
-                           "its mean plane): only planar surface meshes can "
-                           "be smoothed",
-                           tag, d);
+    for (size_t b0 = 0; b0 < nb; b0 = entity_end(blocks, nb, b0)) {
+        size_t b1 = entity_end(blocks, nb, b0);
+        int tag = blocks[b0].tag;
+        const double *q0 = xyz + 3 * blocks[b0].conn[0];
+        if (!surface_normal(xyz, blocks, b0, b1, nrm)) {
+            snprintf(msg, size,
+                     "Surface %d has a degenerate mesh (zero area)", tag);
+            return GETME_ERR_INVALID_MESH;
+        }
+        double d = plane_distance(xyz, blocks, b0, b1, q0, nrm);
+        if (d > tol) {
+            snprintf(msg, size,
+                     "Surface %d is not planar (a node lies %.3g from its "
+                     "mean plane): only planar surface meshes can be "
+                     "smoothed",
+                     tag, d);
+            return GETME_ERR_TOPOLOGY;
+        }
         if (b0 == 0) {
             memcpy(first, nrm, sizeof first);
             continue;
@@ -160,11 +166,13 @@ static getme_status fit_plane(gg_frame *f, const double *xyz, int32_t n,
         double c[3];
         cross3(first, nrm, c);
         if (norm3(c) > PLANE_TOL * 100 ||
-            plane_distance(xyz, blocks, b0, b1, conn, p0, first) > tol)
-            return gg_fail(msg, GETME_ERR_TOPOLOGY,
-                           "Surfaces %d and %d do not lie in one plane: "
-                           "smooth them in separate calls",
-                           first_tag, tag);
+            plane_distance(xyz, blocks, b0, b1, p0, first) > tol) {
+            snprintf(msg, size,
+                     "Surfaces %d and %d do not lie in one plane: smooth "
+                     "them in separate calls",
+                     first_tag, tag);
+            return GETME_ERR_TOPOLOGY;
+        }
     }
     /* e1: the unit axis most orthogonal to the normal, made orthogonal. */
     double axis[3] = {0, 0, 0}, e1[3], e2[3];
@@ -187,7 +195,7 @@ static getme_status fit_plane(gg_frame *f, const double *xyz, int32_t n,
     return GETME_OK;
 }
 
-static void to_local(const gg_frame *f, double *xyz, int32_t n)
+static void to_local(const getme__frame *f, double *xyz, int32_t n)
 {
     for (int32_t i = 0; i < n; i++) {
         double d[3];
@@ -197,7 +205,7 @@ static void to_local(const gg_frame *f, double *xyz, int32_t n)
     }
 }
 
-void gg_frame_to_global(const gg_frame *f, const double *local,
+void getme__frame_to_global(const getme__frame *f, const double *local,
                         double *global)
 {
     if (!f->rotated) {
@@ -227,38 +235,38 @@ static void reverse_element(int32_t *c, int nv)
     c[nv - 1] = t;
 }
 
-static void orient_surfaces(const double *xyz, const gg_block *blocks, int nb,
-                            int32_t *const *conn)
+static void orient_surfaces(const double *xyz,
+                            const getme__model_block *blocks, size_t nb)
 {
-    for (int b0 = 0; b0 < nb; b0 = entity_end(blocks, nb, b0)) {
-        int b1 = entity_end(blocks, nb, b0);
+    for (size_t b0 = 0; b0 < nb; b0 = entity_end(blocks, nb, b0)) {
+        size_t b1 = entity_end(blocks, nb, b0);
         double total = 0;
-        for (int b = b0; b < b1; b++) {
-            int nv = blocks[b].type == GETME_TRI ? 3 : 4;
+        for (size_t b = b0; b < b1; b++) {
+            int nv = blocks[b].type == 2 ? 3 : 4;
             for (int32_t i = 0; i < blocks[b].count; i++)
-                total += signed_area(xyz, conn[b] + (size_t)nv * i, nv);
+                total += signed_area(xyz, blocks[b].conn + (size_t)nv * i, nv);
         }
         if (total >= 0)
             continue;
-        for (int b = b0; b < b1; b++) {
-            int nv = blocks[b].type == GETME_TRI ? 3 : 4;
+        for (size_t b = b0; b < b1; b++) {
+            int nv = blocks[b].type == 2 ? 3 : 4;
             for (int32_t i = 0; i < blocks[b].count; i++)
-                reverse_element(conn[b] + (size_t)nv * i, nv);
+                reverse_element(blocks[b].conn + (size_t)nv * i, nv);
         }
     }
 }
 
-getme_status gg_planar_prepare(gg_frame *frame, double *xyz, int32_t n,
-                               const gg_block *blocks, int nb,
-                               int32_t *const *conn, gg_msg *msg)
+getme_status getme__planar_prepare(getme__frame *frame, double *xyz,
+                                   int32_t n, getme__model_block *blocks,
+                                   size_t nb, char *msg, size_t size)
 {
     memset(frame, 0, sizeof *frame);
-    if (!all_same_z(xyz, n)) {
-        getme_status st = fit_plane(frame, xyz, n, blocks, nb, conn, msg);
+    if (!getme__all_same_z(xyz, n)) {
+        getme_status st = fit_plane(frame, xyz, n, blocks, nb, msg, size);
         if (st != GETME_OK)
             return st;
         to_local(frame, xyz, n);
     }
-    orient_surfaces(xyz, blocks, nb, conn);
+    orient_surfaces(xyz, blocks, nb);
     return GETME_OK;
 }

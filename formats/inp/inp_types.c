@@ -45,6 +45,28 @@ static int family_count(const char *type, const char *family)
     return count;
 }
 
+/* Abaqus' node order of C3D10, C3D15 and C3D20 mapped to Gmsh's
+   (getme_mesh_add_elements_ho): Gmsh's node k is Abaqus' node order[k]
+   (0-based).  Abaqus: corners, then the mid-edge nodes of the bottom
+   face's edges in turn, the top face's, then the vertical edges (C3D10:
+   1-2, 2-3, 3-1, 1-4, 2-4, 3-4); Gmsh's lists edges by their first
+   corner.  Proved on CalculiX's own decks and meshio's output
+   (tests/highorder/test_highorder_inp.py, docs/highorder.md). */
+static const int8_t order_c3d10[10] = {0, 1, 2, 3, 4, 5, 6, 7, 9, 8};
+static const int8_t order_c3d15[15] = {0, 1, 2, 3, 4,  5,  6, 8,
+                                       12, 7, 13, 14, 9, 11, 10};
+static const int8_t order_c3d20[20] = {0,  1,  2,  3,  4,  5,  6,
+                                       7,  8,  11, 16, 9,  17, 10,
+                                       18, 19, 12, 15, 13, 14};
+
+const int8_t *inp_ho_order(int ho_type)
+{
+    return ho_type == GETME_TET10     ? order_c3d10
+           : ho_type == GETME_PRISM15 ? order_c3d15
+           : ho_type == GETME_HEX20   ? order_c3d20
+                                      : NULL;
+}
+
 inp_kind inp_element_kind(const char *type, int *gtype, int *nv)
 {
     *gtype = -1;
@@ -59,7 +81,11 @@ inp_kind inp_element_kind(const char *type, int *gtype, int *nv)
         case 5: *gtype = GETME_PYRAMID; return INP_KIND_SOLID;
         case 6: *gtype = GETME_PRISM; return INP_KIND_SOLID;
         case 8: *gtype = GETME_HEX; return INP_KIND_SOLID;
-        case 10: case 13: case 15: case 20: case 27: return INP_KIND_SOLID2;
+        /* second order, smoothed with their corners (docs/highorder.md) */
+        case 10: *gtype = INP_HO + GETME_TET10; return INP_KIND_SOLID;
+        case 15: *gtype = INP_HO + GETME_PRISM15; return INP_KIND_SOLID;
+        case 20: *gtype = INP_HO + GETME_HEX20; return INP_KIND_SOLID;
+        case 13: case 27: return INP_KIND_SOLID2;
         default: *nv = 0; return INP_KIND_OTHER;
         }
     }

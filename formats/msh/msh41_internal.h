@@ -1,13 +1,14 @@
 /*
  * msh41_internal.h -- the native MSH 4.1 path of the MSH adapter (private).
  *
- * msh_format.c tries this path first for MSH 4.1 and 2.2 files: it reads the file
- * in one streaming pass without creating a Gmsh model (msh41_reader.c,
- * msh41_build.c), and writes by copying the input with new coordinates in
- * $Nodes (msh41_writer.c).  Files it does not handle (parametric nodes,
+ * msh_format.c reads MSH 4.1 and 2.2 files in one streaming pass without
+ * a Gmsh model (msh41_reader.c, then msh41_build.c hands them to the model
+ * builder of formats/model), and writes by copying the input with new
+ * coordinates in $Nodes (msh41_writer.c).  Files it does not handle (parametric nodes,
  * partitioned meshes, big-endian binary, element types it does not know,
  * planar meshes outside a plane z = const...) are declined as "not
- * eligible" and go through Gmsh's reader instead.
+ * eligible" and go to the next adapter: Gmsh's reader through the Gmsh
+ * plugin (plugin/src/gmsh_format.c) when the application registered it.
  *
  * msh41_input is the buffered byte reader both sides share: ASCII tokens
  * with line counting, binary records, and an optional echo that copies
@@ -17,7 +18,8 @@
 #ifndef GETME_MSH41_INTERNAL_H
 #define GETME_MSH41_INTERNAL_H
 
-#include "getme_formats.h"
+#include "adapter.h"
+#include "model.h"
 
 #include <stddef.h>
 #include <stdint.h>
@@ -59,27 +61,25 @@ void msh41_in_skip_space(msh41_input *in);
 /* Start / stop copying consumed bytes to out (NULL stops). */
 void msh41_in_echo(msh41_input *in, FILE *out);
 
-/* ---- element types (msh41_reader.c) ------------------------------------- */
+/* ---- element types and node tags: the shared model code (formats/model) */
 
-/* Nodes per element of an MSH element type, 0 if this reader does not know
-   the type; *order gets its polynomial order (0 for points). */
-int msh41_type_nodes(int msh_type, int *order);
-/* "tetrahedron", "10-node tetrahedron"... as the Gmsh path words them. */
-void msh41_type_name(int msh_type, char *buf, size_t size);
+static inline int msh41_type_nodes(int msh_type, int *order)
+{
+    return getme__msh_type_nodes(msh_type, order);
+}
 
-/* ---- node tag -> mesh node index ---------------------------------------- */
-
-typedef struct msh41_nodemap {
-    uint64_t max_tag;
-    int32_t *dense;       /* max_tag + 1 entries (-1: absent), or NULL   */
-    uint64_t *sorted_tag; /* sparse numbering: sorted tags...            */
-    int32_t *sorted_idx;  /* ... and their indices                       */
-    size_t n;
-} msh41_nodemap;
+typedef getme__nodemap msh41_nodemap;
 
 /* Index of tag, -1 if absent. */
-int32_t msh41_map_find(const msh41_nodemap *map, uint64_t tag);
-void msh41_map_free(msh41_nodemap *map);
+static inline int32_t msh41_map_find(const msh41_nodemap *map, uint64_t tag)
+{
+    return getme__nodemap_find(map, tag);
+}
+
+static inline void msh41_map_free(msh41_nodemap *map)
+{
+    getme__nodemap_free(map);
+}
 
 /* ---- what stays open between reading and writing ------------------------ */
 
@@ -128,15 +128,12 @@ typedef struct msh41_nblock { /* one $Nodes entity block (file order) */
     size_t first, count;
 } msh41_nblock;
 
-typedef struct msh41_eblock { /* one $Elements block of the top dimension */
-    int tag, type;            /* entity tag, MSH element type */
-    int32_t count;
-    int32_t *conn;            /* node indices (file order, later mesh);
-                                 NULL for a type GETMe cannot smooth */
-    int64_t *ids;             /* element tags */
-} msh41_eblock;
+/* One $Elements block of the top dimension: entity tag, MSH type, count,
+   node indices (file order, later mesh; NULL for a type GETMe cannot
+   smooth), element tags -- the model builder's block. */
+typedef getme__model_block msh41_eblock;
 
-enum { MSH41_USED = 1, MSH41_FIXGRP = 2 }; /* msh41_reader.flag bits */
+enum { MSH41_FIXGRP = GETME__NODE_FIXGRP }; /* msh41_reader.flag bit */
 
 typedef struct msh41_reader {
     getme_doc *doc;

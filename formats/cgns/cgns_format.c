@@ -1,5 +1,5 @@
 /*
- * cgns_format.c -- the CGNS adapter (getme_format_cgns): unstructured zones
+ * cgns_format.c -- the CGNS adapter (getme__format_cgns): unstructured zones
  * of ADF and HDF5 CGNS files, read through libcgns (Debian libcgns-dev 3.4),
  * written back by overwriting only the coordinate arrays of a byte copy.
  * See docs/cgns.md for what is read, what is fixed and what is refused.
@@ -185,7 +185,7 @@ static void cgns_close(getme_doc *doc)
     doc->impl = NULL;
 }
 
-const getme_format getme_format_cgns = {
+const getme_format getme__format_cgns = {
     "cgns",
     "CGNS (ADF and HDF5; unstructured zones, via libcgns)",
     cgns_probe,

@@ -17,7 +17,7 @@
 #ifndef GETME_INP_INTERNAL_H
 #define GETME_INP_INTERNAL_H
 
-#include "getme_formats.h"
+#include "adapter.h"
 
 #include <stddef.h>
 #include <stdint.h>
@@ -121,6 +121,10 @@ typedef enum inp_kind {
 /* Classify an upper-case Abaqus element type name; *gtype and *nv get the
    getme type and node count for the known kinds (nv 0 = any). */
 inp_kind inp_element_kind(const char *type, int *gtype, int *nv);
+/* gtype of second-order solids: INP_HO + getme_ho_type (C3D10, C3D15,
+   C3D20 and their variants); their node order in Gmsh's from Abaqus'. */
+#define INP_HO 100
+const int8_t *inp_ho_order(int ho_type);
 
 /* ---- hash tables (inp_hash.c) ------------------------------------------- */
 

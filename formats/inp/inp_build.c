@@ -577,6 +577,24 @@ static getme_io_status fix_nodes(builder *b, const getme_doc_options *opts,
 
 /* ---- the mesh --------------------------------------------------------------- */
 
+/* Second-order elements in Abaqus' node order, to the core in Gmsh's. */
+static getme_status inp_add_ho(getme_mesh *mesh, getme_ho_type type,
+                               int32_t count, const int32_t *conn,
+                               const int32_t *region)
+{
+    int nv = getme_ho_type_num_nodes(type);
+    const int8_t *order = inp_ho_order(type);
+    int32_t *g = malloc(((size_t)count * nv + 1) * sizeof *g);
+    if (!g)
+        return GETME_ERR_NOMEM;
+    for (int32_t e = 0; e < count; e++)
+        for (int k = 0; k < nv; k++)
+            g[(size_t)e * nv + k] = conn[(size_t)e * nv + order[k]];
+    getme_status st = getme_mesh_add_elements_ho(mesh, type, count, g, region);
+    free(g);
+    return st;
+}
+
 static getme_io_status add_blocks(builder *b, getme_mesh *mesh)
 {
     inp_deck *d = b->d;
@@ -588,7 +606,9 @@ static getme_io_status add_blocks(builder *b, getme_mesh *mesh)
         const inp_elem_block *eb = &d->eblocks[k];
         if (eb->kind != b->smooth || eb->count == 0)
             continue;
-        int nv = getme_type_num_nodes((getme_elem_type)eb->gtype);
+        int ho = eb->gtype >= INP_HO ? eb->gtype - INP_HO : -1;
+        int nv = ho >= 0 ? getme_ho_type_num_nodes((getme_ho_type)ho)
+                         : getme_type_num_nodes((getme_elem_type)eb->gtype);
         for (int32_t e = 0; e < eb->count && !st; e++) {
             const int32_t *c = d->conn + eb->conn_beg + (size_t)e * nv;
             for (int i = 1; i < nv && !st; i++)
@@ -607,9 +627,12 @@ static getme_io_status add_blocks(builder *b, getme_mesh *mesh)
         }
         if (st)
             break;
-        getme_status gs = getme_mesh_add_elements(
-            mesh, (getme_elem_type)eb->gtype, eb->count, d->conn + eb->conn_beg,
-            region + b->sfirst[k]);
+        getme_status gs =
+            ho >= 0 ? inp_add_ho(mesh, (getme_ho_type)ho, eb->count,
+                                 d->conn + eb->conn_beg, region + b->sfirst[k])
+                    : getme_mesh_add_elements(mesh, (getme_elem_type)eb->gtype,
+                                              eb->count, d->conn + eb->conn_beg,
+                                              region + b->sfirst[k]);
         if (gs != GETME_OK) {
             char w[600];
             st = getme_doc_fail(b->doc, gs == GETME_ERR_NOMEM

@@ -46,6 +46,19 @@ int cgns_getme_type(cgns_elem_t type)
     }
 }
 
+/* getme_elem_type, CGNS_HO + getme_ho_type (second order), or -1. */
+static int smooth_kind(cgns_elem_t type)
+{
+    int ho = cgns_ho_type(type);
+    return ho >= 0 ? CGNS_HO + ho : cgns_getme_type(type);
+}
+
+static int kind_nodes(int kind)
+{
+    return kind >= CGNS_HO ? getme_ho_type_num_nodes((getme_ho_type)(kind - CGNS_HO))
+                           : getme_type_num_nodes((getme_elem_type)kind);
+}
+
 static int is_poly(cgns_elem_t type)
 {
     return type == CGNS_ENUMV(MIXED) || type == CGNS_ENUMV(NGON_n) ||
@@ -253,8 +266,9 @@ static getme_io_status refuse(const zone_ctx *c, const cgns_section *sec,
         ? "elements of a higher dimension than the base's cell dimension"
         : (t == CGNS_ENUMV(NGON_n) || t == CGNS_ENUMV(NFACE_n))
             ? "polygonal/polyhedral elements are not smoothed"
-            : "only linear TETRA_4, PYRA_5, PENTA_6, HEXA_8 (3-D) and TRI_3, "
-              "QUAD_4 (2-D) elements are smoothed";
+            : "only TETRA_4, PYRA_5, PENTA_6, HEXA_8, TETRA_10, HEXA_20, "
+              "HEXA_27, PENTA_15, PENTA_18 (3-D) and TRI_3, QUAD_4 (2-D) "
+              "elements are smoothed";
     return getme_doc_fail(c->doc, GETME_IO_ERR_UNSUPPORTED,
                           "%s: %s/%s: element %ld is %s: %s", c->doc->path,
                           c->path, sec->name, (long)number,
@@ -327,7 +341,7 @@ static getme_io_status add_block(const zone_ctx *c, const cgns_section *sec,
                                  const cgsize_t *numbers)
 {
     cgns_impl *impl = c->impl;
-    int nv = getme_type_num_nodes((getme_elem_type)type);
+    int nv = kind_nodes(type);
     int32_t off = impl->zones[c->z].node_offset;
     int32_t first = getme_mesh_num_elements(c->doc->mesh);
     int region = region_id(c, &sec->fams);
@@ -357,13 +371,28 @@ static getme_io_status add_block(const zone_ctx *c, const cgns_section *sec,
     }
     for (size_t k = 0; k < (size_t)count * (size_t)nv; k++)
         conn[k] += off - 1;
-    if (getme_mesh_add_elements(c->doc->mesh, (getme_elem_type)type, count,
-                                conn, regions) != GETME_OK)
+    getme_status gs =
+        type >= CGNS_HO
+            ? getme_mesh_add_elements_ho(c->doc->mesh,
+                                         (getme_ho_type)(type - CGNS_HO),
+                                         count, conn, regions)
+            : getme_mesh_add_elements(c->doc->mesh, (getme_elem_type)type,
+                                      count, conn, regions);
+    if (gs != GETME_OK)
         st = getme_doc_fail(c->doc, GETME_IO_ERR_PARSE, "%s: %s/%s: %s",
                             c->doc->path, c->path, sec->name,
                             getme_mesh_error(c->doc->mesh));
     free(regions);
-    if (st == GETME_IO_OK && impl->zones[c->z].single)
+    if (st == GETME_IO_OK && impl->zones[c->z].single && type >= CGNS_HO) {
+        /* the float rounding repair checks the corners only (README) */
+        int lin = getme_ho_type_linear((getme_ho_type)(type - CGNS_HO));
+        int nl = getme_type_num_nodes((getme_elem_type)lin);
+        for (int32_t i = 0; i < count; i++) /* in place: nl <= nv */
+            for (int a = 0; a < nl; a++)
+                conn[(size_t)i * nl + a] = conn[(size_t)i * nv + a];
+        st = keep_conn(c, lin, count, conn,
+                       first - impl->zones[c->z].first_elem);
+    } else if (st == GETME_IO_OK && impl->zones[c->z].single)
         st = keep_conn(c, type, count, conn,
                        first - impl->zones[c->z].first_elem);
     if (st != GETME_IO_OK)
@@ -388,7 +417,9 @@ static getme_io_status add_block(const zone_ctx *c, const cgns_section *sec,
 static getme_io_status add_type(const zone_ctx *c, const cgns_section *sec,
                                 int type, int32_t count)
 {
-    int nv = getme_type_num_nodes((getme_elem_type)type);
+    int nv = kind_nodes(type);
+    const int8_t *order =
+        type >= CGNS_HO ? cgns_ho_order(type - CGNS_HO) : NULL;
     int32_t *conn = malloc((size_t)count * (size_t)nv * sizeof *conn);
     cgsize_t *numbers = malloc((size_t)count * sizeof *numbers);
     cgsize_t n = sec->end - sec->start + 1;
@@ -405,10 +436,11 @@ static getme_io_status add_type(const zone_ctx *c, const cgns_section *sec,
         const cgsize_t *nodes;
         int cnt;
         element_at(sec, i, &t, &nodes, &cnt);
-        if (cgns_getme_type(t) != type)
+        if (smooth_kind(t) != type)
             continue;
         for (int a = 0; a < nv; a++)
-            conn[(size_t)k * (size_t)nv + (size_t)a] = (int32_t)nodes[a];
+            conn[(size_t)k * (size_t)nv + (size_t)a] =
+                (int32_t)nodes[order ? order[a] : a];
         numbers[k++] = sec->start + i;
     }
     st = add_block(c, sec, type, count, conn, numbers);
@@ -421,7 +453,7 @@ static getme_io_status add_type(const zone_ctx *c, const cgns_section *sec,
    dimensional ones fix their nodes, anything else is refused. */
 static getme_io_status use_section(const zone_ctx *c, const cgns_section *sec)
 {
-    int32_t counts[GETME_NUM_TYPES] = {0};
+    int32_t counts[CGNS_HO + GETME_NUM_HO_TYPES] = {0};
     cgsize_t n = sec->end - sec->start + 1;
     int fix_boundary = cgns_default_fixed(sec->name, &sec->fams, c->opts);
     int fix_all = cgns_named(sec->name, &sec->fams, c->opts->num_fix,
@@ -433,7 +465,7 @@ static getme_io_status use_section(const zone_ctx *c, const cgns_section *sec)
         const cgsize_t *nodes;
         int cnt;
         element_at(sec, i, &t, &nodes, &cnt);
-        int d = cgns_type_dim(t), g = cgns_getme_type(t);
+        int d = cgns_type_dim(t), g = smooth_kind(t);
         if (d >= 0 && d < c->impl->dim) {
             boundary = 1;
             if (fix_boundary)
@@ -448,7 +480,7 @@ static getme_io_status use_section(const zone_ctx *c, const cgns_section *sec)
     }
     if (boundary && fix_boundary)
         c->impl->num_bnd_sections++;
-    for (int g = 0; g < GETME_NUM_TYPES; g++) {
+    for (int g = 0; g < CGNS_HO + GETME_NUM_HO_TYPES; g++) {
         if (counts[g] == 0)
             continue;
         getme_io_status st = add_type(c, sec, g, counts[g]);

@@ -24,63 +24,6 @@
 
 #define TOK 128
 
-/* ---- element types ------------------------------------------------------ */
-
-typedef struct type_info {
-    int type, nodes, order;
-    const char *family;
-} type_info;
-
-/* The MSH types Gmsh writes for meshes up to order 5 (Gmsh's
-   getElementProperties: family, order, nodes).  Other types make the
-   reader decline the file, so Gmsh's reader deals with them. */
-static const type_info TYPES[] = {
-    {1, 2, 1, "line"},           {2, 3, 1, "triangle"},
-    {3, 4, 1, "quadrilateral"},  {4, 4, 1, "tetrahedron"},
-    {5, 8, 1, "hexahedron"},     {6, 6, 1, "prism"},
-    {7, 5, 1, "pyramid"},        {8, 3, 2, "line"},
-    {9, 6, 2, "triangle"},       {10, 9, 2, "quadrilateral"},
-    {11, 10, 2, "tetrahedron"},  {12, 27, 2, "hexahedron"},
-    {13, 18, 2, "prism"},        {14, 14, 2, "pyramid"},
-    {15, 1, 0, "point"},         {16, 8, 2, "quadrilateral"},
-    {17, 20, 2, "hexahedron"},   {18, 15, 2, "prism"},
-    {19, 13, 2, "pyramid"},      {20, 9, 3, "triangle"},
-    {21, 10, 3, "triangle"},     {22, 12, 4, "triangle"},
-    {23, 15, 4, "triangle"},     {24, 15, 5, "triangle"},
-    {25, 21, 5, "triangle"},     {26, 4, 3, "line"},
-    {27, 5, 4, "line"},          {28, 6, 5, "line"},
-    {29, 20, 3, "tetrahedron"},  {30, 35, 4, "tetrahedron"},
-    {31, 56, 5, "tetrahedron"},  {92, 64, 3, "hexahedron"},
-    {93, 125, 4, "hexahedron"},
-};
-
-static const type_info *find_type(int msh_type)
-{
-    for (size_t i = 0; i < sizeof TYPES / sizeof *TYPES; i++)
-        if (TYPES[i].type == msh_type)
-            return &TYPES[i];
-    return NULL;
-}
-
-int msh41_type_nodes(int msh_type, int *order)
-{
-    const type_info *t = find_type(msh_type);
-    if (order)
-        *order = t ? t->order : 0;
-    return t ? t->nodes : 0;
-}
-
-void msh41_type_name(int msh_type, char *buf, size_t size)
-{
-    const type_info *t = find_type(msh_type);
-    if (!t)
-        snprintf(buf, size, "element type %d", msh_type);
-    else if (t->order > 1)
-        snprintf(buf, size, "%d-node %s", t->nodes, t->family);
-    else
-        snprintf(buf, size, "%s", t->family);
-}
-
 /* ---- messages ----------------------------------------------------------- */
 
 getme_io_status msh41_fail(msh41_reader *r, getme_io_status st,
@@ -715,7 +658,7 @@ static getme_io_status new_eblock(msh41_reader *r, int dim, int tag,
     msh41_type_nodes(type, &order);
     int linear = order == 1 && ((dim == 3 && type >= 4 && type <= 7) ||
                                 (dim == 2 && (type == 2 || type == 3)));
-    if (linear) {
+    if (linear || getme__msh_type_ho(type, dim) >= 0) {
         b->conn = malloc((size_t)count * (size_t)nv * sizeof *b->conn);
         b->ids = malloc((size_t)count * sizeof *b->ids);
         if (!b->conn || !b->ids)
@@ -945,15 +888,7 @@ static getme_io_status read_nodes22(msh41_reader *r)
     return st;
 }
 
-static int type_dim(int msh_type)
-{
-    const type_info *t = find_type(msh_type);
-    if (!t)
-        return -1;
-    const char *f = t->family;
-    return !strcmp(f, "point") ? 0 : !strcmp(f, "line") ? 1
-           : !strcmp(f, "triangle") || !strcmp(f, "quadrilateral") ? 2 : 3;
-}
+static int type_dim(int msh_type) { return getme__msh_type_dim(msh_type); }
 
 /* Does (dim, physical) belong to a group a --fix (or --free) word names?
    Counts the matches per word for check_fix_names. */

@@ -1,0 +1,96 @@
+/*
+ * highorder.h -- second-order elements (docs/highorder.md): the mesh's
+ * record of them, the reference elements, and the workspace view in which
+ * the smoother sees linear elements and the other nodes are dependent.
+ */
+#ifndef GETME_HIGHORDER_H
+#define GETME_HIGHORDER_H
+
+#include "internal.h"
+
+#define GETME_HO_MAX_NV 27
+
+/* ---- the mesh's record (highorder.c) ------------------------------------ */
+
+typedef struct getme_ho_block {
+    int type;        /* getme_ho_type                                      */
+    int32_t first;   /* global index of its first element                  */
+    int32_t count;
+    int32_t *conn;   /* count * nv, Gmsh order                             */
+} getme_ho_block;
+
+typedef struct getme_ho_mesh {
+    getme_ho_block *blocks;
+    int num_blocks, cap_blocks;
+    int32_t num_elements;
+} getme_ho_mesh;
+
+void getme__ho_mesh_free(getme_ho_mesh *ho);
+
+/* ---- reference elements (highorder_basis.c) ----------------------------- */
+
+typedef struct getme_ho_info {
+    int nv;       /* all nodes                                             */
+    int nlin;     /* corners                                               */
+    int lin;      /* linear getme_elem_type                                */
+    int dim;      /* 2 or 3                                                */
+    /* corners of the edge (2), quad face (4) or body (8) of each
+       dependent node k >= nlin, local indices; ncorner[k] is 2, 4 or 8 */
+    int8_t ncorner[GETME_HO_MAX_NV];
+    int8_t corner[GETME_HO_MAX_NV][8];
+    /* dn[k][j][d]: derivative along reference axis d of shape function j at
+       node k (Gmsh's reference element and polynomial space)             */
+    double dn[GETME_HO_MAX_NV][GETME_HO_MAX_NV][3];
+} getme_ho_info;
+
+extern const int getme__ho_nv[GETME_NUM_HO_TYPES];
+extern const int getme__ho_lin[GETME_NUM_HO_TYPES];
+
+/* Fill info for type: solves the Vandermonde system of the type's
+   polynomial space on its reference nodes.  0, or -1 if singular (a bug in
+   the tables). */
+int getme__ho_info_init(int type, getme_ho_info *info);
+
+/* Smallest and largest Jacobian determinant over the nodes of one element
+   with all nv nodes at x (nv triples). */
+void getme__ho_det_range(const getme_ho_info *info, const double *x,
+                         double *dmin, double *dmax);
+
+/* ---- the workspace view (highorder_ws.c) -------------------------------- */
+
+struct getme_ws;
+
+typedef struct getme_ho_ws {
+    int32_t nh;       /* dependent nodes                                   */
+    int32_t *node;    /* nh: its internal node index                       */
+    uint8_t *nc;      /* nh: 2 edge, 4 face, 8 body                        */
+    uint8_t *pinned;  /* nh: never moves                                   */
+    uint8_t *straight;/* nh: exactly at its straight position initially   */
+    int32_t *cn;      /* 8 * nh: corners, internal indices, canonical order */
+    double *ref;      /* 3 * nh: the offset in the entity's frame          */
+    double *x0;       /* 3 * nn: workspace coordinates at the start        */
+    int8_t *etype;    /* ne: getme_ho_type of internal element, or -1 (also
+                         for a tet10/tri6 that stays affine: see attach)   */
+    int64_t *eptr;    /* ne + 1: into eho                                  */
+    int32_t *eho;     /* dependent node index of each slot k >= nlin       */
+    getme_ho_info *info; /* GETME_NUM_HO_TYPES, filled for types present   */
+} getme_ho_ws;
+
+/* Attach the mesh's second-order elements to a freshly built workspace
+   (ws->ho stays NULL if there are none): getme_smooth, getme_mesh_untangle
+   and getme_mesh_distort do; the workspaces built only for faces
+   (fix_boundary, topology) need not.  GETME_OK, GETME_ERR_NOMEM, or
+   GETME_ERR_TOPOLOGY with the message on the mesh. */
+getme_status getme__ho_attach(struct getme_ws *ws, getme_mesh *mesh);
+void getme__ho_free(getme_ho_ws *ho);
+
+/* 1 if internal element e is valid at all its nodes with corners at
+   coords (dependent nodes placed from them); 1 for linear elements. */
+int getme__ho_valid(const struct getme_ws *ws, const double *coords,
+                    int32_t e);
+
+/* Write the dependent nodes placed from ws->x into the mesh (pinned ones
+   are not written). */
+void getme__ho_store(const struct getme_ws *ws, getme_mesh *mesh);
+
+#endif /* GETME_HIGHORDER_H */

@@ -1,0 +1,269 @@
+/*
+ * highorder_basis.c -- the second-order reference elements: node positions
+ * in Gmsh's order (docs/highorder.md lists them; tests/msh compares them
+ * with gmsh.model.mesh.getElementProperties), each type's polynomial space,
+ * and from these the shape function derivatives at the nodes.
+ *
+ * The shape functions are not written out by hand: for a space of
+ * monomials m_0..m_{n-1} and reference nodes xi_0..xi_{n-1}, the functions
+ * N_j with N_j(xi_k) = delta_jk have coefficients C = V^-1 with
+ * V[k][m] = m_m(xi_k).  So each type needs only facts (node positions and
+ * the space: P2 for tets and triangles, serendipity for hex20 and quad8,
+ * Q2 for hex27 and quad9, P2 x {1, z} plus z^2 {1, x, y} for prism15,
+ * P2 x Q2 for prism18), and a wrong table shows as a singular V.
+ */
+#include "highorder.h"
+
+#include <math.h>
+#include <string.h>
+
+const int getme__ho_nv[GETME_NUM_HO_TYPES] = {10, 20, 27, 15, 18, 6, 8, 9};
+const int getme__ho_lin[GETME_NUM_HO_TYPES] = {
+    GETME_TET, GETME_HEX, GETME_HEX, GETME_PRISM, GETME_PRISM,
+    GETME_TRI, GETME_QUAD, GETME_QUAD};
+
+/* Reference nodes, Gmsh's order (getElementProperties of MSH types 11, 17,
+   12, 18, 13, 9, 16, 10). */
+static const double ref_tet10[10][3] = {
+    {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {.5, 0, 0},
+    {.5, .5, 0}, {0, .5, 0}, {0, 0, .5}, {0, .5, .5}, {.5, 0, .5}};
+static const double ref_hex27[27][3] = {
+    {-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
+    {-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1},
+    {0, -1, -1}, {-1, 0, -1}, {-1, -1, 0}, {1, 0, -1},
+    {1, -1, 0}, {0, 1, -1}, {1, 1, 0}, {-1, 1, 0},
+    {0, -1, 1}, {-1, 0, 1}, {1, 0, 1}, {0, 1, 1},
+    {0, 0, -1}, {0, -1, 0}, {-1, 0, 0}, {1, 0, 0},
+    {0, 1, 0}, {0, 0, 1}, {0, 0, 0}};
+static const double ref_prism18[18][3] = {
+    {0, 0, -1}, {1, 0, -1}, {0, 1, -1}, {0, 0, 1}, {1, 0, 1}, {0, 1, 1},
+    {.5, 0, -1}, {0, .5, -1}, {0, 0, 0}, {.5, .5, -1}, {1, 0, 0},
+    {0, 1, 0}, {.5, 0, 1}, {0, .5, 1}, {.5, .5, 1},
+    {.5, 0, 0}, {0, .5, 0}, {.5, .5, 0}};
+static const double ref_tri6[6][3] = {
+    {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {.5, 0, 0}, {.5, .5, 0}, {0, .5, 0}};
+static const double ref_quad9[9][3] = {
+    {-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0},
+    {0, -1, 0}, {1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, 0, 0}};
+
+/* hex20, prism15 and quad8 are the first nodes of hex27, prism18, quad9. */
+static const double (*ref_nodes(int type))[3]
+{
+    switch (type) {
+    case GETME_TET10: return ref_tet10;
+    case GETME_HEX20: case GETME_HEX27: return ref_hex27;
+    case GETME_PRISM15: case GETME_PRISM18: return ref_prism18;
+    case GETME_TRI6: return ref_tri6;
+    default: return ref_quad9;
+    }
+}
+
+/* Exponents (x, y, z) of the monomials of each type's space. */
+typedef struct { int8_t e[27][3]; } space;
+
+static int fill_space(int type, space *s)
+{
+    int n = 0;
+    switch (type) {
+    case GETME_TET10: case GETME_TRI6: {
+        int dim = type == GETME_TET10 ? 3 : 2;
+        for (int a = 0; a <= 2; a++)
+            for (int b = 0; a + b <= 2; b++)
+                for (int c = 0; a + b + c <= 2 && (dim == 3 || c == 0); c++) {
+                    s->e[n][0] = (int8_t)a, s->e[n][1] = (int8_t)b;
+                    s->e[n++][2] = (int8_t)c;
+                }
+        return n;
+    }
+    case GETME_HEX27: case GETME_QUAD9: case GETME_HEX20: case GETME_QUAD8: {
+        int three = type == GETME_HEX27 || type == GETME_HEX20;
+        int serendipity = type == GETME_HEX20 || type == GETME_QUAD8;
+        for (int a = 0; a <= 2; a++)
+            for (int b = 0; b <= 2; b++)
+                for (int c = 0; c <= (three ? 2 : 0); c++) {
+                    /* serendipity: a square may appear only next to
+                       linear factors: (a==2)+(b==2)+(c==2) <= 1 and the
+                       total "superlinear degree" as in Q1 + squares */
+                    if (serendipity && ((a == 2) + (b == 2) + (c == 2) > 1))
+                        continue;
+                    s->e[n][0] = (int8_t)a, s->e[n][1] = (int8_t)b;
+                    s->e[n++][2] = (int8_t)c;
+                }
+        return n;
+    }
+    default: { /* prisms: P2(x, y) times powers of z */
+        for (int a = 0; a <= 2; a++)
+            for (int b = 0; a + b <= 2; b++)
+                for (int c = 0; c <= 2; c++) {
+                    if (type == GETME_PRISM15 && c == 2 && a + b > 1)
+                        continue;
+                    s->e[n][0] = (int8_t)a, s->e[n][1] = (int8_t)b;
+                    s->e[n++][2] = (int8_t)c;
+                }
+        return n;
+    }
+    }
+}
+
+static double ipow(double x, int k)
+{
+    return k == 0 ? 1.0 : k == 1 ? x : x * x;
+}
+
+/* Value, or derivative along axis d (d >= 0), of monomial e at p. */
+static double mono(const int8_t e[3], const double p[3], int d)
+{
+    double v = 1.0;
+    for (int a = 0; a < 3; a++) {
+        if (a == d) {
+            if (e[a] == 0)
+                return 0.0;
+            v *= e[a] * ipow(p[a], e[a] - 1);
+        } else {
+            v *= ipow(p[a], e[a]);
+        }
+    }
+    return v;
+}
+
+/* Invert the n x n matrix a (row-major, GETME_HO_MAX_NV stride) into inv by
+   Gauss-Jordan elimination with partial pivoting; -1 if singular. */
+static int invert(int n, double a[][GETME_HO_MAX_NV],
+                  double inv[][GETME_HO_MAX_NV])
+{
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++)
+            inv[i][j] = i == j;
+    for (int c = 0; c < n; c++) {
+        int p = c;
+        for (int r = c + 1; r < n; r++)
+            if (fabs(a[r][c]) > fabs(a[p][c]))
+                p = r;
+        if (fabs(a[p][c]) < 1e-12)
+            return -1;
+        for (int j = 0; j < n; j++) {
+            double t = a[c][j]; a[c][j] = a[p][j]; a[p][j] = t;
+            t = inv[c][j]; inv[c][j] = inv[p][j]; inv[p][j] = t;
+        }
+        double s = 1.0 / a[c][c];
+        for (int j = 0; j < n; j++)
+            a[c][j] *= s, inv[c][j] *= s;
+        for (int r = 0; r < n; r++) {
+            if (r == c || a[r][c] == 0.0)
+                continue;
+            double f = a[r][c];
+            for (int j = 0; j < n; j++)
+                a[r][j] -= f * a[c][j], inv[r][j] -= f * inv[c][j];
+        }
+    }
+    return 0;
+}
+
+static int same_point(const double *a, const double *b)
+{
+    return fabs(a[0] - b[0]) < 1e-12 && fabs(a[1] - b[1]) < 1e-12 &&
+           fabs(a[2] - b[2]) < 1e-12;
+}
+
+/* Which corners a dependent node belongs to: the edge whose reference
+   midpoint it is, else the quad face whose centre it is, else (hex27's
+   last node) the body. */
+static int find_entity(getme_ho_info *info, const double (*ref)[3],
+                       int k)
+{
+    int lin = info->lin;
+    const getme_edge_table *et = &getme__edges[lin];
+    for (int i = 0; i < et->num_edges; i++) {
+        const double *a = ref[et->node[i][0]], *b = ref[et->node[i][1]];
+        double m[3] = {0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]),
+                       0.5 * (a[2] + b[2])};
+        if (same_point(m, ref[k])) {
+            info->ncorner[k] = 2;
+            info->corner[k][0] = et->node[i][0];
+            info->corner[k][1] = et->node[i][1];
+            return 0;
+        }
+    }
+    const getme_face_table *ft = &getme__faces[lin];
+    for (int f = 0; f < ft->num_faces && info->dim == 3; f++) {
+        if (ft->size[f] != 4)
+            continue;
+        double m[3] = {0, 0, 0};
+        for (int i = 0; i < 4; i++)
+            for (int d = 0; d < 3; d++)
+                m[d] += 0.25 * ref[ft->node[f][i]][d];
+        if (same_point(m, ref[k])) {
+            info->ncorner[k] = 4;
+            for (int i = 0; i < 4; i++)
+                info->corner[k][i] = ft->node[f][i];
+            return 0;
+        }
+    }
+    /* the centre of the whole element: quad9's 9th node (a face in the
+       plane) or hex27's 27th */
+    info->ncorner[k] = (int8_t)info->nlin;
+    for (int i = 0; i < info->nlin; i++)
+        info->corner[k][i] = (int8_t)i;
+    return info->nlin == 4 || info->nlin == 8 ? 0 : -1;
+}
+
+int getme__ho_info_init(int type, getme_ho_info *info)
+{
+    _Static_assert(GETME_NUM_HO_TYPES == 8, "tables cover every type");
+    memset(info, 0, sizeof *info);
+    info->nv = getme__ho_nv[type];
+    info->lin = getme__ho_lin[type];
+    info->nlin = getme__nv[info->lin];
+    info->dim = getme_type_dim((getme_elem_type)info->lin);
+    const double (*ref)[3] = ref_nodes(type);
+    space s;
+    int n = fill_space(type, &s);
+    if (n != info->nv)
+        return -1;
+    double v[GETME_HO_MAX_NV][GETME_HO_MAX_NV], c[GETME_HO_MAX_NV][GETME_HO_MAX_NV];
+    for (int k = 0; k < n; k++)
+        for (int m = 0; m < n; m++)
+            v[k][m] = mono(s.e[m], ref[k], -1);
+    if (invert(n, v, c))
+        return -1;
+    /* N_j = sum_m c[m][j] m_m, so dN_j/dd at node k = sum_m c[m][j] dm_m */
+    for (int k = 0; k < n; k++)
+        for (int j = 0; j < n; j++)
+            for (int d = 0; d < 3; d++) {
+                double sum = 0.0;
+                for (int m = 0; m < n; m++)
+                    sum += c[m][j] * mono(s.e[m], ref[k], d);
+                info->dn[k][j][d] = sum;
+            }
+    for (int k = info->nlin; k < n; k++)
+        if (find_entity(info, ref, k))
+            return -1;
+    return 0;
+}
+
+void getme__ho_det_range(const getme_ho_info *info, const double *x,
+                         double *dmin, double *dmax)
+{
+    double lo = INFINITY, hi = -INFINITY;
+    for (int k = 0; k < info->nv; k++) {
+        double j[3][3] = {{0}};
+        for (int n = 0; n < info->nv; n++) {
+            const double *g = info->dn[k][n];
+            const double *p = x + 3 * n;
+            for (int a = 0; a < 3; a++)
+                for (int d = 0; d < 3; d++)
+                    j[a][d] += p[a] * g[d];
+        }
+        double det = info->dim == 2
+                         ? j[0][0] * j[1][1] - j[0][1] * j[1][0]
+                         : j[0][0] * (j[1][1] * j[2][2] - j[1][2] * j[2][1]) -
+                               j[0][1] * (j[1][0] * j[2][2] - j[1][2] * j[2][0]) +
+                               j[0][2] * (j[1][0] * j[2][1] - j[1][1] * j[2][0]);
+        if (!(det == det))
+            det = -INFINITY;
+        lo = det < lo ? det : lo;
+        hi = det > hi ? det : hi;
+    }
+    *dmin = lo;
+    *dmax = hi;
+}

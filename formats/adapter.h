@@ -1,0 +1,45 @@
+/*
+ * adapter.h -- the built-in adapters' view of a document (private to
+ * libgetme_formats): the fields of getme_doc, the adapters of doc.c, and
+ * the short status names the adapters use.
+ */
+#ifndef GETME_FORMATS_PRIVATE_ADAPTER_H
+#define GETME_FORMATS_PRIVATE_ADAPTER_H
+
+#include "getme_formats_adapter.h"
+
+#include <stdint.h>
+
+struct getme_doc {
+    const getme_format *format;
+    char *path;          /* input path (owned)                               */
+    getme_mesh *mesh;    /* the mesh to smooth (owned)                       */
+    void *impl;          /* adapter private state                            */
+    /* element ids as written in the file, per global element index (may be
+       NULL); used in messages about invalid elements                       */
+    int64_t *elem_ids;
+    getme_quality_stats stats; /* all elements as read (getme_doc_open)     */
+    int have_stats;
+    char info[1024];     /* one line the CLI may log: zones, sets, fixed...  */
+    char error[1024];    /* the last error, one line                         */
+    char warning[1024];  /* input accepted with a caveat, one line           */
+};
+
+/* The built-in adapters (each in its own folder). */
+extern const getme_format getme__format_msh;  /* msh/msh_format.c   */
+extern const getme_format getme__format_inp;  /* inp/inp_format.c   */
+extern const getme_format getme__format_cgns; /* cgns/cgns_format.c */
+
+/* The adapters' short names for the status codes (they predate
+   getme_formats_status; kept so the parsers read as before). */
+typedef getme_formats_status getme_io_status;
+#define GETME_IO_OK GETME_FORMATS_OK
+#define GETME_IO_ERR_OPEN GETME_FORMATS_ERR_OPEN
+#define GETME_IO_ERR_PARSE GETME_FORMATS_ERR_PARSE
+#define GETME_IO_ERR_UNSUPPORTED GETME_FORMATS_ERR_UNSUPPORTED
+#define GETME_IO_ERR_INVALID GETME_FORMATS_ERR_INVALID
+#define GETME_IO_ERR_WRITE GETME_FORMATS_ERR_WRITE
+#define GETME_IO_ERR_USAGE GETME_FORMATS_ERR_ARGUMENT
+#define GETME_IO_ERR_INTERNAL GETME_FORMATS_ERR_INTERNAL
+
+#endif /* GETME_FORMATS_PRIVATE_ADAPTER_H */
