@@ -99,8 +99,8 @@ static int keep_if_invalid(getme_run *run, int32_t e, int32_t **bad,
     return 0;
 }
 
-/* The moving nodes of the invalid elements bad[0..nbad) that can still
-   step down the table, each once, into run->list (serial: few elements
+/* The moving nodes of the invalid elements among bad[0..nbad) that can
+   still step down the table, each once, into run->list (serial: few elements
    are invalid, and the list order must not depend on the thread count). */
 static int32_t nodes_to_step(getme_run *run, int nR, const int32_t *bad,
                              int32_t nbad)
@@ -109,6 +109,8 @@ static int32_t nodes_to_step(getme_run *run, int nR, const int32_t *bad,
     int32_t m = 0;
     for (int32_t k = 0; k < nbad; k++) {
         int32_t e = bad[k];
+        if (run->q[e] > 0.0)
+            continue; /* the whole element list was passed (no memory) */
         int t = getme__ws_type(ws, e);
         const int32_t *c = getme__ws_nodes(ws, t, e);
         for (int i = 0; i < getme__nv[t]; i++) {
