@@ -20,7 +20,9 @@ program, so old builds are measured the same way as new ones:
             stage and finishing step)
   after     statistics, measures and worst lists of the result
   write     "Writing" to "Done writing"
-  total     the whole command (wall), and peak RSS (wait4's ru_maxrss)
+  total     the whole command (wall), its CPU time (user + system; less
+            sensitive to a loaded machine than wall time), and peak RSS
+            (wait4's ru_maxrss)
 
 Runs alternate build by build (A B A B ...) so that a shared machine's load
 hits every build alike; the table gives medians over the repetitions and
@@ -43,7 +45,8 @@ DONE = re.compile(r"Done optimizing mesh \(Wall ([0-9.]+)s\)")
 
 FIELDS = [("read", "read s", 2), ("before", "before s", 2), ("setup", "set-up s", 2),
           ("ns1", "stage-1 ns/el-it", 1), ("stage2", "stage 2 s", 2), ("after", "after s", 2),
-          ("write", "write s", 2), ("total", "total s", 2), ("rss", "peak MiB", 0)]
+          ("write", "write s", 2), ("total", "total s", 2), ("cpu", "CPU s", 2),
+          ("rss", "peak MiB", 0)]
 
 
 def one(exe, mesh, threads, tmp):
@@ -84,6 +87,7 @@ def one(exe, mesh, threads, tmp):
         "ns1": (s1[-1] - s1[0]) / (len(s1) - 1) / ne * 1e9 if len(s1) > 1 else float("nan"),
         "stage2": done - s1[-1], "after": arrive["writing"] - arrive["done"],
         "write": arrive["written"] - arrive["writing"], "total": total,
+        "cpu": ru.ru_utime + ru.ru_stime,
         "rss": ru.ru_maxrss / 1024.0, "q_min_star": r["after"]["q_min_star"],
         "q_mean": r["after"]["q_mean"],
         "iterations": f"{r['iterations']['mean_stage']}/{r['iterations']['min_stage']}",
@@ -126,6 +130,11 @@ def main():
             med = {k: {f: statistics.median(x[f] for x in v) for f, _, _ in FIELDS}
                    for k, v in res.items()}
             short = os.path.basename(mesh).split("-g")[0]
+            with open(mesh, "rb") as f:  # MSH "$MeshFormat\n4.1 0 8": 0 = ASCII
+                head = f.read(64).split(b"\n")
+            if len(head) > 1 and head[0].strip() == b"$MeshFormat" and \
+                    head[1].split()[1:2] == [b"0"]:
+                short += " (ASCII)"
             for t in threads:
                 for name, _ in runs:
                     m, r0 = med[(name, t)], res[(name, t)][0]
@@ -143,7 +152,7 @@ def main():
                     a1, a2 = med[(name, threads[0])], med[(name, threads[-1])]
                     lines.append(f"| {short} | {threads[0]}→{threads[-1]} | speedup {name} | "
                                  f"| | | {a1['ns1'] / a2['ns1']:.2f} | | | | "
-                                 f"{a1['total'] / a2['total']:.2f} | | | | |")
+                                 f"{a1['total'] / a2['total']:.2f} | | | | | |")
     text = "\n".join(lines)
     print(text)
     if a.out:
