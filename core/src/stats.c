@@ -20,6 +20,7 @@ getme_status getme_mesh_element_qualities(getme_mesh *mesh, double *q)
 #pragma omp parallel for schedule(static)
         for (int32_t e = 0; e < bl->count; e++) {
             double x[3 * GETME_MAX_NV];
+            getme__prefetch_local(mesh, bl, e + GETME_PREFETCH_AHEAD);
             getme__gather_local(mesh, bl, e, ysign, x);
             q[bl->first + e] = getme__quality(bl->type, x);
         }
