@@ -213,11 +213,13 @@ static int read_input(args *a, cli_paths *paths, int size, getme_doc **doc,
         return code;
     getme_mesh *mesh = getme_doc_mesh(*doc);
     if (getme_mesh_dim(mesh) != 3) {
-        /* the split (METIS dual graph over faces: 3 common nodes) and the
-           parts are built for volume elements; a planar mesh large enough
-           to need several machines is not a case we have */
+        /* a planar mesh's mirror detection (which side of its plane is
+           up) is a decision over the whole mesh that the parts do not
+           share yet; the split is also built for volumes (METIS dual
+           graph over faces, 3 common nodes) */
         cli_error("%s: planar meshes (triangles, quads) are not distributed "
-                  "by getme-mpi; smooth them with getme smooth", a->input);
+                  "by getme-mpi (their orientation is decided on the whole "
+                  "mesh); smooth them with getme smooth", a->input);
         return CLI_EXIT_UNSUPPORTED;
     }
     char desc[256];
