@@ -52,7 +52,6 @@ getme_status gg_fix_classified(const getme_gmsh_model *model,
                                const getme__nodemap *all, uint8_t *flags,
                                gg_msg *msg)
 {
-    (void)msg;
     for (int e = 0; e < model->num_entities; e++)
         own_nodes(model->entities[2 * e], model->entities[2 * e + 1], all,
                   flags);
@@ -61,27 +60,35 @@ getme_status gg_fix_classified(const getme_gmsh_model *model,
        (the volume they cut), not a model surface or curve.  They are no
        geometry: their nodes move as the rest of the volume's.  Pieces of
        model surfaces and curves have those as parents and stay fixed. */
+    int *parents = malloc(((size_t)model->num_entities + 1) * sizeof *parents);
+    if (!parents)
+        return gg_fail(msg, GETME_ERR_NOMEM, "Out of memory");
+    int np = 0;
+    for (int e = 0; e < model->num_entities; e++) {
+        int sdim, stag;
+        parent_of(model->entities[2 * e], model->entities[2 * e + 1], &sdim,
+                  &stag);
+        if (sdim == model->dim)
+            parents[np++] = stag;
+    }
     int *dt = NULL;
     size_t n = 0;
     int ierr = 0;
     gmshModelGetEntities(&dt, &n, -1, &ierr);
-    for (size_t i = 0; !ierr && i + 1 < n; i += 2) {
+    for (size_t i = 0; !ierr && np && i + 1 < n; i += 2) {
         if (dt[i] >= model->dim)
             continue;
         int pdim, ptag;
         parent_of(dt[i], dt[i + 1], &pdim, &ptag);
         if (pdim != model->dim)
             continue;
-        for (int e = 0; e < model->num_entities; e++) {
-            int sdim, stag;
-            parent_of(model->entities[2 * e], model->entities[2 * e + 1],
-                      &sdim, &stag);
-            if (sdim == pdim && stag == ptag) {
+        for (int e = 0; e < np; e++)
+            if (parents[e] == ptag) {
                 own_nodes(dt[i], dt[i + 1], all, flags);
                 break;
             }
-        }
     }
+    free(parents);
     gmshFree(dt);
     return GETME_OK;
 }
