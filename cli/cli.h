@@ -187,6 +187,14 @@ void cli_smooth_doc_options(const cli_smooth_opts *o, getme_doc_options *d);
 void cli_smooth_begin(cli_smooth_opts *o, getme_params *params);
 /* The thread count decided (OMP_NUM_THREADS or every core) if not given. */
 void cli_smooth_threads(cli_smooth_opts *o);
+/* The progress callback cli_smooth_begin installs (data: the
+   cli_smooth_opts): one log line per iteration, appended to the history. */
+int cli_smooth_progress(const getme_progress *p, void *data);
+/* Untangle doc's mesh (untangle.c): a warning with the counts, the elements
+   that stay invalid named by their file ids in an error.  0,
+   CLI_EXIT_TANGLED or CLI_EXIT_INTERNAL. */
+int cli_untangle(cli_smooth_opts *o, const char *input, getme_doc *doc,
+                 getme_untangle_result *ur);
 /* "N invalid (inverted or degenerate) elements in the input, M remain
    after untangling (...)". */
 void cli_untangle_warning(const cli_log *log, const getme_untangle_result *ur);

@@ -109,51 +109,6 @@ static int write_output(const smooth_args *a, const cli_paths *paths,
     return 0;
 }
 
-/* Elements listed by file id in the error about elements that stay
-   invalid. */
-#define MAX_NAMED 20
-
-/* Untangle an input with invalid elements: one warning line with the
-   counts; the elements that stay invalid named by their file ids.
-   Returns 0, CLI_EXIT_TANGLED or CLI_EXIT_INTERNAL. */
-static int untangle(smooth_args *a, getme_doc *doc, getme_untangle_result *ur)
-{
-    getme_mesh *mesh = getme_doc_mesh(doc);
-    cli_smooth_threads(&a->o);
-    int threads = a->o.params.num_threads;
-    cli_info(&a->o.log, "Untangling (%d thread%s)...", threads,
-             threads == 1 ? "" : "s");
-    getme_status st = getme_mesh_untangle(mesh, &a->o.params, ur);
-    if (st != GETME_OK && st != GETME_ERR_INVALID_MESH) {
-        cli_error("%s: %s", a->input, getme_mesh_error(mesh));
-        return CLI_EXIT_INTERNAL;
-    }
-    cli_untangle_warning(&a->o.log, ur);
-    long long after = (long long)ur->num_invalid_after;
-    if (after == 0)
-        return 0;
-    int32_t ne = getme_mesh_num_elements(mesh);
-    double *q = malloc((size_t)ne * sizeof *q);
-    char list[MAX_NAMED * 22 + 8] = "";
-    size_t len = 0;
-    int named = 0;
-    if (q && getme_mesh_element_qualities(mesh, q) == GETME_OK)
-        for (int32_t e = 0; e < ne && named < MAX_NAMED; e++)
-            if (!(q[e] > 0.0))
-                len += (size_t)snprintf(list + len, sizeof list - len, "%s%lld",
-                                        named++ ? ", " : "",
-                                        (long long)getme_doc_element_id(doc, e));
-    free(q);
-    cli_error("%s: %lld element%s could not be untangled (%lld with every node "
-              "fixed): %s%s; %s",
-              a->input, after, after == 1 ? "" : "s",
-              (long long)ur->num_stuck, list, after > named ? ", ..." : "",
-              a->o.allow_invalid ? "writing the partly untangled mesh as asked"
-                                 : "no output written (--allow-invalid writes "
-                                   "the partly untangled mesh)");
-    return CLI_EXIT_TANGLED;
-}
-
 static int run(smooth_args *a)
 {
     cli_smooth_opts *so = &a->o;
@@ -199,7 +154,7 @@ static int run(smooth_args *a)
     int ho_invalid = ho_before.n > 0 && ho_before.ratio <= 0.0 &&
                      so->params.untangle;
     if ((before.num_invalid > 0 || ho_invalid) &&
-        (code = untangle(a, doc, &ur)) != 0) {
+        (code = cli_untangle(&a->o, a->input, doc, &ur)) != 0) {
         if (code == CLI_EXIT_TANGLED && so->allow_invalid) {
             cli_write_guard(&guard, 1);
             write_output(a, &paths, doc, "partly untangled, not smoothed, ");

@@ -153,7 +153,7 @@ void cli_smooth_doc_options(const cli_smooth_opts *o, getme_doc_options *d)
     d->verbose = o->log.verbose;
 }
 
-static int on_progress(const getme_progress *p, void *data)
+int cli_smooth_progress(const getme_progress *p, void *data)
 {
     cli_smooth_opts *o = data;
     cli_history *h = &o->history;
@@ -223,7 +223,7 @@ void cli_untangle_warning(const cli_log *log, const getme_untangle_result *ur)
 
 void cli_smooth_begin(cli_smooth_opts *o, getme_params *params)
 {
-    o->params.progress = on_progress;
+    o->params.progress = cli_smooth_progress;
     o->params.progress_data = o;
     cli_smooth_threads(o);
     /* the parameters actually used (getme gmsh: inside its options) */

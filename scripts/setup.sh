@@ -15,7 +15,7 @@ jobs=$(nproc 2>/dev/null || echo 2)
 PACKAGES="cmake make gcc libc6-dev libgmsh-dev gmsh python3-gmsh libcgns-dev cgns-convert \
 libhdf5-dev calculix-ccx python3 python3-numpy python3-meshio python3-h5py python3-matplotlib \
 xvfb xdotool x11-apps imagemagick time python3-netgen occt-misc gmsh-doc \
-calculix-ccx-test"
+calculix-ccx-test libopenmpi-dev openmpi-bin libmetis-dev"
 
 missing=""
 for p in $PACKAGES; do
@@ -44,6 +44,8 @@ case "$mode" in
   test)
     # Tests run side by side on few cores: OpenMP threads must not spin.
     export OMP_WAIT_POLICY=passive
+    # getme-mpi's tests (label mpi) run mpirun as root in CI containers.
+    export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
     build build -DGETME_WERROR=ON
     echo "Info    : running the test suite (release build)"
     ctest --test-dir build --output-on-failure -j "$jobs"

@@ -67,7 +67,8 @@ typedef enum getme_status {
     GETME_ERR_INVALID_MESH = 3, /* the input has invalid (inverted) elements  */
     GETME_ERR_TOPOLOGY = 4,     /* node index out of range, repeated node ... */
     GETME_ERR_STATE = 5,        /* call out of order (e.g. no elements yet)   */
-    GETME_ERR_CANCELLED = 6     /* the progress callback asked to stop        */
+    GETME_ERR_CANCELLED = 6,    /* the progress callback asked to stop        */
+    GETME_ERR_COMM = 7          /* a getme_comm hook reported a failure       */
 } getme_status;
 
 /* A static English description of a status code ("invalid mesh", ...). */
@@ -157,6 +158,12 @@ GETME_API int32_t getme_mesh_num_elements(const getme_mesh *mesh);
 /* Number of elements of one type. */
 GETME_API int32_t getme_mesh_num_elements_of_type(const getme_mesh *mesh,
                                                   getme_elem_type type);
+
+/* Element e (0-based, in the order of getme_mesh_add_elements): its type
+   into *type and its node indices into nodes (room for 8); returns the
+   number of nodes, or 0 if e is out of range. */
+GETME_API int getme_mesh_get_element(const getme_mesh *mesh, int32_t e,
+                                     getme_elem_type *type, int32_t *nodes);
 
 /* Read-only view of the current coordinates (3 per node, caller's order). */
 GETME_API const double *getme_mesh_coords(const getme_mesh *mesh);
@@ -686,6 +693,88 @@ typedef struct getme_result {
 GETME_API getme_status getme_smooth(getme_mesh *mesh,
                                     const getme_params *params,
                                     getme_result *result);
+
+/* ------------------------------------------------------------------------ */
+/* Distributed smoothing (docs/distributed.md)                              */
+/* ------------------------------------------------------------------------ */
+
+/*
+ * A mesh split over several processes (MPI ranks, say) is smoothed by
+ * GETMe adaptive with the same result, bit for bit, as getme_smooth() on
+ * the whole mesh, for any number of processes and threads.  Each process
+ * calls getme_smooth_part() on its part: the elements it owns plus one
+ * ghost layer, every element that shares a node with an owned one (so the
+ * Eq. 9 neighbourhoods of owned elements are complete), with the nodes of
+ * all of them and the fixed marks of the whole mesh.  The library never
+ * talks to other processes itself: it calls the hooks below, which the
+ * caller implements (dist/ does it with MPI).  A copy of a node is its
+ * occurrence in one process's part; all copies of a node hold the same
+ * values at all times.  Every hook returns 0 on success; any other value
+ * makes getme_smooth_part() stop with GETME_ERR_COMM.  Every process calls
+ * the same hooks in the same order (collective calls).
+ *
+ * 128-bit integers are passed as 16 bytes, two's complement, in the
+ * machine's byte order (on x86-64: the low 64-bit word first); a sum of
+ * them must be the exact 128-bit sum (add the low words, carry into the
+ * high ones).
+ */
+typedef struct getme_comm {
+    void *ctx;                  /* passed to every hook                      */
+    const uint8_t *owned;       /* per element of the part: 1 = owned here,
+                                   0 = ghost; every element of the whole
+                                   mesh is owned by exactly one process     */
+    const uint8_t *counted;     /* per node of the part: 1 = this process
+                                   counts the node in reported node counts;
+                                   exactly one copy of every node is 1      */
+    /* Called once before the node hooks: the library keeps nodes in its
+       own order; node i of the arrays the node hooks receive is node
+       caller_index[i] of the part (a permutation of 0 .. num_nodes - 1). */
+    int (*node_order)(void *ctx, int32_t num_nodes,
+                      const int32_t *caller_index);
+    /* values: per_node 128-bit integers per node (library order): replace
+       those of every copy by the sum over all copies of the node. */
+    int (*node_sum)(void *ctx, void *values, int per_node);
+    /* flags: one byte per node (library order): set every copy to 1 if any
+       copy is nonzero, else 0. */
+    int (*node_or)(void *ctx, uint8_t *flags);
+    /* Sums over all processes, in place (count values). */
+    int (*sum_i64)(void *ctx, int64_t *values, int count);
+    int (*sum_i128)(void *ctx, void *values, int count);
+    /* Minimum over all processes, in place (count values). */
+    int (*min)(void *ctx, double *values, int count);
+} getme_comm;
+
+/*
+ * GETMe adaptive on this process's part (see getme_comm).  params as for
+ * getme_smooth() (method GETME_METHOD_ADAPTIVE only); the finishing step
+ * (params->finish) is not run here but by getme_smooth_finish() on the
+ * gathered mesh.  The input must be valid (every element of every part;
+ * untangle the whole mesh first): otherwise every process returns
+ * GETME_ERR_INVALID_MESH.  result holds the values of the whole mesh
+ * (identical on every process).  The positions of the part's nodes are
+ * those getme_smooth() reaches before its finishing step.  The progress
+ * callback is called on every process with the same values; its return
+ * value is ignored (a stop must be the same on all processes).
+ */
+GETME_API getme_status getme_smooth_part(getme_mesh *part,
+                                         const getme_params *params,
+                                         const getme_comm *comm,
+                                         getme_result *result);
+
+/*
+ * The end of a distributed run, on one process holding the whole mesh as
+ * read (mesh at its input coordinates): set the coordinates to xyz (3 per
+ * node, the gathered positions getme_smooth_part() reached) and run the
+ * finishing step exactly as getme_smooth() does after its loop; result
+ * (filled by getme_smooth_part()) is updated (finishing passes, final
+ * statistics, seconds added).  The mesh then equals getme_smooth()'s
+ * output bit for bit.  The finishing step is serial in getme_smooth()
+ * too; it touches only the worst elements' neighbourhoods.
+ */
+GETME_API getme_status getme_smooth_finish(getme_mesh *mesh,
+                                           const getme_params *params,
+                                           const double *xyz,
+                                           getme_result *result);
 
 /* ------------------------------------------------------------------------ */
 /* Untangling                                                               */

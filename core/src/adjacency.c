@@ -299,6 +299,9 @@ getme_status getme__adj_build(getme_adj *adj, const getme_ws *ws)
     adj->count = malloc(ne * sizeof *adj->count);
     adj->irregular = malloc(ne);
     adj->nsum = malloc(nn * sizeof *adj->nsum);
+    /* The fixed-point scale of the sums (adjacency.h). */
+    adj->qscale = 0x1p61 / getme__pow2_ceil((double)ws->max_star + 1.0);
+    adj->qinv = 1.0 / adj->qscale;
     uint64_t *rn = check ? malloc(nn * sizeof *rn) : NULL, *re = NULL;
     int32_t *edeg = NULL;
     getme_status st = GETME_ERR_NOMEM;
@@ -339,16 +342,20 @@ static inline void add_block_sums(int t, getme_adj *adj, const getme_ws *ws,
     int nv = getme__nv[t];
     int ned = ws->dim == 3 ? getme__edges[t].num_edges : 0;
     for (int32_t e = e0; e < e1; e++) {
-        double v = q[e];
+        /* uint64: wrap-around is defined; the true sums fit (adjacency.h) */
+        uint64_t v = (uint64_t)getme__fx64(q[e], adj->qscale);
         const int32_t *c = getme__ws_nodes(ws, t, e);
         for (int i = 0; i < nv; i++)
-            adj->nsum[c[i]] += v;
+            adj->nsum[c[i]] = (int64_t)((uint64_t)adj->nsum[c[i]] + v);
         if (ned == 0)
             continue; /* planar: no edge sums (and no edge arrays) */
         const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
         for (int j = 0; j < ned; j++)
             if (slot[j] != GETME_NO_SLOT)
-                adj->esum[getme__adj_edge(adj, c, t, j, slot[j])] += v;
+            {
+                int64_t *d = &adj->esum[getme__adj_edge(adj, c, t, j, slot[j])];
+                *d = (int64_t)((uint64_t)*d + v);
+            }
     }
 }
 

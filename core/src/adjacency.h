@@ -31,6 +31,7 @@
 #ifndef GETME_ADJACENCY_H
 #define GETME_ADJACENCY_H
 
+#include "exact.h"
 #include "workspace.h"
 
 /* An element edge's slot that does not fit in a byte (a node with more
@@ -50,8 +51,18 @@ typedef struct getme_adj {
     uint8_t *irregular; /* ne: 1 = use the union walk for this element     */
     int32_t num_irregular;
     int32_t num_edges;  /* 3-D only                                        */
-    double *nsum;       /* nn: S_v at the current qualities                */
-    double *esum;       /* num_edges: S_e at the current qualities         */
+    /* Exact fixed-point sums (exact.h): the same bits whatever order the
+       elements are added in.  A quality q (|q| < 2) is the integer
+       trunc(q * qscale), qscale = 2^(61 - b) with 2^b > the largest star,
+       so a term is below 2^(62 - b) and a node's or an edge's sum (at most
+       2^b - 1 terms) below 2^62: int64 holds it.  The inclusion-exclusion
+       of up to 8 node and 12 edge sums wraps in uint64 (its result fits,
+       getme__adj_nsum).  A term's
+       truncation is below 2^(b - 61) (docs/distributed.md compares it
+       with the double sums this replaced). */
+    int64_t *nsum;      /* nn: S_v at the current qualities                */
+    int64_t *esum;      /* num_edges: S_e at the current qualities         */
+    double qscale, qinv; /* 2^(61 - b) and its inverse                    */
 } getme_adj;
 
 /* Build everything above for ws (parallel, deterministic).  GETME_OK or
@@ -88,7 +99,10 @@ static inline int32_t getme__adj_edge(const getme_adj *adj, const int32_t *c,
     return adj->eptr[a < b ? a : b] + slot;
 }
 
-/* Sum of q over N(e) for a regular element e of type t (see above). */
+/* Sum of q over N(e) for a regular element e of type t (see above), as
+   the nearest double to the exact sum of the fixed-point qualities: the
+   inclusion-exclusion is exact in integers, so it equals the union walk's
+   exact sum (weights.c) bit for bit. */
 static inline double getme__adj_nsum(const getme_adj *adj,
                                      const getme_ws *ws, const double *q,
                                      int t, int32_t e)
@@ -97,17 +111,25 @@ static inline double getme__adj_nsum(const getme_adj *adj,
     const getme_face_table *ft = &getme__faces[t];
     const int32_t *f = getme__adj_faces(adj, ws, t, e);
     int nv = getme__nv[t];
-    double sv = 0.0, sf = 0.0, se = 0.0;
+    /* In wrapping uint64 arithmetic: the sum over N(e) is a sum of
+       non-negative terms (valid qualities, q <= 1 up to rounding), each
+       below 2^(61 - b), over fewer than nv 2^b elements (N(e) is inside
+       the union of nv stars), so below nv 2^61 <= 2^64: the true value is
+       what the wrapped uint64 holds, whatever the partial sums did. */
+    const double qs = adj->qscale;
+    uint64_t sv = 0, sf = 0, se = 0;
     for (int i = 0; i < nv; i++)
-        sv += adj->nsum[c[i]];
+        sv += (uint64_t)adj->nsum[c[i]];
     for (int k = 0; k < ft->num_faces; k++)
-        sf += f[k] >= 0 ? q[f[k]] : 0.0;
+        sf += f[k] >= 0 ? (uint64_t)getme__fx64(q[f[k]], qs) : 0;
+    uint64_t qe = (uint64_t)getme__fx64(q[e], qs);
     if (ws->dim == 2) /* sum_e S_e = nv q_E + sf, plus q_E once */
-        return sv - (double)(nv - 1) * q[e] - sf;
+        return (double)(sv - (uint64_t)(nv - 1) * qe - sf) * adj->qinv;
     const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
     for (int k = 0; k < getme__edges[t].num_edges; k++)
-        se += adj->esum[getme__adj_edge(adj, c, t, k, slot[k])];
-    return sv - se + (double)(ft->num_faces - 1) * q[e] + sf;
+        se += (uint64_t)adj->esum[getme__adj_edge(adj, c, t, k, slot[k])];
+    return (double)(sv - se + (uint64_t)(ft->num_faces - 1) * qe + sf) *
+           adj->qinv;
 }
 
 #endif /* GETME_ADJACENCY_H */

@@ -6,7 +6,8 @@
  * Every face is met at its lowest node: walking that node's star, each
  * element contributes the faces it has there whose other nodes are all
  * higher, keyed by those other nodes (sorted); sides with equal keys are
- * the same face.  No face table or hash is built, each loop iteration
+ * the same face.  No global face table is built (a small per-thread hash
+ * groups the sides met at one node), each loop iteration
  * writes only the entries of faces whose lowest node it owns (race-free),
  * and the node order of the workspace keeps the stars it reads in cache.
  */
@@ -55,31 +56,37 @@ static void corner_table(corner_faces table[GETME_NUM_TYPES][GETME_MAX_NV])
 }
 
 /* One side of a face seen from its lowest node: the other nodes, sorted
-   (-1 padded), and which element face it is. */
+   (-1 padded), and which element face it is; rep: the first side with the
+   same key (its group), and for that first side, how many sides the group
+   has (n), the second one (second) and its hash slot (slot). */
 typedef struct face_key {
     int32_t k[3];
     int32_t elem;
     int32_t face;
+    int32_t rep, n, second, slot;
 } face_key;
-
-static inline int key_less(const face_key *a, const face_key *b)
-{
-    for (int i = 0; i < 3; i++)
-        if (a->k[i] != b->k[i])
-            return a->k[i] < b->k[i];
-    return a->elem < b->elem;
-}
 
 static inline int key_same(const face_key *a, const face_key *b)
 {
     return a->k[0] == b->k[0] && a->k[1] == b->k[1] && a->k[2] == b->k[2];
 }
 
-/* The faces whose lowest node is u, as sorted keys in buf; returns how
-   many. */
+static inline uint32_t key_hash(const face_key *a)
+{
+    uint32_t h = (uint32_t)a->k[0] * 0x9E3779B1u ^
+                 (uint32_t)a->k[1] * 0x85EBCA77u ^
+                 (uint32_t)a->k[2] * 0xC2B2AE3Du;
+    return h ^ (h >> 15);
+}
+
+/* The faces whose lowest node is u, as keys in buf, grouped by key through
+   the hash table (all -1 on entry and on return; mask + 1 slots, at least
+   twice the sides).  Only the groups matter, not their order, so no sort
+   is needed: a hash lookup per side is linear in the star, where the
+   sorted insertion it replaces was quadratic.  Returns how many sides. */
 static int faces_at(const getme_ws *ws,
                     corner_faces table[GETME_NUM_TYPES][GETME_MAX_NV],
-                    int32_t u, face_key *buf)
+                    int32_t u, face_key *buf, int32_t *hash, uint32_t mask)
 {
     int m = 0;
     for (int64_t s = ws->star_ptr[u]; s < ws->star_ptr[u + 1]; s++) {
@@ -102,13 +109,26 @@ static int faces_at(const getme_ws *ws,
                     o[j] = o[j - 1];
                     o[j - 1] = tmp;
                 }
-            face_key key = {{o[0], o[1], o[2]}, n, cf->face[k]};
-            int j = m++;
-            for (; j > 0 && key_less(&key, &buf[j - 1]); j--)
-                buf[j] = buf[j - 1];
-            buf[j] = key;
+            face_key *key = &buf[m];
+            *key = (face_key){{o[0], o[1], o[2]}, n, cf->face[k], m, 1, -1, 0};
+            uint32_t h = key_hash(key) & mask;
+            while (hash[h] >= 0 && !key_same(&buf[hash[h]], key))
+                h = (h + 1) & mask;
+            if (hash[h] < 0) {
+                hash[h] = m;
+                key->slot = (int32_t)h;
+            } else {
+                face_key *r = &buf[hash[h]];
+                key->rep = hash[h];
+                if (r->n++ == 1)
+                    r->second = m;
+            }
+            m++;
         }
     }
+    for (int i = 0; i < m; i++)
+        if (buf[i].rep == i)
+            hash[buf[i].slot] = -1;
     return m;
 }
 
@@ -138,33 +158,39 @@ getme_status getme__ws_faces(const getme_ws *ws, const int64_t *foff,
 {
     static const int max_faces_at_corner = 4; /* pyramid apex */
     size_t bufsize = (size_t)ws->max_star * max_faces_at_corner + 1;
+    size_t hsize = 16;
+    while (hsize < 2 * bufsize)
+        hsize *= 2;
     face_key *bufs = malloc((size_t)ws->nt * bufsize * sizeof *bufs);
-    if (!bufs)
+    int32_t *hashes = malloc((size_t)ws->nt * hsize * sizeof *hashes);
+    if (!bufs || !hashes) {
+        free(bufs);
+        free(hashes);
         return GETME_ERR_NOMEM;
+    }
+    memset(hashes, 0xff, (size_t)ws->nt * hsize * sizeof *hashes);
     corner_faces table[GETME_NUM_TYPES][GETME_MAX_NV];
     corner_table(table);
 #pragma omp parallel for schedule(dynamic, 1024) num_threads(ws->nt)
     for (int32_t u = 0; u < ws->nn; u++) {
-        face_key *buf = bufs + (size_t)omp_get_thread_num() * bufsize;
-        int m = faces_at(ws, table, u, buf);
-        for (int a = 0; a < m;) {
-            int b = a + 1;
-            while (b < m && key_same(&buf[a], &buf[b]))
-                b++;
-            for (int i = a; i < b; i++) {
-                int32_t v = -1;
-                if (b - a > 2) {
+        int th = omp_get_thread_num();
+        face_key *buf = bufs + (size_t)th * bufsize;
+        int m = faces_at(ws, table, u, buf, hashes + (size_t)th * hsize,
+                         (uint32_t)(hsize - 1));
+        for (int i = 0; i < m; i++) {
+            const face_key *r = &buf[buf[i].rep];
+            int32_t v = -1;
+            if (r->n > 2) {
+                v = GETME_FACE_IRREGULAR;
+            } else if (r->n == 2) {
+                v = buf[i].rep == i ? buf[r->second].elem : r->elem;
+                if (same_simplex(ws, buf[i].elem, v))
                     v = GETME_FACE_IRREGULAR;
-                } else if (b - a == 2) {
-                    v = buf[i == a ? a + 1 : a].elem;
-                    if (same_simplex(ws, buf[i].elem, v))
-                        v = GETME_FACE_IRREGULAR;
-                }
-                *slot(ws, foff, out, buf[i].elem, buf[i].face) = v;
             }
-            a = b;
+            *slot(ws, foff, out, buf[i].elem, buf[i].face) = v;
         }
     }
     free(bufs);
+    free(hashes);
     return GETME_OK;
 }

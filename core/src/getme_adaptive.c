@@ -47,64 +47,81 @@ static inline double weight(const getme_run *run, int t, int32_t e)
                 ((double)adj->count[e] * q[e]));
 }
 
-/* AddTransformedElementNodesAndWeights for element e (type t). */
-static inline void add_transformed(getme_run *run, int t, int32_t e,
-                                   double sigma)
+/* A node's contribution w x (3 coordinates) and w, added to its exact
+   fixed-point sums (set_scales): wf = trunc(w wscale) is the element's
+   weight as an integer, each coordinate becomes trunc(x pscale), and their
+   product is exact in 128 bits, so sum w x and sum w are exact sums of the
+   same integer weights.  Returns 1 if a coordinate is beyond run->xbound,
+   where the bound would not hold (nothing is added; the caller redoes the
+   scatter with a larger bound). */
+static inline int add_node(const getme_run *run, int32_t n, int64_t wf,
+                           const double *x)
+{
+    double b = run->xbound;
+    if (!(fabs(x[0]) < b && fabs(x[1]) < b && fabs(x[2]) < b))
+        return 1;
+    getme_fx *a = run->facc + 4 * (int64_t)n;
+    double ps = run->pscale;
+    a[0] += (getme_fx)wf * getme__fx64(x[0], ps);
+    a[1] += (getme_fx)wf * getme__fx64(x[1], ps);
+    a[2] += (getme_fx)wf * getme__fx64(x[2], ps);
+    a[3] += wf;
+    return 0;
+}
+
+/* AddTransformedElementNodesAndWeights for element e (type t); returns 1
+   on a bound overflow (add_node). */
+static inline int add_transformed(getme_run *run, int t, int32_t e,
+                                  double sigma)
 {
     const getme_ws *ws = run->ws;
     double x[3 * GETME_MAX_NV], y[3 * GETME_MAX_NV];
-    double w = weight(run, t, e);
+    int64_t w = getme__fx64(weight(run, t, e), run->wscale);
     getme__ws_gather(ws, ws->x, t, e, x);
     getme__transform(t, x, sigma, y);
     const int32_t *c = getme__ws_nodes(ws, t, e);
+    int ovf = 0;
     for (int i = 0; i < getme__nv[t]; i++) {
         int32_t n = c[i];
         if (ws->fixed[n])
             continue;
-        double *a = run->acc + 4 * (int64_t)n;
-        a[0] += w * y[3 * i];
-        a[1] += w * y[3 * i + 1];
-        a[2] += w * y[3 * i + 2];
-        a[3] += w;
+        ovf |= add_node(run, n, w, y + 3 * i);
         run->in_t[n] = 1;
     }
+    return ovf;
 }
 
 /* AddUntransformedElementNodesAndWeights for element e (type t). */
-static inline void add_untransformed(getme_run *run, int t, int32_t e)
+static inline int add_untransformed(getme_run *run, int t, int32_t e)
 {
     const getme_ws *ws = run->ws;
-    double w = weight(run, t, e);
+    int64_t w = getme__fx64(weight(run, t, e), run->wscale);
     const int32_t *c = getme__ws_nodes(ws, t, e);
+    int ovf = 0;
     for (int i = 0; i < getme__nv[t]; i++) {
         int32_t n = c[i];
-        if (!run->in_t[n])
-            continue;
-        const double *x = ws->x + 3 * (int64_t)n;
-        double *a = run->acc + 4 * (int64_t)n;
-        a[0] += w * x[0];
-        a[1] += w * x[1];
-        a[2] += w * x[2];
-        a[3] += w;
+        if (run->in_t[n])
+            ovf |= add_node(run, n, w, ws->x + 3 * (int64_t)n);
     }
+    return ovf;
 }
 
 /* The free elements of [e0, e1), all of type t, transformed; t is a
    constant in each copy (GETME_FOR_TYPE). */
 static inline void transform_block(int t, getme_run *run, int32_t e0,
-                                   int32_t e1, double sigma, int32_t *count)
+                                   int32_t e1, double sigma, int32_t *count,
+                                   int *ovf)
 {
     for (int32_t e = e0; e < e1; e++)
-        if (run->ws->free_elem[e]) {
-            add_transformed(run, t, e, sigma);
+        if (run->ws->free_elem[e] && getme__owned(run, e)) {
+            *ovf |= add_transformed(run, t, e, sigma);
             (*count)++;
         }
 }
 
 /* q_mean stage: every free element is transformed.  Blocks run colour by
    colour: blocks of one colour share no node, so they scatter without
-   atomics, and each node receives its contributions in the same order
-   whatever the thread count. */
+   atomics; the sums are exact (exact.h), so their order does not matter. */
 static int32_t scatter_all(getme_run *run, double sigma)
 {
     const getme_ws *ws = run->ws;
@@ -113,15 +130,17 @@ static int32_t scatter_all(getme_run *run, double sigma)
         int32_t b0 = ws->colour_ptr[c], b1 = ws->colour_ptr[c + 1];
         int nt = c == ws->serial_colour ? 1 : ws->nt;
         int32_t count = 0;
+        int ovf = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nt) \
-    reduction(+ : count)
+    reduction(+ : count) reduction(| : ovf)
         for (int32_t k = b0; k < b1; k++) {
             int32_t b = ws->colour_blocks[k];
             int32_t e0 = ws->block_start[b], e1 = ws->block_start[b + 1];
             GETME_FOR_TYPE(getme__ws_type(ws, e0), transform_block, run, e0,
-                           e1, sigma, &count);
+                           e1, sigma, &count, &ovf);
         }
         total += count;
+        run->overflow |= ovf;
     }
     return total;
 }
@@ -161,6 +180,13 @@ static int32_t scatter_some(getme_run *run, double qt, double sigma)
                 run->nodes[nn++] = c[i];
             }
     }
+    if (run->comm) { /* I_T of the whole mesh: nodes of remote t-elements */
+        getme__dist_node_or(run, run->in_t);
+        nn = 0;
+        for (int32_t i = 0; i < ws->nn; i++)
+            if (run->in_t[i])
+                run->nodes[nn++] = i;
+    }
     for (int32_t k = 0; k < nn; k++) /* the elements around I_T */
         for (int64_t j = ws->star_ptr[run->nodes[k]];
              j < ws->star_ptr[run->nodes[k] + 1]; j++) {
@@ -174,15 +200,17 @@ static int32_t scatter_some(getme_run *run, double qt, double sigma)
         run->eflag[run->elems[k]] = 0;
     run->num_nodes = nn;
     run->num_elems = ne;
+    int ovf = 0;
     for (int32_t k = 0; k < run->num_t; k++) {
         int32_t e = run->tlist[k];
-        add_transformed(run, getme__ws_type(ws, e), e, sigma);
+        ovf |= add_transformed(run, getme__ws_type(ws, e), e, sigma);
     }
     for (int32_t k = 0; k < ne; k++) {
         int32_t e = run->elems[k];
-        if (run->q[e] > qt)
-            add_untransformed(run, getme__ws_type(ws, e), e);
+        if (run->q[e] > qt && getme__owned(run, e))
+            ovf |= add_untransformed(run, getme__ws_type(ws, e), e);
     }
+    run->overflow |= ovf;
     return run->num_t;
 }
 
@@ -209,10 +237,9 @@ static int tlist_reserve(getme_run *run, int64_t n)
 /* After an iteration of the q*_min stage: bring the Eq. 9 sums up to date
    by the quality changes of the elements that moved (run->elems; their old
    qualities are in run->qold), and the list of elements with q <= q_t
-   (only those elements can have entered or left it).  The sums are
-   updated serially in list order, so they do not depend on the thread
-   count; each cycle start recomputes them from scratch, which bounds the
-   rounding drift of the updates. */
+   (only those elements can have entered or left it).  The sums are exact
+   fixed point (exact.h): an update by the difference of the old and new
+   fixed-point qualities gives the same bits as a recomputation. */
 static getme_status update_after(getme_run *run, double qt)
 {
     const getme_ws *ws = run->ws;
@@ -221,18 +248,22 @@ static getme_status update_after(getme_run *run, double qt)
         getme__adj_sums_all(adj, ws, run->q);
     for (int32_t k = 0; run->qold && k < run->num_elems; k++) {
         int32_t e = run->elems[k];
-        double d = run->q[e] - run->qold[k];
-        if (d == 0.0)
+        if (run->q[e] == run->qold[k])
             continue;
+        uint64_t d = (uint64_t)getme__fx64(run->q[e], adj->qscale) -
+                     (uint64_t)getme__fx64(run->qold[k], adj->qscale);
         int t = getme__ws_type(ws, e);
         const int32_t *c = getme__ws_nodes(ws, t, e);
         for (int i = 0; i < getme__nv[t]; i++)
-            adj->nsum[c[i]] += d;
+            adj->nsum[c[i]] = (int64_t)((uint64_t)adj->nsum[c[i]] + d);
         if (ws->dim == 3) {
             const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
             for (int j = 0; j < getme__edges[t].num_edges; j++)
-                if (slot[j] != GETME_NO_SLOT)
-                    adj->esum[getme__adj_edge(adj, c, t, j, slot[j])] += d;
+                if (slot[j] != GETME_NO_SLOT) {
+                    int64_t *s =
+                        &adj->esum[getme__adj_edge(adj, c, t, j, slot[j])];
+                    *s = (int64_t)((uint64_t)*s + d);
+                }
         }
     }
 
@@ -248,12 +279,13 @@ static getme_status update_after(getme_run *run, double qt)
     }
     for (int32_t k = 0; k < run->num_elems; k++) {
         int32_t e = run->elems[k];
-        if (run->q[e] <= qt && !run->tflag[e]) {
+        if (run->q[e] <= qt && !run->tflag[e] && getme__owned(run, e)) {
             run->tflag[e] = 1;
             run->tlist[n++] = e;
         }
     }
-    qsort(run->tlist, (size_t)n, sizeof *run->tlist, cmp_int32);
+    if (n > 1) /* a part may have none (and no list yet) */
+        qsort(run->tlist, (size_t)n, sizeof *run->tlist, cmp_int32);
     run->num_t = n;
     return GETME_OK;
 }
@@ -265,7 +297,8 @@ static getme_status start_tlist(getme_run *run, double qt)
     const getme_ws *ws = run->ws;
     int32_t n = 0;
     for (int32_t e = 0; e < ws->ne; e++) {
-        run->tflag[e] = ws->free_elem[e] && run->q[e] <= qt;
+        run->tflag[e] =
+            ws->free_elem[e] && getme__owned(run, e) && run->q[e] <= qt;
         n += run->tflag[e];
     }
     if (tlist_reserve(run, n) != 0)
@@ -278,18 +311,91 @@ static getme_status start_tlist(getme_run *run, double qt)
     return GETME_OK;
 }
 
-/* ComputeNewNodes: p-hat = weighted sum / weight sum, for I_T. */
+/* ComputeNewNodes: p-hat = weighted sum / weight sum, for I_T, from the
+   exact sums (which are cleared for the next iteration).  The quotient of
+   the two integers' doubles is scaled back by 1 / pscale, a power of two,
+   so the only roundings are the two conversions and the division. */
 static void compute_new_nodes(getme_run *run)
 {
+    double back = 1.0 / run->pscale;
 #pragma omp parallel for schedule(static) num_threads(run->ws->nt) \
     if (run->num_nodes > GETME_PAR_MIN)
     for (int32_t k = 0; k < run->num_nodes; k++) {
-        double *a = run->acc + 4 * (int64_t)run->nodes[k];
-        double inv = 1.0 / a[3];
-        a[0] *= inv;
-        a[1] *= inv;
-        a[2] *= inv;
+        int64_t n = run->nodes[k];
+        getme_fx *f = run->facc + 4 * n;
+        double *a = run->acc + 4 * n;
+        double inv = 1.0 / (double)f[3];
+        a[0] = (double)f[0] * inv * back;
+        a[1] = (double)f[1] * inv * back;
+        a[2] = (double)f[2] * inv * back;
+        f[0] = f[1] = f[2] = f[3] = 0;
     }
+}
+
+/* Undo a scatter: zero the sums and the I_T flags it set. */
+static void clear_sums(getme_run *run)
+{
+    memset(run->facc, 0, (size_t)run->ws->nn * 4 * sizeof *run->facc);
+    for (int32_t k = 0; k < run->num_nodes; k++)
+        run->in_t[run->nodes[k]] = 0;
+}
+
+/* This iteration's fixed-point scales (exact.h), from bounds every term
+   obeys, all powers of two (so the scales are exact):
+     w = sqrt(mean of q over N(E) / q_E) <= sqrt(2 / q_lo) <= W, where q_lo
+       is the lowest quality of a free element (every element that
+       contributes has a free node, and q <= 1 up to rounding);
+     |x| < xbound for every coordinate contributed (add_node checks it);
+     a node sums fewer than star_bound = 2^b terms (its elements).
+   wscale = 2^(64 - b) / W makes the integer weight wf < 2^(64 - b);
+   pscale = 2^62 / xbound makes a coordinate's integer < 2^62; a product is
+   below 2^(126 - b) and a node's sum of fewer than 2^b of them below 2^126:
+   no overflow in 128 bits (and sum wf < 2^64).
+   Precision: a coordinate's truncation is < 1 / pscale = 2^-62 xbound
+   = 2^-58 X (X = 2^ceil(log2 max |x|)), below a double's 2^-52 X ulp at
+   the mesh's extent; p-hat is a mean with the integer weights, so their
+   truncation (relative < W / (w 2^(64 - b)) <= 2^(b - 62) / q_lo) only
+   perturbs the weights, moving p-hat by at most that fraction of the
+   spread of the points averaged (an element's size), never by X
+   (docs/distributed.md). */
+static void set_scales(getme_run *run, double q_lo)
+{
+    double lo = q_lo > 0x1p-600 ? q_lo : 0x1p-600;
+    double W = getme__pow2_ceil(sqrt(2.0 / lo) * (1.0 + 0x1p-40));
+    run->wscale = 0x1p64 / run->star_bound / W;
+    run->pscale = 0x1p62 / run->xbound;
+}
+
+/* xbound: a power of two above 16 |x| for every coordinate x of the mesh
+   (a transformed element stays near its own nodes, so its nodes are far
+   inside; add_node checks), and star_bound. */
+static void set_bounds(getme_run *run)
+{
+    const getme_ws *ws = run->ws;
+    double m = 0.0;
+    int64_t big = 0;
+#pragma omp parallel for schedule(static) num_threads(ws->nt) \
+    reduction(max : m, big)
+    for (int32_t i = 0; i < ws->nn; i++) {
+        const double *x = ws->x + 3 * (int64_t)i;
+        for (int d = 0; d < 3; d++)
+            m = fabs(x[d]) > m ? fabs(x[d]) : m;
+        int64_t s = ws->star_ptr[i + 1] - ws->star_ptr[i];
+        big = s > big ? s : big;
+    }
+    double neg[2] = {-m, -(double)big}; /* maxima of the whole mesh */
+    getme__dist_min(run, neg, 2);
+    m = -neg[0];
+    big = (int64_t)-neg[1];
+    run->xbound = 16.0 * getme__pow2_ceil(m > 0x1p-500 ? m : 0x1p-500);
+    run->star_bound = getme__pow2_ceil((double)big + 1.0);
+    if (run->comm) { /* the Eq. 9 sums' scale from the largest star of the
+                        whole mesh, as getme__adj_build sets it for one */
+        run->adj->qscale = 0x1p61 / run->star_bound;
+        run->adj->qinv = 1.0 / run->adj->qscale;
+    }
+    if (run->star_bound < 4.0) /* wf < 2^62: an int64 */
+        run->star_bound = 4.0;
 }
 
 /* Room for the old qualities of run->num_elems elements in run->qold,
@@ -311,15 +417,29 @@ static void qold_reserve(getme_run *run)
    Decided by the stage, not by qt: a q*_min cycle's qt can be 1 on a
    mesh that is mostly perfect, and must still use its own lists. */
 static getme_status iterate(getme_run *run, int mean_stage, double qt,
-                            const double *R, int nR,
+                            double q_lo, const double *R, int nR,
                             int32_t *num_transformed, int32_t *num_relaxed)
 {
     double sigma = run->params->sigma;
-    if (mean_stage) {
+    if (mean_stage)
         getme__adj_sums_all(run->adj, run->ws, run->q);
-        *num_transformed = scatter_all(run, sigma);
-    } else {
-        *num_transformed = scatter_some(run, qt, sigma);
+    for (;;) {
+        set_scales(run, q_lo);
+        run->overflow = 0;
+        *num_transformed = mean_stage ? scatter_all(run, sigma)
+                                      : scatter_some(run, qt, sigma);
+        if (!getme__dist_any(run, run->overflow))
+            break;
+        /* A transformed node beyond xbound (never seen in practice): clear
+           the sums and start over with room for it; deterministic, since
+           the bound and the test are. */
+        clear_sums(run);
+        run->xbound *= 256.0;
+    }
+    if (run->comm) { /* every copy of a node gets the whole mesh's sums */
+        if (mean_stage)
+            getme__dist_node_or(run, run->in_t);
+        getme__dist_node_sum(run, run->facc, 4);
     }
     compute_new_nodes(run);
     if (!mean_stage) {
@@ -328,6 +448,14 @@ static getme_status iterate(getme_run *run, int mean_stage, double qt,
             run->qold[k] = run->q[run->elems[k]];
     }
     *num_relaxed = getme__relax(run, R, nR);
+    if (run->comm) { /* counts of the whole mesh, each node once */
+        int64_t c[2] = {*num_transformed, 0};
+        for (int32_t k = 0; k < run->num_nodes; k++)
+            c[1] += run->counted[run->nodes[k]] && run->ridx[run->nodes[k]];
+        getme__dist_sum_i64(run, c, 2);
+        *num_transformed = (int32_t)c[0];
+        *num_relaxed = (int32_t)c[1];
+    }
     getme__reset_nodes(run);
     return mean_stage ? GETME_OK : update_after(run, qt);
 }
@@ -390,11 +518,16 @@ static inline uint64_t bits_of(double v)
    patterns sort like their values; a histogram of the top 16 bits, then
    of the next 16 inside the chosen bin, leaves a handful of candidates for
    the quickselect.  Returns -1 if out of memory. */
-double getme__threshold(const getme_run *run, double fraction,
-                        int32_t min_count)
+double getme__threshold(getme_run *run, double fraction, int32_t min_count)
 {
     const getme_ws *ws = run->ws;
-    int32_t n = ws->num_free_elem;
+    int64_t n = ws->num_free_elem;
+    if (run->comm) { /* the free elements of the whole mesh */
+        n = 0;
+        for (int32_t e = 0; e < ws->ne; e++)
+            n += ws->free_elem[e] && run->owned[e];
+        getme__dist_sum_i64(run, &n, 1);
+    }
     if (n == 0)
         return 0.0;
     double pos = fraction * (double)n;
@@ -406,16 +539,21 @@ double getme__threshold(const getme_run *run, double fraction,
         return -1.0;
     uint64_t prefix = 0, mask = 0;
     int64_t in_bin = n;
-    for (int shift = 48; shift >= 32; shift -= 16) {
+    /* Distributed: the histograms are summed over processes, and two more
+       levels pin all 64 bits, so no process needs the candidates. */
+    int last = run->comm ? 0 : 32;
+    for (int shift = 48; shift >= last; shift -= 16) {
         memset(hist, 0, 65536 * sizeof *hist);
         for (int32_t e = 0; e < ws->ne; e++) {
             uint64_t b = bits_of(run->q[e]);
-            if (ws->free_elem[e] && (b & mask) == prefix)
+            if (ws->free_elem[e] && getme__owned(run, e) &&
+                (b & mask) == prefix)
                 hist[(b >> shift) & 0xffff]++;
         }
+        getme__dist_sum_i64(run, hist, 65536);
         int64_t below = 0;
         int bin = 0;
-        while (below + hist[bin] <= k)
+        while (bin < 65535 && below + hist[bin] <= k)
             below += hist[bin++];
         k -= below;
         in_bin = hist[bin];
@@ -423,6 +561,11 @@ double getme__threshold(const getme_run *run, double fraction,
         mask |= (uint64_t)0xffff << shift;
     }
     free(hist);
+    if (run->comm) {
+        double qt;
+        memcpy(&qt, &prefix, sizeof qt);
+        return qt;
+    }
     double *cand = malloc((size_t)in_bin * sizeof *cand);
     if (!cand)
         return -1.0;
@@ -443,7 +586,12 @@ static getme_status alloc_adaptive(getme_run *run)
     const getme_ws *ws = run->ws;
     size_t ne = (size_t)(ws->ne ? ws->ne : 1);
     run->tflag = calloc(ne, 1);
-    if (!run->tflag)
+    /* 64-byte aligned: a node's four sums are one cache line. */
+    size_t fbytes = (size_t)(ws->nn ? ws->nn : 1) * 4 * sizeof *run->facc;
+    run->facc = aligned_alloc(64, fbytes);
+    if (run->facc)
+        memset(run->facc, 0, fbytes);
+    if (!run->tflag || !run->facc)
         return GETME_ERR_NOMEM;
     if (run->adj->num_irregular == 0)
         return GETME_OK;
@@ -461,6 +609,8 @@ static void free_adaptive(getme_run *run)
     free(run->tlist);
     free(run->tflag);
     free(run->qold);
+    free(run->facc);
+    run->facc = NULL;
     run->qold = NULL, run->cap_qold = 0, run->cap_t = 0;
     if (run->stamps)
         for (int t = 0; t < run->ws->nt; t++)
@@ -489,13 +639,19 @@ getme_status getme__adaptive(getme_run *run)
     getme_result *res = run->result;
     double *best = NULL;
     getme_status st = alloc_adaptive(run);
-    if (st != GETME_OK)
+    if (st == GETME_OK) {
+        best = p->keep_best ? malloc((size_t)ws->nn * 3 * sizeof *best) : NULL;
+        if (p->keep_best && !best)
+            st = GETME_ERR_NOMEM;
+    }
+    /* Distributed: all processes stop if one has no memory (the others
+       would wait for it in the first hook). */
+    if (getme__dist_any(run, st != GETME_OK)) {
+        st = GETME_ERR_NOMEM;
         goto done;
-    st = GETME_ERR_NOMEM;
-    best = p->keep_best ? malloc((size_t)ws->nn * 3 * sizeof *best) : NULL;
-    if (p->keep_best && !best)
-        goto done;
+    }
     lists_all(run);
+    set_bounds(run);
     run->guard = p->corner_guard;
     set_corner_floor(run, p->corner_floor > res->corner_sj_initial
                               ? p->corner_floor
@@ -515,11 +671,15 @@ getme_status getme__adaptive(getme_run *run)
         int32_t ntrans, nrelax;
         getme_stage stage = state == MEAN_RUNNING ? GETME_STAGE_MEAN
                                                   : GETME_STAGE_MIN;
-        if ((st = iterate(run, state == MEAN_RUNNING, qt, R, nR, &ntrans,
-                          &nrelax)) != GETME_OK)
+        if ((st = iterate(run, state == MEAN_RUNNING, qt, q_min, R, nR,
+                          &ntrans, &nrelax)) != GETME_OK)
             break;
         double prev_mean = q_mean, prev_min = q_min;
-        getme__ws_summary(ws, run->q, &q_mean, &q_min, NULL);
+        getme__summary(run, &q_mean, &q_min, NULL);
+        if (run->comm_failed) {
+            st = GETME_ERR_COMM;
+            break;
+        }
         res->iterations = it;
         if (stage == GETME_STAGE_MEAN)
             res->iterations_mean++;
@@ -531,7 +691,8 @@ getme_status getme__adaptive(getme_run *run)
                 memcpy(best, ws->x, (size_t)ws->nn * 3 * sizeof *best);
         }
         if (getme__report(run, it, stage, res->cycles_min, q_min, q_mean, qt,
-                          ntrans, nrelax)) {
+                          ntrans, nrelax) &&
+            !run->comm) { /* distributed: every process must go on alike */
             res->stop_reason = GETME_STOP_CANCELLED;
             st = GETME_ERR_CANCELLED;
             break;
@@ -579,14 +740,31 @@ getme_status getme__adaptive(getme_run *run)
         /* Fixed nodes are equal in both copies, so this keeps them exact. */
         memcpy(ws->x, best, (size_t)ws->nn * 3 * sizeof *best);
         getme__ws_qualities(ws, run->q);
-        getme__ws_summary(ws, run->q, &q_mean, &q_min, NULL);
+        getme__summary(run, &q_mean, &q_min, NULL);
     }
-    if (st == GETME_OK && p->finish)
+    /* Distributed: getme_smooth_finish() runs it on the gathered mesh. */
+    if (st == GETME_OK && p->finish && !run->comm)
         st = getme__finish(run);
-    getme__ws_summary(ws, run->q, &res->q_mean, &res->q_min_star, &res->q_min);
+    getme__summary(run, &res->q_mean, &res->q_min_star, &res->q_min);
+    if (st == GETME_OK && run->comm_failed)
+        st = GETME_ERR_COMM;
     res->threshold = qt;
 done:
     free(best);
     free_adaptive(run);
+    return st;
+}
+
+getme_status getme__adaptive_finish(getme_run *run)
+{
+    const getme_params *p = run->params;
+    getme_result *res = run->result;
+    run->guard = p->corner_guard;
+    set_corner_floor(run, p->corner_floor > res->corner_sj_initial
+                              ? p->corner_floor
+                              : res->corner_sj_initial);
+    getme_status st = p->finish ? getme__finish(run) : GETME_OK;
+    getme__ws_summary(run->ws, run->q, &res->q_mean, &res->q_min_star,
+                      &res->q_min);
     return st;
 }

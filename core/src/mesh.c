@@ -23,6 +23,7 @@ const char *getme_status_string(getme_status status)
     case GETME_ERR_TOPOLOGY: return "bad connectivity";
     case GETME_ERR_STATE: return "call out of order";
     case GETME_ERR_CANCELLED: return "cancelled";
+    case GETME_ERR_COMM: return "communication failed";
     }
     return "unknown status";
 }
@@ -186,6 +187,19 @@ int32_t getme_mesh_num_elements_of_type(const getme_mesh *mesh,
         if (mesh->blocks[b].type == (int)type)
             n += mesh->blocks[b].count;
     return n;
+}
+
+int getme_mesh_get_element(const getme_mesh *mesh, int32_t e,
+                           getme_elem_type *type, int32_t *nodes)
+{
+    if (!mesh || !type || !nodes || e < 0 || e >= mesh->num_elements)
+        return 0;
+    int32_t local;
+    const getme_block *b = getme__find_block(mesh, e, &local);
+    int nv = getme__nv[b->type];
+    memcpy(nodes, b->conn + (size_t)local * nv, (size_t)nv * sizeof *nodes);
+    *type = (getme_elem_type)b->type;
+    return nv;
 }
 
 const double *getme_mesh_coords(const getme_mesh *mesh)

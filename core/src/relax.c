@@ -8,6 +8,8 @@
  */
 #include "smooth_internal.h"
 
+#include <stdlib.h>
+
 /* Eq. 10 for node i with table entry rho.  rho = 0 and rho = 1 are taken
    literally so that a reset node gets its old coordinates bit for bit. */
 static inline void place(getme_run *run, int32_t i, double rho)
@@ -57,17 +59,60 @@ static int32_t count_invalid(const getme_run *run)
     return bad;
 }
 
-/* The moving nodes of invalid elements that can still step down the table,
-   each once, into run->list (serial: few elements are invalid, and the
-   list order must not depend on the thread count). */
-static int32_t nodes_to_step(getme_run *run, int nR)
+/* The invalid elements of the list (q <= 0 at xnew), in list order, into
+   *bad (grown as needed; *cap its room).  Returns how many, or -1 if out of
+   memory.  Few elements are invalid, so after this one scan each step of
+   the table re-checks only them and the stars it touched, instead of
+   counting over the whole list again. */
+static int32_t list_invalid(const getme_run *run, int32_t **bad, int64_t *cap)
+{
+    int32_t n = count_invalid(run), m = 0;
+    if (n > *cap) {
+        int32_t *p = realloc(*bad, (size_t)n * 2 * sizeof *p);
+        if (!p)
+            return -1;
+        *bad = p;
+        *cap = 2 * (int64_t)n;
+    }
+    for (int32_t k = 0; m < n && k < run->num_elems; k++)
+        if (!(run->q[run->elems[k]] > 0.0))
+            (*bad)[m++] = run->elems[k];
+    return m;
+}
+
+/* Append element e to the bad list if it is invalid and not yet in it
+   (mark: bit 0x80 of eflag, cleared by the caller).  0, or -1 if out of
+   memory. */
+static int keep_if_invalid(getme_run *run, int32_t e, int32_t **bad,
+                           int32_t *n, int64_t *cap)
+{
+    if (run->q[e] > 0.0 || (run->eflag[e] & 0x80))
+        return 0;
+    if (*n >= *cap) {
+        int64_t c = 2 * *cap + 64;
+        int32_t *p = realloc(*bad, (size_t)c * sizeof *p);
+        if (!p)
+            return -1;
+        *bad = p;
+        *cap = c;
+    }
+    run->eflag[e] |= 0x80;
+    (*bad)[(*n)++] = e;
+    return 0;
+}
+
+/* The moving nodes of the invalid elements among bad[0..nbad) that can
+   still step down the table, each once, into run->list (serial: few elements
+   are invalid, and the list order must not depend on the thread count). */
+static int32_t nodes_to_step(getme_run *run, int nR, const int32_t *bad,
+                             int32_t nbad)
 {
     const getme_ws *ws = run->ws;
     int32_t m = 0;
-    for (int32_t k = 0; k < run->num_elems; k++) {
-        int32_t e = run->elems[k];
+    for (int32_t k = 0; k < nbad; k++) {
+        int32_t e = bad[k];
         if (run->q[e] > 0.0)
-            continue;
+            continue; /* the whole element list was passed (no memory) */
         int t = getme__ws_type(ws, e);
         const int32_t *c = getme__ws_nodes(ws, t, e);
         for (int i = 0; i < getme__nv[t]; i++) {
@@ -79,6 +124,89 @@ static int32_t nodes_to_step(getme_run *run, int nR)
         }
     }
     return m;
+}
+
+/* Step one node of the list down the table and re-evaluate the elements
+   of their stars (m nodes in run->list). */
+static void step_nodes(getme_run *run, const double *R, int32_t m)
+{
+    const getme_ws *ws = run->ws;
+    for (int32_t j = 0; j < m; j++) {
+        int32_t i = run->list[j];
+        run->ridx[i]++;
+        place(run, i, R[run->ridx[i]]);
+        run->flag[i] = 0;
+    }
+    for (int32_t j = 0; j < m; j++) {
+        int32_t i = run->list[j];
+        for (int64_t k = ws->star_ptr[i]; k < ws->star_ptr[i + 1]; k++)
+            run->q[ws->star[k]] = trial_quality(run, ws->star[k]);
+    }
+}
+
+/* Distributed: every part steps while any part has an invalid element, and
+   a node steps when any copy of it has an invalid element (the same steps
+   as one process takes, so the same bits).  Each round counts over the
+   whole list: the incremental list of steps_local would need the other
+   parts' lists too. */
+static void steps_dist(getme_run *run, const double *R, int nR)
+{
+    while (getme__dist_any(run, count_invalid(run) > 0)) {
+        nodes_to_step(run, nR, run->elems, run->num_elems);
+        int32_t m = getme__dist_step_list(run, nR);
+        if (!getme__dist_any(run, m > 0))
+            break; /* unreachable for a valid input, see getme__relax */
+        step_nodes(run, R, m);
+    }
+}
+
+/* One process: the invalid elements are listed once, then each step of
+   the table re-checks only them and the stars it re-evaluated. */
+static void steps_local(getme_run *run, const double *R, int nR)
+{
+    const getme_ws *ws = run->ws;
+    int64_t cap = 0;
+    int32_t *bad = NULL, *next = NULL;
+    int32_t nbad = list_invalid(run, &bad, &cap);
+    int64_t cap_next = cap;
+    if (nbad > 0 && !(next = malloc((size_t)cap * sizeof *next)))
+        nbad = -1;
+    while (nbad != 0) {
+        /* Out of memory for the lists: the whole list is the candidate
+           set (slower, same result). */
+        int32_t m = nbad > 0 ? nodes_to_step(run, nR, bad, nbad)
+                             : nodes_to_step(run, nR, run->elems,
+                                             run->num_elems);
+        if (m == 0)
+            break; /* unreachable for a valid input, see above */
+        step_nodes(run, R, m);
+        if (nbad < 0) {
+            nbad = count_invalid(run) > 0 ? -1 : 0;
+            continue;
+        }
+        /* Still invalid: some of the old ones, and elements of the stars
+           just re-evaluated (no other element changed). */
+        int32_t n = 0;
+        int fail = 0;
+        for (int32_t k = 0; k < nbad; k++)
+            fail |= keep_if_invalid(run, bad[k], &next, &n, &cap_next);
+        for (int32_t j = 0; j < m; j++) {
+            int32_t i = run->list[j];
+            for (int64_t k = ws->star_ptr[i]; k < ws->star_ptr[i + 1]; k++)
+                fail |= keep_if_invalid(run, ws->star[k], &next, &n,
+                                        &cap_next);
+        }
+        for (int32_t k = 0; k < n; k++)
+            run->eflag[next[k]] &= 0x7f;
+        int32_t *tmp = bad;
+        int64_t tcap = cap;
+        bad = next, cap = cap_next;
+        next = tmp, cap_next = tcap;
+        nbad = fail ? (count_invalid(run) > 0 ? -1 : 0) : n;
+    }
+    free(bad);
+    free(next);
+
 }
 
 int32_t getme__relax(getme_run *run, const double *R, int nR)
@@ -103,22 +231,10 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
        are re-evaluated.  An invalid element always has a node that can
        still step: with all its moving nodes at R's last entry 0 it would
        be back at its old, valid shape. */
-    while (count_invalid(run) > 0) {
-        int32_t m = nodes_to_step(run, nR);
-        if (m == 0)
-            break; /* unreachable for a valid input, see above */
-        for (int32_t j = 0; j < m; j++) {
-            int32_t i = run->list[j];
-            run->ridx[i]++;
-            place(run, i, R[run->ridx[i]]);
-            run->flag[i] = 0;
-        }
-        for (int32_t j = 0; j < m; j++) {
-            int32_t i = run->list[j];
-            for (int64_t k = ws->star_ptr[i]; k < ws->star_ptr[i + 1]; k++)
-                q[ws->star[k]] = trial_quality(run, ws->star[k]);
-        }
-    }
+    if (run->comm)
+        steps_dist(run, R, nR);
+    else
+        steps_local(run, R, nR);
 
     int32_t relaxed = 0;
 #pragma omp parallel for schedule(static) num_threads(nt) \

@@ -5,6 +5,7 @@
 #ifndef GETME_SMOOTH_INTERNAL_H
 #define GETME_SMOOTH_INTERNAL_H
 
+#include "exact.h"
 #include "workspace.h"
 
 /* Loops over fewer items than this run on one thread: in the q*_min stage
@@ -48,6 +49,18 @@ typedef struct getme_run {
     double *qold;       /* q*_min stage: qualities of run->elems before the
                            relaxation step (NULL: sums are recomputed)      */
     int64_t cap_qold;
+    /* GETMe's node sums in exact fixed point (exact.h, getme_adaptive.c):
+       per node sum w x' (3) and sum w, zero between iterations. */
+    getme_fx *facc;     /* 4 * nn                                          */
+    double xbound;      /* power of two >= |x'| of any transformed node    */
+    double star_bound;  /* power of two > any node's number of elements    */
+    double pscale, wscale; /* this iteration's scales of sum w x', sum w   */
+    int overflow;       /* a term exceeded xbound: the scatter is redone   */
+    /* Distributed runs only (getme_smooth_part, dist.c); NULL otherwise. */
+    const getme_comm *comm;
+    uint8_t *owned;     /* ne: element owned by this process (else ghost)  */
+    uint8_t *counted;   /* nn: node counted by this process                */
+    int comm_failed;    /* a hook failed: the loop stops (GETME_ERR_COMM)  */
     /* The corner guard (params.corner_guard): relaxation and the finishing
        step treat a hex/prism/pyramid/quad whose worst corner falls below
        min(its old value, corner_floor) like an invalid element. */
@@ -103,10 +116,15 @@ int getme__report(getme_run *run, int iteration, getme_stage stage, int cycle,
    run's arrays, so that its temporaries do not add to the peak). */
 getme_status getme__adaptive(getme_run *run);
 
+/* getme_smooth_finish(): the finishing step and the final statistics on a
+   workspace at the positions a distributed loop reached, set up as
+   getme__adaptive() sets it (corner guard and floor). */
+getme_status getme__adaptive_finish(getme_run *run);
+
 /* The quality at position fraction * n (at least min_count - 1, at most
    n - 1) of the sorted qualities of the free elements; 0 without free
    elements, -1 if out of memory (getme_adaptive.c). */
-double getme__threshold(const getme_run *run, double fraction,
+double getme__threshold(getme_run *run, double fraction,
                         int32_t min_count);
 
 /* Worst corner scaled Jacobian over the elements with corners (1 if none),
@@ -127,5 +145,33 @@ getme_status getme__untangle(getme_ws *ws, double *q,
 getme_status getme__untangle_message(getme_mesh *mesh,
                                      const getme_untangle_result *res);
 getme_status getme__laplace(getme_run *run);
+
+/* ---- distributed runs (dist.c); each is the local operation when
+   run->comm is NULL, so the single-process code calls them unchanged ---- */
+
+/* Element e counts here (owned, or not distributed). */
+static inline int getme__owned(const getme_run *run, int32_t e)
+{
+    return !run->owned || run->owned[e];
+}
+
+/* 1 if local is nonzero on any process. */
+int getme__dist_any(getme_run *run, int local);
+/* Each node's flag becomes the OR over its copies. */
+void getme__dist_node_or(getme_run *run, uint8_t *flags);
+/* Each node's per_node sums become the sums over its copies. */
+void getme__dist_node_sum(getme_run *run, getme_fx *v, int per_node);
+/* After relax's local choice of nodes to step (their run->flag set): the
+   flags ORed over copies, and run->list rebuilt from them in run->nodes
+   order; returns its length.  Every copy of a node then steps alike. */
+int32_t getme__dist_step_list(getme_run *run, int nR);
+/* In-place global sums and minima. */
+void getme__dist_sum_i64(getme_run *run, int64_t *v, int n);
+void getme__dist_min(getme_run *run, double *v, int n);
+/* q_mean, q*_min, q_min (may be NULL) of the whole mesh: sums over owned
+   elements (exact), minima over all local ones (a ghost is a copy of
+   another process's element, so it cannot change a global minimum). */
+void getme__summary(getme_run *run, double *q_mean, double *q_min_star,
+                    double *q_min);
 
 #endif /* GETME_SMOOTH_INTERNAL_H */

@@ -2,6 +2,7 @@
  * stats.c -- element qualities and the statistics the CLI, the Gmsh plugin
  * and the benchmark report (Gmsh-style histogram, q*_min, q_mean).
  */
+#include "exact.h"
 #include "internal.h"
 
 #include <stdlib.h>
@@ -19,6 +20,7 @@ getme_status getme_mesh_element_qualities(getme_mesh *mesh, double *q)
 #pragma omp parallel for schedule(static)
         for (int32_t e = 0; e < bl->count; e++) {
             double x[3 * GETME_MAX_NV];
+            getme__prefetch_local(mesh, bl, e + GETME_PREFETCH_AHEAD);
             getme__gather_local(mesh, bl, e, ysign, x);
             q[bl->first + e] = getme__quality(bl->type, x);
         }
@@ -27,7 +29,7 @@ getme_status getme_mesh_element_qualities(getme_mesh *mesh, double *q)
 }
 
 static void add_value(getme_quality_stats *s, double v, int has_free,
-                      int32_t e, double *sum)
+                      int32_t e, getme_ufx *sum)
 {
     s->num_elements++;
     if (!(v > 0.0)) {
@@ -39,7 +41,7 @@ static void add_value(getme_quality_stats *s, double v, int has_free,
         int bin = (int)(v * GETME_HIST_BINS);
         s->histogram[bin >= GETME_HIST_BINS ? GETME_HIST_BINS - 1 : bin]++;
     }
-    *sum += v;
+    *sum += (getme_ufx)getme__fx_q(v);
     if (v < s->q_min)
         s->q_min = v;
     if (v > s->q_max)
@@ -66,9 +68,9 @@ getme_status getme_mesh_quality_stats(getme_mesh *mesh, int type,
     if (!q)
         return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
     getme_mesh_element_qualities(mesh, q);
-    /* Serial in element order: the sum (hence q_mean) is the same for any
-       thread count. */
-    double sum = 0.0;
+    /* An exact fixed-point sum (exact.h): q_mean is the same bits for any
+       thread count and any order or split of the elements. */
+    getme_ufx sum = 0;
     for (int b = 0; b < mesh->num_blocks; b++) {
         const getme_block *bl = &mesh->blocks[b];
         if (type >= 0 && bl->type != type)
@@ -82,7 +84,9 @@ getme_status getme_mesh_quality_stats(getme_mesh *mesh, int type,
             add_value(s, q[bl->first + e], has_free, bl->first + e, &sum);
         }
     }
-    s->q_mean = s->num_elements ? sum / (double)s->num_elements : 0.0;
+    s->q_mean = s->num_elements ? getme__fx_double((getme_fx)sum, GETME_FX_QINV) /
+                                    (double)s->num_elements
+                              : 0.0;
     if (s->num_elements == 0)
         s->q_min = s->q_max = 0.0;
     free(q);

@@ -29,9 +29,10 @@
    hundreds of elements) takes the slower single-pass path. */
 #define MAX_UNION 1024
 
-static double union_weight(const getme_ws *ws, const double *q, int t,
-                           int32_t e, getme_stamp *st)
+static double union_weight(const getme_ws *ws, const getme_adj *adj,
+                           const double *q, int t, int32_t e, getme_stamp *st)
 {
+    const double qs = adj->qscale;
     const int32_t *c = getme__ws_nodes(ws, t, e);
     int nv = getme__nv[t];
     if (++st->now == 0) { /* wrapped after 2^32 elements: start afresh */
@@ -45,21 +46,22 @@ static double union_weight(const getme_ws *ws, const double *q, int t,
         total += ws->star_ptr[c[i] + 1] - ws->star_ptr[c[i]];
 
     if (total > MAX_UNION) {
-        double sum = 0.0;
+        uint64_t sum = 0; /* < nv 2^61: see getme__adj_nsum */
         int32_t count = 0;
         for (int i = 0; i < nv; i++)
             for (int64_t k = ws->star_ptr[c[i]]; k < ws->star_ptr[c[i] + 1]; k++) {
                 int32_t n = ws->star[k];
                 int fresh = mark[n] != now;
                 mark[n] = now;
-                sum += fresh ? q[n] : 0.0;
+                sum += fresh ? (uint64_t)getme__fx64(q[n], qs) : 0;
                 count += fresh;
             }
-        return sqrt(sum / ((double)count * q[e]));
+        return sqrt((double)sum * adj->qinv / ((double)count * q[e]));
     }
     /* Pass 1: the union's members, each once (branch-free append).
-       Pass 2: their qualities, summed in four independent chains so the
-       additions overlap; the order is fixed, so the result is too. */
+       Pass 2: their qualities, summed exactly in fixed point (exact.h), so
+       the result equals the inclusion-exclusion formula's (adjacency.h)
+       and does not depend on the order of the stars. */
     int32_t u[MAX_UNION];
     int32_t count = 0;
     for (int i = 0; i < nv; i++) {
@@ -72,20 +74,14 @@ static double union_weight(const getme_ws *ws, const double *q, int t,
             mark[n] = now;
         }
     }
-    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
-    int32_t k = 0;
-    for (; k + 4 <= count; k += 4) {
-        s0 += q[u[k]];
-        s1 += q[u[k + 1]];
-        s2 += q[u[k + 2]];
-        s3 += q[u[k + 3]];
-    }
-    for (; k < count; k++)
-        s0 += q[u[k]];
-    return sqrt(((s0 + s1) + (s2 + s3)) / ((double)count * q[e]));
+    uint64_t sum = 0; /* < nv 2^61: see getme__adj_nsum */
+    for (int32_t k = 0; k < count; k++)
+        sum += (uint64_t)getme__fx64(q[u[k]], qs);
+    return sqrt((double)sum * adj->qinv / ((double)count * q[e]));
 }
 
 double getme__weight_union(const getme_run *run, int t, int32_t e)
 {
-    return union_weight(run->ws, run->q, t, e, &run->stamps[omp_get_thread_num()]);
+    return union_weight(run->ws, run->adj, run->q, t, e,
+                        &run->stamps[omp_get_thread_num()]);
 }

@@ -2,6 +2,7 @@
  * workspace.c -- build the smoother's working copy of a mesh: locality
  * order, node stars, colour-blocks (see workspace.h for why).
  */
+#include "exact.h"
 #include "workspace.h"
 
 #include <math.h>
@@ -376,35 +377,21 @@ void getme__ws_qualities(const getme_ws *ws, double *q)
         q[e] = getme__ws_quality(ws, ws->x, e);
 }
 
-/* Chunk of the deterministic sum: fixed, so partial sums do not depend on
-   how many threads there are. */
-#define SUM_CHUNK 4096
-
+/* Exact fixed-point sum (exact.h): the same bits for any thread count and
+   any split of the elements; values in [-2, 2], n < 2^31 (its bound). */
 double getme__det_sum(const double *v, int32_t n, int nt)
 {
-    int32_t nc = (n + SUM_CHUNK - 1) / SUM_CHUNK;
-    double small[64];
-    double *part = nc <= 64 ? small : malloc((size_t)nc * sizeof *part);
-    if (!part) { /* no memory: a serial sum is just as deterministic */
-        double s = 0.0;
+    getme_ufx s = 0;
+#pragma omp parallel num_threads(nt)
+    {
+        getme_ufx part = 0;
+#pragma omp for schedule(static) nowait
         for (int32_t i = 0; i < n; i++)
-            s += v[i];
-        return s;
+            part += (getme_ufx)getme__fx_q(v[i]);
+#pragma omp critical(getme_det_sum)
+        s += part;
     }
-#pragma omp parallel for schedule(static) num_threads(nt)
-    for (int32_t c = 0; c < nc; c++) {
-        double s = 0.0;
-        int32_t end = (c + 1) * SUM_CHUNK < n ? (c + 1) * SUM_CHUNK : n;
-        for (int32_t i = c * SUM_CHUNK; i < end; i++)
-            s += v[i];
-        part[c] = s;
-    }
-    double s = 0.0;
-    for (int32_t c = 0; c < nc; c++)
-        s += part[c];
-    if (part != small)
-        free(part);
-    return s;
+    return getme__fx_double((getme_fx)s, GETME_FX_QINV);
 }
 
 void getme__ws_summary(const getme_ws *ws, const double *q, double *q_mean,

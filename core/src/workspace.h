@@ -129,7 +129,8 @@ getme_status getme__ws_faces(const getme_ws *ws, const int64_t *foff,
 /* Qualities of all elements at ws->x into q (parallel). */
 void getme__ws_qualities(const getme_ws *ws, double *q);
 
-/* Deterministic sum of q over [0, n) (fixed chunking, any thread count). */
+/* Sum of v over [0, n), exact in fixed point (exact.h) before its one
+   rounding: the same bits for any thread count and any order. */
 double getme__det_sum(const double *v, int32_t n, int nt);
 
 /* Count, q_mean and q*_min (over free elements) of q. */

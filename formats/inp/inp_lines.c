@@ -4,6 +4,7 @@
  * size is read with constant memory for its text.
  */
 #include "inp_internal.h"
+#include "numparse.h"
 
 #include <errno.h>
 #include <math.h>
@@ -190,7 +191,7 @@ int inp_parse_real(const inp_field *f, double *v)
     tmp[f->n] = '\0';
     char *endp;
     errno = 0;
-    double x = strtod(tmp, &endp);
+    double x = numparse_strtod(tmp, &endp);
     if (endp != tmp + f->n || !isfinite(x))
         return -1;
     *v = x;

@@ -124,22 +124,33 @@ static int is_space(int c)
 
 void msh41_in_skip_space(msh41_input *in)
 {
-    int c;
-    while ((c = msh41_in_peek(in)) >= 0 && is_space(c))
-        msh41_in_getc(in);
+    for (;;) {
+        /* Inside the buffer without a call per byte; refill at its end. */
+        while (in->pos < in->len && is_space(in->buf[in->pos]))
+            in->line += in->buf[in->pos++] == '\n';
+        if (in->pos < in->len || refill(in))
+            return;
+    }
 }
 
 int msh41_in_token(msh41_input *in, char *tok, size_t size)
 {
     msh41_in_skip_space(in);
     size_t n = 0;
-    int c, too_long = 0;
-    while ((c = msh41_in_peek(in)) >= 0 && !is_space(c)) {
-        if (n + 1 < size)
-            tok[n++] = (char)c;
-        else
-            too_long = 1;
-        in->pos++;
+    int too_long = 0;
+    for (;;) {
+        size_t pos = in->pos, len = in->len;
+        const unsigned char *b = in->buf;
+        while (pos < len && !is_space(b[pos])) {
+            if (n + 1 < size)
+                tok[n++] = (char)b[pos];
+            else
+                too_long = 1;
+            pos++;
+        }
+        in->pos = pos;
+        if (pos < len || refill(in))
+            break;
     }
     tok[n] = 0;
     return too_long ? -1 : (int)n;

@@ -14,6 +14,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "msh41_internal.h"
+#include "numparse.h"
 
 #include <errno.h>
 #include <math.h>
@@ -173,7 +174,7 @@ static getme_io_status read_double(msh41_reader *r, double *v)
     if (st != GETME_IO_OK)
         return st;
     errno = 0;
-    *v = strtod(tok, &end);
+    *v = numparse_strtod(tok, &end);
     if (*end || end == tok)
         return msh41_fail(r, GETME_IO_ERR_PARSE, "bad number '%s' in $%s",
                           tok, r->section);

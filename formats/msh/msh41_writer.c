@@ -18,6 +18,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "msh41_internal.h"
+#include "numparse.h"
 
 #include <errno.h>
 #include <stdlib.h>
@@ -139,7 +140,7 @@ static int format_double(double v, char *buf, size_t size)
     int n = 0;
     for (int prec = 15; prec <= 17; prec++) {
         n = snprintf(buf, size, "%.*g", prec, v);
-        if (strtod(buf, NULL) == v)
+        if (numparse_strtod(buf, NULL) == v)
             break;
     }
     return n;
@@ -170,7 +171,7 @@ static int ascii_coord_line(writer *w, uint64_t tag)
     size_t prefix = (size_t)(p - line); /* the tag's text, kept */
     double old[3];
     for (int k = 0; k < 3; k++, p = end) {
-        old[k] = strtod(p, &end);
+        old[k] = numparse_strtod(p, &end);
         if (end == p)
             return -1;
     }

@@ -15,27 +15,81 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Mark the nodes classified on entity (dim, tag) as free (OWN). */
+static void own_nodes(int dim, int tag, const getme__nodemap *all,
+                      uint8_t *flags)
+{
+    size_t *tags = NULL, nt = 0, nc = 0, np = 0;
+    double *coord = NULL, *param = NULL;
+    int ierr = 0;
+    gmshModelMeshGetNodes(&tags, &nt, &coord, &nc, &param, &np, dim, tag, 0,
+                          0, &ierr);
+    for (size_t i = 0; !ierr && i < nt; i++) {
+        int32_t k = getme__nodemap_find(all, tags[i]);
+        if (k >= 0)
+            flags[k] |= GETME__NODE_OWN;
+    }
+    gmshFree(tags);
+    gmshFree(coord);
+    gmshFree(param);
+}
+
+/* The model entity a partitioned entity (gmsh -part) belongs to, or the
+   entity itself when it has no parent. */
+static void parent_of(int dim, int tag, int *pdim, int *ptag)
+{
+    int ierr = 0;
+    *pdim = -1;
+    *ptag = -1;
+    gmshModelGetParent(dim, tag, pdim, ptag, &ierr);
+    if (ierr || *pdim < 0) {
+        *pdim = dim;
+        *ptag = tag;
+    }
+}
+
 getme_status gg_fix_classified(const getme_gmsh_model *model,
                                const getme__nodemap *all, uint8_t *flags,
                                gg_msg *msg)
 {
-    (void)msg;
+    for (int e = 0; e < model->num_entities; e++)
+        own_nodes(model->entities[2 * e], model->entities[2 * e + 1], all,
+                  flags);
+    /* A partitioned model (gmsh -part): the boundaries between partitions
+       are entities of lower dimension whose parent is a smoothed entity
+       (the volume they cut), not a model surface or curve.  They are no
+       geometry: their nodes move as the rest of the volume's.  Pieces of
+       model surfaces and curves have those as parents and stay fixed. */
+    int *parents = malloc(((size_t)model->num_entities + 1) * sizeof *parents);
+    if (!parents)
+        return gg_fail(msg, GETME_ERR_NOMEM, "Out of memory");
+    int np = 0;
     for (int e = 0; e < model->num_entities; e++) {
-        size_t *tags = NULL, nt = 0, nc = 0, np = 0;
-        double *coord = NULL, *param = NULL;
-        int ierr = 0;
-        gmshModelMeshGetNodes(&tags, &nt, &coord, &nc, &param, &np,
-                              model->entities[2 * e],
-                              model->entities[2 * e + 1], 0, 0, &ierr);
-        for (size_t i = 0; !ierr && i < nt; i++) {
-            int32_t k = getme__nodemap_find(all, tags[i]);
-            if (k >= 0)
-                flags[k] |= GETME__NODE_OWN;
-        }
-        gmshFree(tags);
-        gmshFree(coord);
-        gmshFree(param);
+        int sdim, stag;
+        parent_of(model->entities[2 * e], model->entities[2 * e + 1], &sdim,
+                  &stag);
+        if (sdim == model->dim)
+            parents[np++] = stag;
     }
+    int *dt = NULL;
+    size_t n = 0;
+    int ierr = 0;
+    gmshModelGetEntities(&dt, &n, -1, &ierr);
+    for (size_t i = 0; !ierr && np && i + 1 < n; i += 2) {
+        if (dt[i] >= model->dim)
+            continue;
+        int pdim, ptag;
+        parent_of(dt[i], dt[i + 1], &pdim, &ptag);
+        if (pdim != model->dim)
+            continue;
+        for (int e = 0; e < np; e++)
+            if (parents[e] == ptag) {
+                own_nodes(dt[i], dt[i + 1], all, flags);
+                break;
+            }
+    }
+    free(parents);
+    gmshFree(dt);
     return GETME_OK;
 }
 

@@ -1,0 +1,574 @@
+/*
+ * getme_mpi.c -- `mpirun -np N getme-mpi smooth IN -o OUT [options]`:
+ * distributed GETMe adaptive (docs/distributed.md).
+ *
+ * The options are `getme smooth`'s, parsed by the same code (cli/,
+ * libgetme_cli_common): --fix, --free, --free-interfaces, --param,
+ * --max-iter, --threads, --no-untangle, --allow-invalid, --report, --worst,
+ * -v, -q.  Rank 0 reads IN through libgetme_formats (fixed nodes by the
+ * same rules as `getme smooth`), untangles it if needed as `getme smooth`
+ * does, splits it with METIS and sends every rank its part; all ranks run
+ * getme_smooth_part(); rank 0 gathers the positions, runs the finishing
+ * step (getme_smooth_finish) and writes OUT, the same bytes as
+ * `getme smooth IN -o OUT` writes with the same options.  A failure on any
+ * rank stops every rank with one error line from rank 0 and no output.
+ *
+ * Exit codes: those of `getme smooth` (cli.h); 1 also when a rank fails
+ * (smoothing, communication).
+ */
+#include "dist.h"
+#include "cli.h"
+
+#include <errno.h>
+#include <omp.h>
+#include <sys/resource.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct args {
+    const char *input, *output;
+    long worst;
+    cli_smooth_opts o;
+} args;
+
+typedef struct run_state {
+    dist_ctx *c;
+    args *a;
+    int64_t last_bytes;
+    double last_seconds;
+} run_state;
+
+static const char HELP_HEAD[] =
+    "usage: mpirun -np N getme-mpi smooth IN -o OUT [options]\n"
+    "\n"
+    "Distributed GETMe adaptive: rank 0 reads IN (.msh, .inp, .cgns), splits\n"
+    "it with METIS, every rank smooths its part with one ghost layer, rank 0\n"
+    "gathers the positions, runs the finishing step and writes OUT -- the\n"
+    "same bytes as `getme smooth IN -o OUT` with the same options, for any N\n"
+    "and any thread count. Fixed nodes follow getme smooth's rules.\n"
+    "Volume meshes only: a planar mesh (triangles, quads) is refused (exit 5;\n"
+    "smooth it with getme smooth).\n"
+    "\n"
+    "options (as getme smooth's; --threads is per rank, default 1; -v adds\n"
+    "the communication volume and time per iteration and per rank;\n"
+    "--method laplace is not distributed):\n"
+    "  -o, --output FILE      output file (required; the input's format)\n"
+    "  --worst N              list the N worst elements after smoothing\n"
+    "                         (default 10; printed with -v, always in\n"
+    "                         --report)\n";
+
+/* Every rank parses argv the same way; only rank 0 prints.  0 to run, -1
+   after --help, else the exit code. */
+static int parse(int argc, char **argv, args *a)
+{
+    a->worst = 10;
+    if (cli_smooth_opts_init(&a->o, argc) != 0)
+        return CLI_EXIT_INTERNAL;
+    if (argc >= 2 && (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help"))) {
+        fputs(HELP_HEAD, stdout);
+        fputs(CLI_SMOOTH_OPTIONS_HELP, stdout);
+        cli_print_params(stdout);
+        return -1;
+    }
+    if (argc < 2 || strcmp(argv[1], "smooth") != 0) {
+        cli_error("usage: mpirun -np N getme-mpi smooth IN -o OUT [options] "
+                  "(see getme-mpi --help)");
+        return EXIT_USAGE;
+    }
+    for (int i = 2; i < argc; i++) {
+        const char *o = argv[i];
+        int r = cli_smooth_option(&a->o, argc, argv, &i);
+        if (r < 0)
+            return EXIT_USAGE;
+        if (r > 0)
+            continue;
+        if (!strcmp(o, "-h") || !strcmp(o, "--help")) {
+            fputs(HELP_HEAD, stdout);
+            fputs(CLI_SMOOTH_OPTIONS_HELP, stdout);
+            cli_print_params(stdout);
+            return -1;
+        } else if (!strcmp(o, "-o") || !strcmp(o, "--output") ||
+                   !strcmp(o, "--worst")) {
+            if (i + 1 >= argc) {
+                cli_error("%s needs a value (see getme-mpi --help)", o);
+                return EXIT_USAGE;
+            }
+            if (o[2] != 'w')
+                a->output = argv[++i];
+            else if (cli_parse_int(o, argv[++i], 0, 1000000, &a->worst) != 0)
+                return EXIT_USAGE;
+        } else if (o[0] == '-' && o[1]) {
+            cli_error("unknown option '%s' (see getme-mpi --help)", o);
+            return EXIT_USAGE;
+        } else if (!a->input) {
+            a->input = o;
+        } else {
+            cli_error("unexpected argument '%s': one input file only", o);
+            return EXIT_USAGE;
+        }
+    }
+    if (!a->input || !a->output) {
+        cli_error("getme-mpi smooth needs an input file and -o OUTPUT "
+                  "(see getme-mpi --help)");
+        return EXIT_USAGE;
+    }
+    if (a->o.params.method != GETME_METHOD_ADAPTIVE) {
+        cli_error("--method laplace: getme-mpi runs GETMe adaptive only "
+                  "(use getme smooth for smart Laplace)");
+        return EXIT_USAGE;
+    }
+    if (!a->o.params.num_threads) /* per rank: ranks already share cores */
+        a->o.params.num_threads = 1;
+    return 0;
+}
+
+/* Per iteration, on every rank with the same values: rank 0 logs the line
+   of getme smooth and keeps the history (--report); with -v the
+   communication counters are reduced (collective) and logged. */
+static int on_progress(const getme_progress *p, void *data)
+{
+    run_state *s = data;
+    dist_ctx *c = s->c;
+    if (c->rank == 0)
+        cli_smooth_progress(p, &s->a->o);
+    if (!s->a->o.log.verbose)
+        return 0;
+    double v[2] = {(double)(c->bytes_sent + c->bytes_reduced), c->comm_seconds};
+    double bytes = 0.0, secs = 0.0;
+    MPI_Reduce(&v[0], &bytes, 1, MPI_DOUBLE, MPI_SUM, 0, c->comm);
+    MPI_Reduce(&v[1], &secs, 1, MPI_DOUBLE, MPI_MAX, 0, c->comm);
+    cli_info(&s->a->o.log, "It %4d: comm %.1f KiB, %.2f ms", p->iteration,
+             (bytes - (double)s->last_bytes) / 1024.0,
+             1e3 * (secs - s->last_seconds));
+    s->last_bytes = (int64_t)bytes;
+    s->last_seconds = secs;
+    return 0;
+}
+
+/* The part as a core mesh (nodes and elements in the part's order). */
+static getme_status build_part(const dist_ctx *c, getme_mesh **out)
+{
+    getme_status st = getme_mesh_create(out, 3, c->nn, c->coords);
+    if (st != GETME_OK)
+        return st;
+    int64_t off = 0;
+    for (int32_t e = 0; e < c->ne && st == GETME_OK;) {
+        int32_t e1 = e; /* a run of one type */
+        int64_t end = off;
+        while (e1 < c->ne && c->etype[e1] == c->etype[e]) {
+            end += getme_type_num_nodes((getme_elem_type)c->etype[e1]);
+            e1++;
+        }
+        st = getme_mesh_add_elements(*out, (getme_elem_type)c->etype[e],
+                                     e1 - e, c->conn + off, NULL);
+        off = end;
+        e = e1;
+    }
+    if (st == GETME_OK)
+        st = getme_mesh_set_fixed_mask(*out, c->fixed);
+    return st;
+}
+
+/* The lowest failing rank's message to rank 0; every rank learns whether
+   any failed (returns the failing rank, or -1). */
+static int agree(dist_ctx *c, int failed, const char *msg, char *out,
+                 size_t size)
+{
+    int mine = failed ? c->rank : c->size, first = c->size;
+    MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, c->comm);
+    if (first == c->size)
+        return -1;
+    if (first != 0) {
+        if (c->rank == first)
+            MPI_Send(msg, (int)strlen(msg) + 1, MPI_CHAR, 0, 99, c->comm);
+        if (c->rank == 0)
+            MPI_Recv(out, (int)size, MPI_CHAR, first, 99, c->comm,
+                     MPI_STATUS_IGNORE);
+    } else if (c->rank == 0) {
+        snprintf(out, size, "%s", msg);
+    }
+    return first;
+}
+
+/* Rank 0 before the split: check the paths, read, untangle.  0 to go on,
+   else the exit code (the error printed). */
+static int read_input(args *a, cli_paths *paths, int size, getme_doc **doc,
+                      getme_quality_stats *before, cli_measures *mbefore,
+                      getme_untangle_result *ur)
+{
+    cli_smooth_opts *so = &a->o;
+    const cli_log *log = &so->log;
+    int code = cli_check_paths(paths);
+    if (code)
+        return code;
+    getme_doc_options opts;
+    cli_smooth_doc_options(so, &opts);
+    double t0 = omp_get_wtime();
+    cli_info(log, "Reading '%s' on rank 0 of %d...", a->input, size);
+    *doc = cli_open(a->input, &opts, so->params.untangle, &code, log);
+    if (!*doc)
+        return code;
+    if ((code = cli_check_read_files(paths, *doc)) != 0)
+        return code;
+    getme_mesh *mesh = getme_doc_mesh(*doc);
+    if (getme_mesh_dim(mesh) != 3) {
+        /* a planar mesh's mirror detection (which side of its plane is
+           up) is a decision over the whole mesh that the parts do not
+           share yet; the split is also built for volumes (METIS dual
+           graph over faces, 3 common nodes) */
+        cli_error("%s: planar meshes (triangles, quads) are not distributed "
+                  "by getme-mpi (their orientation is decided on the whole "
+                  "mesh); smooth them with getme smooth", a->input);
+        return CLI_EXIT_UNSUPPORTED;
+    }
+    char desc[256];
+    cli_describe_mesh(mesh, desc, sizeof desc);
+    cli_info(log, "Done reading '%s' (%s, %.2f s): %s", a->input,
+             getme_format_name(getme_doc_format(*doc)), omp_get_wtime() - t0,
+             desc);
+    if (getme_doc_info(*doc)[0])
+        cli_info(log, "%s", getme_doc_info(*doc));
+    *before = *getme_doc_stats(*doc);
+    cli_print_stats(log, "Quality before", before);
+    cli_measures_log(log, mesh, "Measures before", mbefore);
+    cli_ho_log(log, *doc, "before", NULL);
+    if (before->num_invalid > 0 &&
+        (code = cli_untangle(so, a->input, *doc, ur)) != 0) {
+        if (code == CLI_EXIT_TANGLED && so->allow_invalid) {
+            cli_guard guard = {0};
+            cli_write_guard(&guard, 1);
+            cli_info(log, "Writing partly untangled, not smoothed, '%s'...",
+                     a->output);
+            getme_formats_status ws = getme_doc_write(*doc, paths->out);
+            if (ws != GETME_FORMATS_OK)
+                cli_error("%s", getme_doc_error(*doc));
+            cli_write_guard(&guard, 0);
+        }
+        return code;
+    }
+    return 0;
+}
+
+/* Rank 0 after the finishing step: log, write OUT and the report.  The
+   exit code. */
+static int finish_output(args *a, const cli_paths *paths, getme_doc *doc,
+                         const getme_quality_stats *before,
+                         const cli_measures *mbefore, const getme_result *res)
+{
+    cli_smooth_opts *so = &a->o;
+    const cli_log *log = &so->log;
+    getme_mesh *mesh = getme_doc_mesh(doc);
+    getme_quality_stats after;
+    cli_measures mafter;
+    cli_smooth_done(so, res);
+    getme_mesh_quality_stats(mesh, -1, &after);
+    cli_print_stats(log, "Quality after ", &after);
+    cli_measures_log(log, mesh, "Measures after ", &mafter);
+    cli_ho_log(log, doc, "after", NULL);
+    if (res->corner_sj_initial < 1.0 || res->corner_sj < 1.0)
+        cli_info(log, "Worst corner scaled Jacobian (hex, prism, pyramid, "
+                      "quad): %.4f before, %.4f after",
+                 res->corner_sj_initial, res->corner_sj);
+    cli_worst_list worst = {0}, worst_free = {0};
+    int code = 0;
+    if (cli_worst(doc, (int32_t)a->worst, 0, &worst) != 0 ||
+        cli_worst(doc, (int32_t)a->worst, GETME_WORST_FREE_ONLY,
+                  &worst_free) != 0) {
+        code = CLI_EXIT_INTERNAL;
+        goto out;
+    }
+    int fixed_worst = after.num_free > 0 && after.q_min < after.q_min_star;
+    if (fixed_worst)
+        cli_warning(log, "qmin %.4f is below q*min %.4f: the worst elements "
+                         "have no free node, no node move can fix them "
+                         "(see --worst, -v)",
+                    after.q_min, after.q_min_star);
+    if (log->verbose) {
+        cli_print_worst(log, doc, &worst, "");
+        if (fixed_worst)
+            cli_print_worst(log, doc, &worst_free, " with a free node");
+    }
+    cli_guard guard = {0};
+    cli_write_guard(&guard, 1);
+    cli_file_stamp report_was;
+    cli_stamp(paths->rep, &report_was);
+    cli_info(log, "Writing '%s'...", a->output);
+    getme_formats_status ws = getme_doc_write(doc, paths->out);
+    if (ws != GETME_FORMATS_OK) {
+        cli_error("%s", getme_doc_error(doc));
+        code = cli_exit_code(ws);
+    } else if (so->report && cli_replaced(paths->rep, &report_was)) {
+        cli_error("report %s: it is a file the output just wrote; not "
+                  "replacing it (choose another report file)", so->report);
+        code = EXIT_USAGE;
+    } else {
+        cli_info(log, "Done writing '%s'", a->output);
+        cli_mesh_counts counts;
+        cli_count_mesh(mesh, &counts);
+        cli_report_extra extra = {doc,     &worst, &worst_free,
+                                  mbefore, &mafter, NULL, NULL};
+        if (so->report &&
+            cli_write_report(paths->rep, a->input, a->output, &so->params,
+                             &counts, before, &after, res, &so->history,
+                             getme_format_name(getme_doc_format(doc)),
+                             &extra) != 0) {
+            cli_error("%s: cannot write the report: %s", so->report,
+                      strerror(errno));
+            code = CLI_EXIT_WRITE;
+        }
+    }
+    cli_write_guard(&guard, 0);
+out:
+    free(worst.items);
+    free(worst_free.items);
+    return code;
+}
+
+int main(int argc, char **argv)
+{
+    MPI_Init(&argc, &argv);
+    dist_ctx c;
+    memset(&c, 0, sizeof c);
+    c.comm = MPI_COMM_WORLD;
+    c.t128 = MPI_DATATYPE_NULL;
+    c.op128 = MPI_OP_NULL;
+    MPI_Comm_rank(c.comm, &c.rank);
+    MPI_Comm_size(c.comm, &c.size);
+    args a;
+    memset(&a, 0, sizeof a);
+    /* rank 0 parses (and prints any error or --help) first; the others
+       parse the same argv only when it succeeded, silently */
+    int code = c.rank == 0 ? parse(argc, argv, &a) : 0;
+    MPI_Bcast(&code, 1, MPI_INT, 0, c.comm);
+    if (code == 0 && c.rank != 0)
+        code = parse(argc, argv, &a);
+    if (code != 0) {
+        cli_smooth_opts_free(&a.o);
+        MPI_Finalize();
+        return code < 0 ? 0 : code;
+    }
+    if (c.rank != 0)
+        a.o.log.quiet = 1; /* rank 0 logs; errors reach it (agree) */
+    cli_smooth_opts *so = &a.o;
+    const cli_log *log = &so->log;
+    double t0 = MPI_Wtime();
+    char err[1200] = "", msg[1200] = "";
+    getme_doc *doc = NULL;
+    getme_mesh *part = NULL;
+    double *xyz = NULL;
+    getme_result res;
+    memset(&res, 0, sizeof res);
+    getme_quality_stats before;
+    cli_measures mbefore;
+    getme_untangle_result ur;
+    memset(&ur, 0, sizeof ur);
+    cli_paths paths = {a.input, a.output, so->report, "", ""};
+
+    /* 1. rank 0 reads, checks the paths, untangles if needed, splits */
+    if (c.rank == 0) {
+        code = read_input(&a, &paths, c.size, &doc, &before, &mbefore, &ur);
+        if (code != 0) {
+            dist_go(&c, code);
+            goto out;
+        }
+        getme_mesh *mesh = getme_doc_mesh(doc);
+        double tp = MPI_Wtime();
+        if (dist_partition_send(mesh, &c, err, sizeof err) != 0) {
+            cli_error("%s: %s", a.input, err);
+            MPI_Abort(c.comm, 1); /* ranks may be waiting for parts */
+        }
+        cli_info(log, "Split into %d parts with METIS in %.2f s: %lld "
+                 "interface nodes, %lld ghost elements",
+                 c.size, MPI_Wtime() - tp, (long long)c.interface_nodes,
+                 (long long)c.ghost_elements);
+    } else {
+        int r = dist_partition_recv(&c);
+        if (r == -2) { /* rank 0 could not read: it said why */
+            code = c.exit_code;
+            goto out;
+        }
+        if (r != 0)
+            snprintf(msg, sizeof msg, "cannot receive its part");
+    }
+
+    /* 2. every rank builds its part; any failure stops all */
+    {
+        const char *fail = getenv("GETME_MPI_FAIL_RANK");
+        if (!msg[0] && fail && atoi(fail) == c.rank)
+            snprintf(msg, sizeof msg, "cannot read its part (failure "
+                     "injected by GETME_MPI_FAIL_RANK)");
+        getme_status st = GETME_OK;
+        if (!msg[0] && (st = build_part(&c, &part)) != GETME_OK)
+            snprintf(msg, sizeof msg, "building its part: %s",
+                     part ? getme_mesh_error(part) : getme_status_string(st));
+        if (!msg[0] && dist_comm_init(&c) != 0)
+            snprintf(msg, sizeof msg, "out of memory for communication");
+        int first = agree(&c, msg[0] != 0, msg, err, sizeof err);
+        if (first >= 0) {
+            if (c.rank == 0)
+                cli_error("rank %d of %d: %s; no output written", first,
+                          c.size, err);
+            code = 1;
+            goto out;
+        }
+    }
+
+    /* 3. smooth */
+    getme_params params = so->params;
+    run_state rs = {&c, &a, 0, 0.0};
+    params.progress = on_progress;
+    params.progress_data = &rs;
+    getme_comm hooks;
+    dist_comm_hooks(&c, &hooks);
+    int threads = params.num_threads;
+    cli_info(log, "Optimizing mesh (GETMe adaptive, %d ranks, %d thread%s "
+             "each)...", c.size, threads, threads == 1 ? "" : "s");
+    double ts = MPI_Wtime();
+    getme_status st = getme_smooth_part(part, &params, &hooks, &res);
+    if (st != GETME_OK)
+        snprintf(msg, sizeof msg, "smoothing: %s", getme_mesh_error(part));
+    int first = agree(&c, st != GETME_OK, msg, err, sizeof err);
+    if (first >= 0) {
+        if (c.rank == 0)
+            cli_error("rank %d of %d: %s; no output written", first, c.size,
+                      err);
+        code = 1;
+        goto out;
+    }
+    double loop_seconds = MPI_Wtime() - ts;
+    if (log->verbose) { /* per rank: the benchmark's numbers (bench/mpi.py) */
+        struct rusage ru;
+        getrusage(RUSAGE_SELF, &ru);
+        int64_t owned = 0;
+        for (int32_t e = 0; e < c.ne; e++)
+            owned += c.owned[e];
+        double mine[9] = {(double)c.ne, (double)owned, (double)c.nn,
+                          c.nb_ptr ? (double)c.nb_ptr[c.num_nb] : 0.0,
+                          loop_seconds, c.comm_seconds,
+                          (double)c.bytes_sent, (double)c.bytes_reduced,
+                          (double)ru.ru_maxrss / 1024.0};
+        double *all = c.rank == 0 ? malloc((size_t)c.size * sizeof mine) : NULL;
+        MPI_Gather(mine, 9, MPI_DOUBLE, all, 9, MPI_DOUBLE, 0, c.comm);
+        for (int r = 0; all && r < c.size; r++) {
+            const double *v = all + 9 * r;
+            cli_info(log, "Rank %d: %.0f elements (%.0f owned), %.0f nodes "
+                     "(%.0f shared copies), loop %.3f s, comm %.3f s, sent "
+                     "%.3f MiB, reduced %.3f MiB, max RSS %.1f MiB",
+                     r, v[0], v[1], v[2], v[3], v[4], v[5], v[6] / 1048576.0,
+                     v[7] / 1048576.0, v[8]);
+        }
+        free(all);
+    }
+    /* 4. gather the counted nodes' positions on rank 0 */
+    {
+        const double *x = getme_mesh_coords(part);
+        int n = 0;
+        for (int32_t i = 0; i < c.nn; i++)
+            n += c.counted[i];
+        int32_t *ids = malloc((size_t)(n ? n : 1) * sizeof *ids);
+        double *pos = malloc((size_t)(n ? n : 1) * 3 * sizeof *pos);
+        int ok = ids && pos;
+        for (int32_t i = 0, k = 0; ok && i < c.nn; i++)
+            if (c.counted[i]) {
+                ids[k] = c.gid[i];
+                memcpy(pos + 3 * (size_t)k++, x + 3 * (size_t)i,
+                       3 * sizeof *x);
+            }
+        int *counts = NULL, *displs = NULL, *c3 = NULL, *d3 = NULL;
+        int32_t *all_ids = NULL;
+        double *all_pos = NULL;
+        if (c.rank == 0) {
+            counts = calloc((size_t)c.size, sizeof *counts);
+            displs = calloc((size_t)c.size, sizeof *displs);
+            c3 = calloc((size_t)c.size, sizeof *c3);
+            d3 = calloc((size_t)c.size, sizeof *d3);
+            ok = ok && counts && displs && c3 && d3;
+        }
+        int okall = 0;
+        MPI_Allreduce(&ok, &okall, 1, MPI_INT, MPI_LAND, c.comm);
+        if (!okall) {
+            if (c.rank == 0)
+                fprintf(stderr, "Error   : out of memory gathering the "
+                                "positions; no output written\n");
+            free(ids), free(pos), free(counts), free(displs), free(c3),
+                free(d3);
+            code = 1;
+            goto out;
+        }
+        MPI_Gather(&n, 1, MPI_INT, counts, 1, MPI_INT, 0, c.comm);
+        int total = 0;
+        if (c.rank == 0) {
+            for (int r = 0; r < c.size; r++) {
+                displs[r] = total;
+                c3[r] = 3 * counts[r];
+                d3[r] = 3 * total;
+                total += counts[r];
+            }
+            all_ids = malloc((size_t)(total ? total : 1) * sizeof *all_ids);
+            all_pos = malloc((size_t)(total ? total : 1) * 3 * sizeof *all_pos);
+            if (!all_ids || !all_pos) {
+                fprintf(stderr, "Error   : out of memory gathering\n");
+                MPI_Abort(c.comm, 1);
+            }
+        }
+        MPI_Gatherv(ids, n, MPI_INT32_T, all_ids, counts, displs, MPI_INT32_T,
+                    0, c.comm);
+        MPI_Gatherv(pos, 3 * n, MPI_DOUBLE, all_pos, c3, d3, MPI_DOUBLE, 0,
+                    c.comm);
+        if (c.rank == 0) {
+            getme_mesh *mesh = getme_doc_mesh(doc);
+            int32_t gnn = getme_mesh_num_nodes(mesh);
+            xyz = malloc((size_t)gnn * 3 * sizeof *xyz);
+            if (!xyz) {
+                fprintf(stderr, "Error   : out of memory\n");
+                MPI_Abort(c.comm, 1);
+            }
+            getme_mesh_get_coords(mesh, xyz);
+            for (int k = 0; k < total; k++)
+                memcpy(xyz + 3 * (size_t)all_ids[k], all_pos + 3 * (size_t)k,
+                       3 * sizeof *xyz);
+        }
+        free(ids), free(pos), free(counts), free(displs), free(c3), free(d3);
+        free(all_ids), free(all_pos);
+    }
+
+    /* 5. rank 0: the finishing step on the gathered mesh, then write */
+    if (c.rank == 0) {
+        getme_mesh *mesh = getme_doc_mesh(doc);
+        double tf = MPI_Wtime();
+        /* rank 0 alone: getme smooth's progress lines, not collective */
+        params.progress = cli_smooth_progress;
+        params.progress_data = so;
+        st = getme_smooth_finish(mesh, &params, xyz, &res);
+        res.num_invalid_initial = ur.num_invalid_before;
+        res.untangle_sweeps = ur.sweeps;
+        res.untangle_seconds = ur.seconds;
+        if (st != GETME_OK) {
+            cli_error("%s: %s; no output written", a.input,
+                      getme_mesh_error(mesh));
+            code = 1;
+        } else {
+            cli_info(log, "GETMe adaptive: %d iterations (%d q_mean, %d "
+                     "q*_min in %d cycles) in %.2f s on %d ranks, finishing "
+                     "%d passes in %.2f s",
+                     res.iterations, res.iterations_mean, res.iterations_min,
+                     res.cycles_min, loop_seconds, c.size, res.passes_finish,
+                     MPI_Wtime() - tf);
+            code = finish_output(&a, &paths, doc, &before, &mbefore, &res);
+            if (code == 0)
+                cli_info(log, "Done (%.2f s in all)", MPI_Wtime() - t0);
+        }
+    }
+    MPI_Bcast(&code, 1, MPI_INT, 0, c.comm);
+out:
+    free(xyz);
+    getme_mesh_free(part);
+    if (doc)
+        getme_doc_close(doc);
+    dist_comm_free(&c);
+    dist_part_free(&c);
+    cli_smooth_opts_free(&a.o);
+    MPI_Finalize();
+    return code;
+}

@@ -1,0 +1,93 @@
+#!/usr/bin/python3
+"""A Gmsh-partitioned MSH file (one file with partition entities, as
+`gmsh -part N` writes it) smooths like the unpartitioned mesh (ctest
+label mpi).
+
+usage: test_mpi_partitioned.py GETME_MPI GETME MPIEXEC SOURCE_DIR [--sanitized]
+
+The distorted mixed "quick" mesh (4 physical volumes) is written by Gmsh
+unpartitioned and partitioned into 3 (one file).  The partition boundaries
+are not fixed: the same number of fixed nodes as the unpartitioned mesh
+(--report); `getme smooth` on both gives the same coordinates up to the
+16 significant digits Gmsh's writer prints (every node's coordinates of the
+partitioned output are the unpartitioned output's rounded to %.16g);
+`mpirun -np 2 getme-mpi smooth` on the partitioned file writes the same
+bytes as `getme smooth` on it, and Gmsh reopens that output with its 3
+partitions.
+"""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+GETME_MPI, GETME, MPIEXEC, SRC = sys.argv[1:5]
+SANITIZED = "--sanitized" in sys.argv[5:]
+sys.path.insert(0, os.path.join(SRC, "bench"))
+sys.path.insert(0, os.path.join(SRC, "tests", "support"))
+import meshes  # noqa: E402
+from checks import Checks  # noqa: E402
+import gmsh  # noqa: E402
+
+ENV = dict(os.environ, OMP_WAIT_POLICY="passive", OMPI_ALLOW_RUN_AS_ROOT="1",
+           OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_rmaps_base_oversubscribe="1")
+if SANITIZED:
+    ENV["ASAN_OPTIONS"] = "detect_leaks=0"
+c = Checks(GETME)
+
+
+def nodes(path):
+    """{tag: (x, y, z)} and the number of partitions of an MSH file."""
+    gmsh.initialize(["test"])
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.open(path)
+        tags, xyz, _ = gmsh.model.mesh.getNodes()
+        return ({int(t): tuple(xyz[3 * i:3 * i + 3]) for i, t in enumerate(tags)},
+                max((max(gmsh.model.getPartitions(d, t), default=0)
+                     for d, t in gmsh.model.getEntities()), default=0))
+    finally:
+        gmsh.finalize()
+
+
+with tempfile.TemporaryDirectory() as tmp:
+    dist = os.path.join(tmp, "distorted.msh")
+    c.run("distort", meshes.generate("mixed", "quick", os.path.join(tmp, "cache"),
+                                     log=lambda *a: None),
+          "-o", dist, "--seed", "3", "--amount", "0.6", "-q")
+    whole, parts = os.path.join(tmp, "whole.msh"), os.path.join(tmp, "parts.msh")
+    gmsh.initialize(["test"])
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.open(dist)
+    gmsh.write(whole)
+    gmsh.model.mesh.partition(3)
+    gmsh.write(parts)
+    gmsh.finalize()
+
+    fixed, out = {}, {}
+    for name, path in (("whole", whole), ("parts", parts)):
+        out[name] = os.path.join(tmp, f"{name}-out.msh")
+        rep = os.path.join(tmp, f"{name}.json")
+        c.run("smooth", path, "-o", out[name], "-q", "--report", rep, env=ENV)
+        fixed[name] = json.load(open(rep))["fixed_nodes"] if os.path.exists(rep) else -1
+    c.check(fixed["whole"] > 0 and fixed["whole"] == fixed["parts"],
+            f"fixed nodes: {fixed['parts']} partitioned, {fixed['whole']} whole "
+            "(partition boundaries are not fixed)")
+    a, _ = nodes(out["whole"])
+    b, np_out = nodes(out["parts"])
+    same = sum(tuple(float("%.16g" % v) for v in a[t]) == b.get(t) for t in a)
+    c.check(a and same == len(a),
+            f"{same} of {len(a)} nodes: the unpartitioned result to 16 digits")
+    mpi_out = os.path.join(tmp, "parts-mpi.msh")
+    p = subprocess.run([MPIEXEC, "--oversubscribe", "-np", "2", GETME_MPI, "smooth",
+                        parts, "-o", mpi_out, "-q"], capture_output=True, text=True,
+                       env=ENV)
+    c.check(p.returncode == 0, f"getme-mpi -np 2: exit {p.returncode}: {p.stderr[-400:]}")
+    c.check(os.path.exists(mpi_out) and
+            open(mpi_out, "rb").read() == open(out["parts"], "rb").read(),
+            "getme-mpi -np 2 on the partitioned file: getme smooth's bytes")
+    _, np_mpi = nodes(mpi_out) if os.path.exists(mpi_out) else (None, 0)
+    c.check(np_out == 3 and np_mpi == 3,
+            f"Gmsh reopens the outputs with 3 partitions ({np_out}, {np_mpi})")
+
+sys.exit(c.summary())
