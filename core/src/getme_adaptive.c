@@ -138,9 +138,10 @@ static inline void transform_block(int t, getme_run *run, int32_t e0,
             if (ws->dim == 3) {
                 const uint8_t *slot = getme__adj_slots(adj, ws, t, ep);
                 for (int k = 0; k < getme__edges[t].num_edges; k++)
-                    __builtin_prefetch(
-                        adj->esum + getme__adj_edge(adj, c, t, k, slot[k]), 0,
-                        3);
+                    if (slot[k] != GETME_NO_SLOT) /* else: irregular */
+                        __builtin_prefetch(
+                            adj->esum + getme__adj_edge(adj, c, t, k, slot[k]),
+                            0, 3);
             }
         }
         if (ws->free_elem[e] && getme__owned(run, e)) {
