@@ -30,16 +30,4 @@ extern const getme_format getme__format_msh;  /* msh/msh_format.c   */
 extern const getme_format getme__format_inp;  /* inp/inp_format.c   */
 extern const getme_format getme__format_cgns; /* cgns/cgns_format.c */
 
-/* The adapters' short names for the status codes (they predate
-   getme_formats_status; kept so the parsers read as before). */
-typedef getme_formats_status getme_io_status;
-#define GETME_IO_OK GETME_FORMATS_OK
-#define GETME_IO_ERR_OPEN GETME_FORMATS_ERR_OPEN
-#define GETME_IO_ERR_PARSE GETME_FORMATS_ERR_PARSE
-#define GETME_IO_ERR_UNSUPPORTED GETME_FORMATS_ERR_UNSUPPORTED
-#define GETME_IO_ERR_INVALID GETME_FORMATS_ERR_INVALID
-#define GETME_IO_ERR_WRITE GETME_FORMATS_ERR_WRITE
-#define GETME_IO_ERR_USAGE GETME_FORMATS_ERR_ARGUMENT
-#define GETME_IO_ERR_INTERNAL GETME_FORMATS_ERR_INTERNAL
-
 #endif /* GETME_FORMATS_PRIVATE_ADAPTER_H */

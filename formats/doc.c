@@ -73,7 +73,7 @@ void getme_doc_options_init(getme_doc_options *opts)
     opts->fix_interfaces = 1;
 }
 
-getme_io_status getme_doc_fail(getme_doc *doc, getme_io_status status,
+getme_formats_status getme_doc_fail(getme_doc *doc, getme_formats_status status,
                                const char *fmt, ...)
 {
     va_list ap;
@@ -138,15 +138,15 @@ int64_t getme_doc_element_id(const getme_doc *doc, int32_t e)
 }
 
 /* Name the first invalid elements by their ids in the file. */
-static getme_io_status check_valid(getme_doc *doc)
+static getme_formats_status check_valid(getme_doc *doc)
 {
     getme_quality_stats *sp = &doc->stats;
     if (getme_mesh_quality_stats(doc->mesh, -1, sp) != GETME_OK)
-        return getme_doc_fail(doc, GETME_IO_ERR_INTERNAL, "%s: out of memory",
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL, "%s: out of memory",
                               doc->path);
     doc->have_stats = 1;
     if (sp->num_invalid == 0)
-        return GETME_IO_OK;
+        return GETME_FORMATS_OK;
     char list[256] = "";
     size_t len = 0;
     for (int i = 0; i < sp->num_reported_invalid && len < sizeof list; i++) {
@@ -154,7 +154,7 @@ static getme_io_status check_valid(getme_doc *doc)
         len += (size_t)snprintf(list + len, sizeof list - len, "%s%lld",
                                 i ? ", " : "", id);
     }
-    return getme_doc_fail(doc, GETME_IO_ERR_INVALID,
+    return getme_doc_fail(doc, GETME_FORMATS_ERR_INVALID,
                           "%s: %lld invalid (inverted or degenerate) element%s, "
                           "first: %s%s; getme smooths valid meshes only",
                           doc->path, (long long)sp->num_invalid,
@@ -175,7 +175,7 @@ static void reset(getme_doc *doc)
 
 /* The built-in adapters, then the caller's, in order: the first that takes
    the path and does not decline the file opens it. */
-static getme_io_status open_with_adapters(getme_doc *doc,
+static getme_formats_status open_with_adapters(getme_doc *doc,
                                           const getme_doc_options *opts)
 {
     const getme_format *const *extra = opts->adapters;
@@ -192,25 +192,25 @@ static getme_io_status open_with_adapters(getme_doc *doc,
         if (!f->probe(doc->path))
             continue;
         doc->format = f;
-        getme_io_status st = f->open(doc, opts);
+        getme_formats_status st = f->open(doc, opts);
         if (st != GETME_FORMATS_DECLINED)
             return st;
         reset(doc);
         declined = 1;
     }
     if (declined) /* the message of the last adapter that declined */
-        return GETME_IO_ERR_UNSUPPORTED;
+        return GETME_FORMATS_ERR_UNSUPPORTED;
     char names[128] = "";
     size_t len = 0;
     for (int i = 0; FORMATS[i] && len < sizeof names; i++)
         len += (size_t)snprintf(names + len, sizeof names - len, "%s%s",
                                 i ? ", " : "", FORMATS[i]->name);
-    return getme_doc_fail(doc, GETME_IO_ERR_UNSUPPORTED,
+    return getme_doc_fail(doc, GETME_FORMATS_ERR_UNSUPPORTED,
                           "%s: unknown file format (supported: %s)",
                           doc->path, names);
 }
 
-getme_io_status getme_doc_open(getme_doc **out, const char *path,
+getme_formats_status getme_doc_open(getme_doc **out, const char *path,
                                const getme_doc_options *opts)
 {
     getme_doc_options defaults;
@@ -221,42 +221,42 @@ getme_io_status getme_doc_open(getme_doc **out, const char *path,
     getme_doc *doc = calloc(1, sizeof *doc);
     *out = doc;
     if (!doc)
-        return GETME_IO_ERR_INTERNAL;
+        return GETME_FORMATS_ERR_INTERNAL;
     doc->path = strdup(path ? path : "");
     if (!doc->path)
-        return getme_doc_fail(doc, GETME_IO_ERR_INTERNAL, "out of memory");
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL, "out of memory");
     struct stat sb;
     if (stat(path, &sb) != 0)
-        return getme_doc_fail(doc, GETME_IO_ERR_OPEN, "%s: %s", path,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_OPEN, "%s: %s", path,
                               strerror(errno));
     if (S_ISDIR(sb.st_mode))
-        return getme_doc_fail(doc, GETME_IO_ERR_OPEN, "%s: is a directory",
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_OPEN, "%s: is a directory",
                               path);
     if (access(path, R_OK) != 0)
-        return getme_doc_fail(doc, GETME_IO_ERR_OPEN, "%s: %s", path,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_OPEN, "%s: %s", path,
                               strerror(errno));
-    getme_io_status st = open_with_adapters(doc, opts);
-    if (st != GETME_IO_OK)
+    getme_formats_status st = open_with_adapters(doc, opts);
+    if (st != GETME_FORMATS_OK)
         return st;
     if (!doc->mesh)
-        return getme_doc_fail(doc, GETME_IO_ERR_INTERNAL,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL,
                               "%s: the %s adapter built no mesh", path,
                               doc->format->name);
     return check_valid(doc);
 }
 
-getme_io_status getme_doc_write(getme_doc *doc, const char *out_path)
+getme_formats_status getme_doc_write(getme_doc *doc, const char *out_path)
 {
     if (!doc || !doc->format || !doc->mesh)
-        return GETME_IO_ERR_INTERNAL;
+        return GETME_FORMATS_ERR_INTERNAL;
     char target[4096], msg[sizeof doc->error];
-    getme_io_status st =
+    getme_formats_status st =
         getme_io_output_path(out_path, target, sizeof target, msg, sizeof msg);
-    if (st != GETME_IO_OK)
+    if (st != GETME_FORMATS_OK)
         return getme_doc_fail(doc, st, "%s", msg);
     for (size_t i = 0; i < getme_doc_num_files(doc); i++)
         if (getme_io_same_file(getme_doc_file(doc, i), target))
-            return getme_doc_fail(doc, GETME_IO_ERR_USAGE,
+            return getme_doc_fail(doc, GETME_FORMATS_ERR_ARGUMENT,
                                   "%s: refusing to overwrite the input%s%s; "
                                   "choose another output file", out_path,
                                   i ? " file " : "", i ? getme_doc_file(doc, i) : "");
@@ -434,17 +434,17 @@ static const char *kind_of(mode_t m)
                          : "not a regular file";
 }
 
-getme_io_status getme_io_output_path(const char *out_path, char *buf,
+getme_formats_status getme_io_output_path(const char *out_path, char *buf,
                                      size_t size, char *msg, size_t msg_size)
 {
     struct stat sb;
     if (!out_path || !*out_path) {
         snprintf(msg, msg_size, "empty output file name");
-        return GETME_IO_ERR_USAGE;
+        return GETME_FORMATS_ERR_ARGUMENT;
     }
     if (snprintf(buf, size, "%s", out_path) >= (int)size) {
         snprintf(msg, msg_size, "%s: path too long", out_path);
-        return GETME_IO_ERR_USAGE;
+        return GETME_FORMATS_ERR_ARGUMENT;
     }
     if (lstat(out_path, &sb) == 0 && S_ISLNK(sb.st_mode)) {
         /* A symbolic link is followed: the file it points to is written
@@ -454,13 +454,13 @@ getme_io_status getme_io_output_path(const char *out_path, char *buf,
             snprintf(msg, msg_size,
                      "%s: a symbolic link to a missing file; give the "
                      "path of the file to write", out_path);
-            return GETME_IO_ERR_USAGE;
+            return GETME_FORMATS_ERR_ARGUMENT;
         }
         int len = snprintf(buf, size, "%s", real);
         free(real);
         if (len >= (int)size) {
             snprintf(msg, msg_size, "%s: path too long", out_path);
-            return GETME_IO_ERR_USAGE;
+            return GETME_FORMATS_ERR_ARGUMENT;
         }
     }
     if (stat(buf, &sb) == 0 && !S_ISREG(sb.st_mode)) {
@@ -468,7 +468,7 @@ getme_io_status getme_io_output_path(const char *out_path, char *buf,
                  "%s: is %s; getme writes regular files only (it writes a "
                  "temporary file and renames it)",
                  out_path, kind_of(sb.st_mode));
-        return GETME_IO_ERR_USAGE;
+        return GETME_FORMATS_ERR_ARGUMENT;
     }
     char dir[4096];
     getme_io_dirname(buf, dir, sizeof dir);
@@ -480,9 +480,9 @@ getme_io_status getme_io_output_path(const char *out_path, char *buf,
                  out_path, strerror(stat(dir, &sb) == 0 && !S_ISDIR(sb.st_mode)
                                         ? ENOTDIR
                                         : e));
-        return GETME_IO_ERR_WRITE;
+        return GETME_FORMATS_ERR_WRITE;
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 int getme_io_same_file(const char *a, const char *b)

@@ -109,19 +109,19 @@ static void free_impl(cgns_impl *impl)
 
 /* The file must exist, be a regular readable file, and look like CGNS,
    before libcgns sees it (its messages for these cases are cryptic). */
-static getme_io_status check_input(getme_doc *doc, cgns_impl *impl)
+static getme_formats_status check_input(getme_doc *doc, cgns_impl *impl)
 {
     struct stat sb;
     FILE *f;
 
     if (stat(doc->path, &sb) != 0)
-        return getme_doc_fail(doc, GETME_IO_ERR_OPEN, "%s: %s", doc->path,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_OPEN, "%s: %s", doc->path,
                               strerror(errno));
     if (!S_ISREG(sb.st_mode))
-        return getme_doc_fail(doc, GETME_IO_ERR_OPEN, "%s: not a regular file",
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_OPEN, "%s: not a regular file",
                               doc->path);
     if (!(f = fopen(doc->path, "rb")))
-        return getme_doc_fail(doc, GETME_IO_ERR_OPEN, "%s: %s", doc->path,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_OPEN, "%s: %s", doc->path,
                               strerror(errno));
     fclose(f);
     impl->in_size = (int64_t)sb.st_size;
@@ -131,50 +131,50 @@ static getme_io_status check_input(getme_doc *doc, cgns_impl *impl)
                         sb.st_mtim.tv_nsec;
     switch (magic(doc->path)) {
     case MAGIC_NONE:
-        return getme_doc_fail(doc, GETME_IO_ERR_PARSE,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_PARSE,
                               "%s: not a CGNS file (%s)", doc->path,
                               sb.st_size == 0 ? "empty"
                                               : "neither ADF nor HDF5");
     case MAGIC_HDF5:
-        return getme_doc_fail(doc, GETME_IO_ERR_PARSE,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_PARSE,
                               "%s: an HDF5 file without a CGNSLibraryVersion "
                               "node: not a CGNS file (meshio's CGNS writer, "
                               "for one, writes such files)", doc->path);
     default:
-        return GETME_IO_OK;
+        return GETME_FORMATS_OK;
     }
 }
 
-static getme_io_status cgns_open(getme_doc *doc, const getme_doc_options *opts)
+static getme_formats_status cgns_open(getme_doc *doc, const getme_doc_options *opts)
 {
     cgns_impl *impl = calloc(1, sizeof *impl);
-    getme_io_status st;
+    getme_formats_status st;
     int fn;
 
     if (!impl)
-        return getme_doc_fail(doc, GETME_IO_ERR_INTERNAL, "%s: out of memory",
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL, "%s: out of memory",
                               doc->path);
     doc->impl = impl;
     cgns_quiet();
-    if ((st = check_input(doc, impl)) != GETME_IO_OK)
+    if ((st = check_input(doc, impl)) != GETME_FORMATS_OK)
         return st;
     if (cg_open(doc->path, CG_MODE_READ, &fn) != CG_OK)
-        return getme_doc_fail(doc, GETME_IO_ERR_PARSE,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_PARSE,
                               "%s: libcgns cannot read the file (truncated or "
                               "damaged?): %s", doc->path, cgns_error());
     if (cg_get_file_type(fn, &impl->file_type) != CG_OK)
         impl->file_type = CG_FILE_NONE;
     st = cgns_read(doc, impl, fn, opts);
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = cgns_check_links(doc, impl, fn);
     cg_close(fn);
     return st;
 }
 
-static getme_io_status cgns_write_doc(getme_doc *doc, const char *out_path)
+static getme_formats_status cgns_write_doc(getme_doc *doc, const char *out_path)
 {
     if (!doc->impl || !doc->mesh)
-        return getme_doc_fail(doc, GETME_IO_ERR_INTERNAL,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL,
                               "%s: document was not read", doc->path);
     return cgns_write(doc, out_path);
 }

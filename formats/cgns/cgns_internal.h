@@ -125,16 +125,16 @@ void cgns_quiet(void);
 /* ---- cgns_names.c ------------------------------------------------------- */
 
 /* Remember a name (duplicates of the same kind are stored once). */
-getme_io_status cgns_add_set(getme_doc *doc, cgns_impl *impl,
+getme_formats_status cgns_add_set(getme_doc *doc, cgns_impl *impl,
                              cgns_set_kind kind, const char *name);
 /* Read the FamilyName / AdditionalFamilyName children of the node cg_goto
    last went to, and remember them as family names. */
-getme_io_status cgns_read_fams(getme_doc *doc, cgns_impl *impl,
+getme_formats_status cgns_read_fams(getme_doc *doc, cgns_impl *impl,
                                cgns_fams *fams);
 /* Check that every name in opts->fix and opts->free_sets exists and that no
-   name is both fixed and freed; GETME_IO_ERR_USAGE with the list of
+   name is both fixed and freed; GETME_FORMATS_ERR_ARGUMENT with the list of
    available names otherwise. */
-getme_io_status cgns_check_names(getme_doc *doc, const cgns_impl *impl,
+getme_formats_status cgns_check_names(getme_doc *doc, const cgns_impl *impl,
                                  const getme_doc_options *opts);
 /* 1 if name or one of fams (either may be NULL) is in the list. */
 int cgns_named(const char *name, const cgns_fams *fams, int count,
@@ -147,7 +147,7 @@ int cgns_default_fixed(const char *name, const cgns_fams *fams,
 /* ---- cgns_reader.c ------------------------------------------------------ */
 
 /* Read the whole file into doc->mesh with fixed nodes marked. */
-getme_io_status cgns_read(getme_doc *doc, cgns_impl *impl, int fn,
+getme_formats_status cgns_read(getme_doc *doc, cgns_impl *impl, int fn,
                           const getme_doc_options *opts);
 /* "/Base/Zone" of zone z into buf. */
 void cgns_zone_path(const cgns_impl *impl, int z, char *buf, size_t size);
@@ -186,7 +186,7 @@ typedef struct cgns_section {
    mark the nodes of lower-dimensional (boundary) sections in fixed unless
    freed, and the nodes of sections named by opts->fix.  On success the
    caller owns *sections (free with cgns_free_sections). */
-getme_io_status cgns_read_sections(getme_doc *doc, cgns_impl *impl, int fn,
+getme_formats_status cgns_read_sections(getme_doc *doc, cgns_impl *impl, int fn,
                                    int z, const getme_doc_options *opts,
                                    uint8_t *fixed, int64_t *elem_ids,
                                    cgns_section **sections,
@@ -201,15 +201,15 @@ int cgns_element_nodes(const cgns_section *sections, int num_sections,
 
 /* Mark the nodes of every BC patch of zone z in fixed (unless freed by
    opts->free_sets and not named by opts->fix). */
-getme_io_status cgns_read_bcs(getme_doc *doc, cgns_impl *impl, int fn, int z,
+getme_formats_status cgns_read_bcs(getme_doc *doc, cgns_impl *impl, int fn, int z,
                               const getme_doc_options *opts, uint8_t *fixed,
                               const cgns_section *sections, int num_sections);
 
 /* ---- cgns_writer.c ------------------------------------------------------ */
 
-getme_io_status cgns_write(getme_doc *doc, const char *out_path);
+getme_formats_status cgns_write(getme_doc *doc, const char *out_path);
 /* Refuse files whose coordinates (or a node above them) are links: the
    writer would modify the linked file. */
-getme_io_status cgns_check_links(getme_doc *doc, const cgns_impl *impl, int fn);
+getme_formats_status cgns_check_links(getme_doc *doc, const cgns_impl *impl, int fn);
 
 #endif /* GETME_CGNS_INTERNAL_H */

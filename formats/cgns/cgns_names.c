@@ -9,19 +9,19 @@
 #include <stdlib.h>
 #include <string.h>
 
-getme_io_status cgns_add_set(getme_doc *doc, cgns_impl *impl,
+getme_formats_status cgns_add_set(getme_doc *doc, cgns_impl *impl,
                              cgns_set_kind kind, const char *name)
 {
     if (name[0] == '\0')
-        return GETME_IO_OK;
+        return GETME_FORMATS_OK;
     for (int i = 0; i < impl->num_sets; i++)
         if (impl->sets[i].kind == kind && strcmp(impl->sets[i].name, name) == 0)
-            return GETME_IO_OK;
+            return GETME_FORMATS_OK;
     if (impl->num_sets == impl->cap_sets) {
         int cap = impl->cap_sets ? 2 * impl->cap_sets : 32;
         cgns_set_name *s = realloc(impl->sets, (size_t)cap * sizeof *s);
         if (!s)
-            return getme_doc_fail(doc, GETME_IO_ERR_INTERNAL,
+            return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL,
                                   "%s: out of memory", doc->path);
         impl->sets = s;
         impl->cap_sets = cap;
@@ -29,10 +29,10 @@ getme_io_status cgns_add_set(getme_doc *doc, cgns_impl *impl,
     impl->sets[impl->num_sets].kind = kind;
     snprintf(impl->sets[impl->num_sets].name, CGNS_NAME_LEN, "%s", name);
     impl->num_sets++;
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-getme_io_status cgns_read_fams(getme_doc *doc, cgns_impl *impl,
+getme_formats_status cgns_read_fams(getme_doc *doc, cgns_impl *impl,
                                cgns_fams *fams)
 {
     char name[CGNS_NAME_LEN], fam[CGNS_NAME_LEN];
@@ -48,12 +48,12 @@ getme_io_status cgns_read_fams(getme_doc *doc, cgns_impl *impl,
         if (cg_multifam_read(i, name, fam) == CG_OK && fam[0] != '\0')
             snprintf(fams->name[fams->count++], CGNS_NAME_LEN, "%s", fam);
     for (int i = 0; i < fams->count; i++) {
-        getme_io_status st = cgns_add_set(doc, impl, CGNS_SET_FAMILY,
+        getme_formats_status st = cgns_add_set(doc, impl, CGNS_SET_FAMILY,
                                           fams->name[i]);
-        if (st != GETME_IO_OK)
+        if (st != GETME_FORMATS_OK)
             return st;
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 static int name_exists(const cgns_impl *impl, const char *name)
@@ -103,7 +103,7 @@ static void list_available(const cgns_impl *impl, char *buf, size_t size)
         snprintf(buf, size, "none");
 }
 
-getme_io_status cgns_check_names(getme_doc *doc, const cgns_impl *impl,
+getme_formats_status cgns_check_names(getme_doc *doc, const cgns_impl *impl,
                                  const getme_doc_options *opts)
 {
     char avail[640];
@@ -113,12 +113,12 @@ getme_io_status cgns_check_names(getme_doc *doc, const cgns_impl *impl,
         const char *const *list = pass ? opts->free_sets : opts->fix;
         for (int i = 0; i < n; i++) {
             if (!list || !list[i])
-                return getme_doc_fail(doc, GETME_IO_ERR_USAGE,
+                return getme_doc_fail(doc, GETME_FORMATS_ERR_ARGUMENT,
                                       "%s: empty set name", doc->path);
             if (name_exists(impl, list[i]))
                 continue;
             list_available(impl, avail, sizeof avail);
-            return getme_doc_fail(doc, GETME_IO_ERR_USAGE,
+            return getme_doc_fail(doc, GETME_FORMATS_ERR_ARGUMENT,
                                   "%s: no BC, family, zone or section named "
                                   "'%s' (names are case-sensitive; "
                                   "available: %s)",
@@ -127,10 +127,10 @@ getme_io_status cgns_check_names(getme_doc *doc, const cgns_impl *impl,
     }
     for (int i = 0; i < opts->num_fix; i++)
         if (cgns_named(opts->fix[i], NULL, opts->num_free, opts->free_sets))
-            return getme_doc_fail(doc, GETME_IO_ERR_USAGE,
+            return getme_doc_fail(doc, GETME_FORMATS_ERR_ARGUMENT,
                                   "%s: '%s' is both fixed and freed",
                                   doc->path, opts->fix[i]);
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 int cgns_named(const char *name, const cgns_fams *fams, int count,

@@ -123,21 +123,21 @@ typedef struct zone_ctx {
     int64_t *elem_ids;
 } zone_ctx;
 
-static getme_io_status oom(const zone_ctx *c)
+static getme_formats_status oom(const zone_ctx *c)
 {
-    return getme_doc_fail(c->doc, GETME_IO_ERR_INTERNAL, "%s: out of memory",
+    return getme_doc_fail(c->doc, GETME_FORMATS_ERR_INTERNAL, "%s: out of memory",
                           c->doc->path);
 }
 
 /* Offsets of a MIXED / NGON_n / NFACE_n section must grow and end at the
    data size; MIXED entries must be fixed-size types of the right length. */
-static getme_io_status check_offsets(const zone_ctx *c, const cgns_section *sec,
+static getme_formats_status check_offsets(const zone_ctx *c, const cgns_section *sec,
                                      cgsize_t size)
 {
     cgsize_t n = sec->end - sec->start + 1;
 
     if (sec->offset[0] != 0 || sec->offset[n] != size)
-        return getme_doc_fail(c->doc, GETME_IO_ERR_PARSE,
+        return getme_doc_fail(c->doc, GETME_FORMATS_ERR_PARSE,
                               "%s: %s/%s: ElementStartOffset does not match "
                               "the connectivity size", c->doc->path, c->path,
                               sec->name);
@@ -145,7 +145,7 @@ static getme_io_status check_offsets(const zone_ctx *c, const cgns_section *sec,
         cgsize_t len = sec->offset[i + 1] - sec->offset[i];
         int npe = 0;
         if (len < 1)
-            return getme_doc_fail(c->doc, GETME_IO_ERR_PARSE,
+            return getme_doc_fail(c->doc, GETME_FORMATS_ERR_PARSE,
                                   "%s: %s/%s: element %ld has no nodes",
                                   c->doc->path, c->path, sec->name,
                                   (long)(sec->start + i));
@@ -155,23 +155,23 @@ static getme_io_status check_offsets(const zone_ctx *c, const cgns_section *sec,
         if ((int)t <= CGNS_ENUMV(ElementTypeUserDefined) ||
             (int)t >= NofValidElementTypes || is_poly(t) ||
             cg_npe(t, &npe) != CG_OK || npe <= 0 || len != npe + 1)
-            return getme_doc_fail(c->doc, GETME_IO_ERR_PARSE,
+            return getme_doc_fail(c->doc, GETME_FORMATS_ERR_PARSE,
                                   "%s: %s/%s: element %ld has an invalid "
                                   "MIXED entry (type code %ld, %ld values)",
                                   c->doc->path, c->path, sec->name,
                                   (long)(sec->start + i), (long)t, (long)len);
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* Every node number must lie in 1..num_nodes of the zone. */
-static getme_io_status check_nodes(const zone_ctx *c, const cgns_section *sec)
+static getme_formats_status check_nodes(const zone_ctx *c, const cgns_section *sec)
 {
     cgsize_t n = sec->end - sec->start + 1;
     int32_t nn = c->impl->zones[c->z].num_nodes;
 
     if (sec->type == CGNS_ENUMV(NFACE_n))
-        return GETME_IO_OK; /* face numbers, refused later anyway */
+        return GETME_FORMATS_OK; /* face numbers, refused later anyway */
     for (cgsize_t i = 0; i < n; i++) {
         cgns_elem_t t;
         const cgsize_t *nodes;
@@ -179,44 +179,44 @@ static getme_io_status check_nodes(const zone_ctx *c, const cgns_section *sec)
         element_at(sec, i, &t, &nodes, &count);
         for (int k = 0; k < count; k++)
             if (nodes[k] < 1 || nodes[k] > nn)
-                return getme_doc_fail(c->doc, GETME_IO_ERR_PARSE,
+                return getme_doc_fail(c->doc, GETME_FORMATS_ERR_PARSE,
                                       "%s: %s/%s: element %ld refers to node "
                                       "%ld, the zone has %ld nodes",
                                       c->doc->path, c->path, sec->name,
                                       (long)(sec->start + i), (long)nodes[k],
                                       (long)nn);
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-static getme_io_status read_section(const zone_ctx *c, int fn, int S,
+static getme_formats_status read_section(const zone_ctx *c, int fn, int S,
                                     cgns_section *sec)
 {
     const cgns_zone *zone = &c->impl->zones[c->z];
     int nbndry, parent_flag;
     cgsize_t size;
-    getme_io_status st;
+    getme_formats_status st;
 
     if (cg_section_read(fn, zone->base, zone->zone, S, sec->name, &sec->type,
                         &sec->start, &sec->end, &nbndry, &parent_flag) != CG_OK)
-        return getme_doc_fail(c->doc, GETME_IO_ERR_PARSE,
+        return getme_doc_fail(c->doc, GETME_FORMATS_ERR_PARSE,
                               "%s: %s: section %d: %s", c->doc->path, c->path,
                               S, cgns_error());
     if (sec->start < 1 || sec->end < sec->start)
-        return getme_doc_fail(c->doc, GETME_IO_ERR_PARSE,
+        return getme_doc_fail(c->doc, GETME_FORMATS_ERR_PARSE,
                               "%s: %s/%s: invalid ElementRange %ld..%ld",
                               c->doc->path, c->path, sec->name,
                               (long)sec->start, (long)sec->end);
     if (cg_goto(fn, zone->base, "Zone_t", zone->zone, "Elements_t", S,
                 "end") != CG_OK)
-        return getme_doc_fail(c->doc, GETME_IO_ERR_PARSE, "%s: %s/%s: %s",
+        return getme_doc_fail(c->doc, GETME_FORMATS_ERR_PARSE, "%s: %s/%s: %s",
                               c->doc->path, c->path, sec->name, cgns_error());
     st = cgns_read_fams(c->doc, c->impl, &sec->fams);
-    if (st != GETME_IO_OK)
+    if (st != GETME_FORMATS_OK)
         return st;
     if (cg_ElementDataSize(fn, zone->base, zone->zone, S, &size) != CG_OK ||
         size < 1)
-        return getme_doc_fail(c->doc, GETME_IO_ERR_PARSE,
+        return getme_doc_fail(c->doc, GETME_FORMATS_ERR_PARSE,
                               "%s: %s/%s: no ElementConnectivity (%s)",
                               c->doc->path, c->path, sec->name, cgns_error());
     sec->data = malloc((size_t)size * sizeof *sec->data);
@@ -232,12 +232,12 @@ static getme_io_status read_section(const zone_ctx *c, int fn, int S,
                                    sec->offset, NULL);
     } else {
         if (cg_npe(sec->type, &sec->npe) != CG_OK || sec->npe <= 0)
-            return getme_doc_fail(c->doc, GETME_IO_ERR_PARSE,
+            return getme_doc_fail(c->doc, GETME_FORMATS_ERR_PARSE,
                                   "%s: %s/%s: unknown element type %d",
                                   c->doc->path, c->path, sec->name,
                                   (int)sec->type);
         if (size != n * sec->npe)
-            return getme_doc_fail(c->doc, GETME_IO_ERR_PARSE,
+            return getme_doc_fail(c->doc, GETME_FORMATS_ERR_PARSE,
                                   "%s: %s/%s: ElementConnectivity has %ld "
                                   "values, %ld %s elements need %ld",
                                   c->doc->path, c->path, sec->name, (long)size,
@@ -246,10 +246,10 @@ static getme_io_status read_section(const zone_ctx *c, int fn, int S,
         rc = cg_elements_read(fn, zone->base, zone->zone, S, sec->data, NULL);
     }
     if (rc != CG_OK)
-        return getme_doc_fail(c->doc, GETME_IO_ERR_PARSE,
+        return getme_doc_fail(c->doc, GETME_FORMATS_ERR_PARSE,
                               "%s: %s/%s: cannot read the connectivity: %s",
                               c->doc->path, c->path, sec->name, cgns_error());
-    if (sec->offset && (st = check_offsets(c, sec, size)) != GETME_IO_OK)
+    if (sec->offset && (st = check_offsets(c, sec, size)) != GETME_FORMATS_OK)
         return st;
     return check_nodes(c, sec);
 }
@@ -258,7 +258,7 @@ static getme_io_status read_section(const zone_ctx *c, int fn, int S,
 
 /* Refuse an element of the smoothed dimension (or higher) that getme cannot
    smooth: second-order, polyhedral, or of a higher dimension. */
-static getme_io_status refuse(const zone_ctx *c, const cgns_section *sec,
+static getme_formats_status refuse(const zone_ctx *c, const cgns_section *sec,
                               cgns_elem_t t, cgsize_t number)
 {
     int d = cgns_type_dim(t);
@@ -270,7 +270,7 @@ static getme_io_status refuse(const zone_ctx *c, const cgns_section *sec,
               "HEXA_27, PENTA_15, PENTA_18, PYRA_13, PYRA_14 (3-D) and "
               "TRI_3, QUAD_4, TRI_6, QUAD_8, QUAD_9 (2-D) elements are "
               "smoothed";
-    return getme_doc_fail(c->doc, GETME_IO_ERR_UNSUPPORTED,
+    return getme_doc_fail(c->doc, GETME_FORMATS_ERR_UNSUPPORTED,
                           "%s: %s/%s: element %ld is %s: %s", c->doc->path,
                           c->path, sec->name, (long)number,
                           cg_ElementTypeName(t), why);
@@ -307,7 +307,7 @@ static int region_id(const zone_ctx *c, const cgns_fams *fams)
 }
 
 /* Keep the connectivity of a RealSingle zone (see cgns_writer.c). */
-static getme_io_status keep_conn(const zone_ctx *c, int type, int32_t count,
+static getme_formats_status keep_conn(const zone_ctx *c, int type, int32_t count,
                                  const int32_t *conn, int32_t have)
 {
     cgns_zone *zone = &c->impl->zones[c->z];
@@ -332,12 +332,12 @@ static getme_io_status keep_conn(const zone_ctx *c, int type, int32_t count,
         off[have + i + 1] = used + (i + 1) * nv;
         ty[have + i] = (uint8_t)type;
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* Add count elements of one getme type: conn holds 1-based zone node
    numbers, numbers[] their CGNS element numbers. */
-static getme_io_status add_block(const zone_ctx *c, const cgns_section *sec,
+static getme_formats_status add_block(const zone_ctx *c, const cgns_section *sec,
                                  int type, int32_t count, int32_t *conn,
                                  const cgsize_t *numbers)
 {
@@ -347,7 +347,7 @@ static getme_io_status add_block(const zone_ctx *c, const cgns_section *sec,
     int32_t first = getme_mesh_num_elements(c->doc->mesh);
     int region = region_id(c, &sec->fams);
     int32_t *regions = malloc((size_t)count * sizeof *regions);
-    getme_io_status st = GETME_IO_OK;
+    getme_formats_status st = GETME_FORMATS_OK;
 
     if (!regions || region < 0) {
         free(regions);
@@ -359,7 +359,7 @@ static getme_io_status add_block(const zone_ctx *c, const cgns_section *sec,
             for (int b = a + 1; b < nv; b++)
                 if (e[a] == e[b]) {
                     free(regions);
-                    return getme_doc_fail(c->doc, GETME_IO_ERR_INVALID,
+                    return getme_doc_fail(c->doc, GETME_FORMATS_ERR_INVALID,
                                           "%s: %s/%s: element %ld is "
                                           "degenerate: node %ld appears "
                                           "twice; getme smooths valid meshes "
@@ -380,11 +380,11 @@ static getme_io_status add_block(const zone_ctx *c, const cgns_section *sec,
             : getme_mesh_add_elements(c->doc->mesh, (getme_elem_type)type,
                                       count, conn, regions);
     if (gs != GETME_OK)
-        st = getme_doc_fail(c->doc, GETME_IO_ERR_PARSE, "%s: %s/%s: %s",
+        st = getme_doc_fail(c->doc, GETME_FORMATS_ERR_PARSE, "%s: %s/%s: %s",
                             c->doc->path, c->path, sec->name,
                             getme_mesh_error(c->doc->mesh));
     free(regions);
-    if (st == GETME_IO_OK && impl->zones[c->z].single && type >= CGNS_HO) {
+    if (st == GETME_FORMATS_OK && impl->zones[c->z].single && type >= CGNS_HO) {
         /* the float rounding repair checks the corners only (README) */
         int lin = getme_ho_type_linear((getme_ho_type)(type - CGNS_HO));
         int nl = getme_type_num_nodes((getme_elem_type)lin);
@@ -393,10 +393,10 @@ static getme_io_status add_block(const zone_ctx *c, const cgns_section *sec,
                 conn[(size_t)i * nl + a] = conn[(size_t)i * nv + a];
         st = keep_conn(c, lin, count, conn,
                        first - impl->zones[c->z].first_elem);
-    } else if (st == GETME_IO_OK && impl->zones[c->z].single)
+    } else if (st == GETME_FORMATS_OK && impl->zones[c->z].single)
         st = keep_conn(c, type, count, conn,
                        first - impl->zones[c->z].first_elem);
-    if (st != GETME_IO_OK)
+    if (st != GETME_FORMATS_OK)
         return st;
     if (impl->num_blocks == impl->cap_blocks) {
         int cap = impl->cap_blocks ? 2 * impl->cap_blocks : 16;
@@ -411,11 +411,11 @@ static getme_io_status add_block(const zone_ctx *c, const cgns_section *sec,
     snprintf(impl->blocks[impl->num_blocks].section, CGNS_NAME_LEN, "%s",
              sec->name);
     impl->num_blocks++;
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* Gather the section's elements of one getme type and add them. */
-static getme_io_status add_type(const zone_ctx *c, const cgns_section *sec,
+static getme_formats_status add_type(const zone_ctx *c, const cgns_section *sec,
                                 int type, int32_t count)
 {
     int nv = kind_nodes(type);
@@ -425,7 +425,7 @@ static getme_io_status add_type(const zone_ctx *c, const cgns_section *sec,
     cgsize_t *numbers = malloc((size_t)count * sizeof *numbers);
     cgsize_t n = sec->end - sec->start + 1;
     int32_t k = 0;
-    getme_io_status st;
+    getme_formats_status st;
 
     if (!conn || !numbers) {
         free(conn);
@@ -452,7 +452,7 @@ static getme_io_status add_type(const zone_ctx *c, const cgns_section *sec,
 
 /* Sort the section's elements: smoothed ones are added per type, lower-
    dimensional ones fix their nodes, anything else is refused. */
-static getme_io_status use_section(const zone_ctx *c, const cgns_section *sec)
+static getme_formats_status use_section(const zone_ctx *c, const cgns_section *sec)
 {
     int32_t counts[CGNS_HO + GETME_NUM_HO_TYPES] = {0};
     cgsize_t n = sec->end - sec->start + 1;
@@ -484,14 +484,14 @@ static getme_io_status use_section(const zone_ctx *c, const cgns_section *sec)
     for (int g = 0; g < CGNS_HO + GETME_NUM_HO_TYPES; g++) {
         if (counts[g] == 0)
             continue;
-        getme_io_status st = add_type(c, sec, g, counts[g]);
-        if (st != GETME_IO_OK)
+        getme_formats_status st = add_type(c, sec, g, counts[g]);
+        if (st != GETME_FORMATS_OK)
             return st;
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-getme_io_status cgns_read_sections(getme_doc *doc, cgns_impl *impl, int fn,
+getme_formats_status cgns_read_sections(getme_doc *doc, cgns_impl *impl, int fn,
                                    int z, const getme_doc_options *opts,
                                    uint8_t *fixed, int64_t *elem_ids,
                                    cgns_section **sections, int *num_sections)
@@ -499,29 +499,29 @@ getme_io_status cgns_read_sections(getme_doc *doc, cgns_impl *impl, int fn,
     zone_ctx c = {doc, impl, z, "", opts, fixed, elem_ids};
     cgns_zone *zone = &impl->zones[z];
     int ns = 0;
-    getme_io_status st = GETME_IO_OK;
+    getme_formats_status st = GETME_FORMATS_OK;
 
     cgns_zone_path(impl, z, c.path, sizeof c.path);
     *sections = NULL;
     *num_sections = 0;
     if (cg_nsections(fn, zone->base, zone->zone, &ns) != CG_OK)
-        return getme_doc_fail(doc, GETME_IO_ERR_PARSE, "%s: %s: %s", doc->path,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_PARSE, "%s: %s: %s", doc->path,
                               c.path, cgns_error());
     cgns_section *secs = calloc(ns > 0 ? (size_t)ns : 1, sizeof *secs);
     if (!secs)
         return oom(&c);
     zone->first_elem = getme_mesh_num_elements(doc->mesh);
-    for (int s = 0; s < ns && st == GETME_IO_OK; s++) {
+    for (int s = 0; s < ns && st == GETME_FORMATS_OK; s++) {
         st = read_section(&c, fn, s + 1, &secs[s]);
-        if (st == GETME_IO_OK)
+        if (st == GETME_FORMATS_OK)
             st = use_section(&c, &secs[s]);
     }
     zone->num_elems = getme_mesh_num_elements(doc->mesh) - zone->first_elem;
-    if (st != GETME_IO_OK) {
+    if (st != GETME_FORMATS_OK) {
         cgns_free_sections(secs, ns);
         return st;
     }
     *sections = secs;
     *num_sections = ns;
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }

@@ -40,9 +40,9 @@
 static const char *const coord_names[3] = {"CoordinateX", "CoordinateY",
                                            "CoordinateZ"};
 
-static getme_io_status oom(getme_doc *doc)
+static getme_formats_status oom(getme_doc *doc)
 {
-    return getme_doc_fail(doc, GETME_IO_ERR_INTERNAL, "%s: out of memory",
+    return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL, "%s: out of memory",
                           doc->path);
 }
 
@@ -50,14 +50,14 @@ static getme_io_status oom(getme_doc *doc)
 
 /* Writing through a link would modify another file: refuse files whose
    coordinates (or a node above them) are links. */
-getme_io_status cgns_check_links(getme_doc *doc, const cgns_impl *impl, int fn)
+getme_formats_status cgns_check_links(getme_doc *doc, const cgns_impl *impl, int fn)
 {
     int cgio;
     double root, id;
     char path[CGNS_PATH_LEN + 32];
 
     if (cg_get_cgio(fn, &cgio) != CG_OK || cg_root_id(fn, &root) != CG_OK)
-        return getme_doc_fail(doc, GETME_IO_ERR_INTERNAL, "%s: %s", doc->path,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL, "%s: %s", doc->path,
                               cgns_error());
     for (int z = 0; z < impl->num_zones; z++) {
         const cgns_zone *zone = &impl->zones[z];
@@ -76,13 +76,13 @@ getme_io_status cgns_check_links(getme_doc *doc, const cgns_impl *impl, int fn)
                          zone->base_name, zone->name, coord_names[level - 3]);
             if (cgio_get_node_id(cgio, root, path, &id) == 0 &&
                 cgio_is_link(cgio, id, &len) == 0 && len > 0)
-                return getme_doc_fail(doc, GETME_IO_ERR_UNSUPPORTED,
+                return getme_doc_fail(doc, GETME_FORMATS_ERR_UNSUPPORTED,
                                       "%s: %s is a link to another file: "
                                       "getme does not write through links",
                                       doc->path, path);
         }
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* ---- RealSingle rounding ------------------------------------------------ */
@@ -154,7 +154,7 @@ static int32_t round_single(const cgns_impl *impl, double *out)
 
 /* ---- copying the input -------------------------------------------------- */
 
-static getme_io_status write_all(getme_doc *doc, int fd, const char *buf,
+static getme_formats_status write_all(getme_doc *doc, int fd, const char *buf,
                                  size_t n, const char *tmp)
 {
     while (n > 0) {
@@ -162,12 +162,12 @@ static getme_io_status write_all(getme_doc *doc, int fd, const char *buf,
         if (w < 0 && errno == EINTR)
             continue;
         if (w <= 0)
-            return getme_doc_fail(doc, GETME_IO_ERR_WRITE, "%s: %s", tmp,
+            return getme_doc_fail(doc, GETME_FORMATS_ERR_WRITE, "%s: %s", tmp,
                                   strerror(errno ? errno : EIO));
         buf += w;
         n -= (size_t)w;
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* Input unchanged since it was read (same file, size and mtime)? */
@@ -180,20 +180,20 @@ static int same_input(const cgns_impl *impl, const struct stat *sb)
            (uint64_t)sb->st_ino == impl->in_ino && mtime == impl->in_mtime_ns;
 }
 
-static getme_io_status copy_input(getme_doc *doc, const cgns_impl *impl,
+static getme_formats_status copy_input(getme_doc *doc, const cgns_impl *impl,
                                   const char *tmp)
 {
     struct stat sb;
-    getme_io_status st = GETME_IO_OK;
+    getme_formats_status st = GETME_FORMATS_OK;
     int in = open(doc->path, O_RDONLY | O_CLOEXEC), out;
     char *buf;
 
     if (in < 0)
-        return getme_doc_fail(doc, GETME_IO_ERR_OPEN, "%s: %s", doc->path,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_OPEN, "%s: %s", doc->path,
                               strerror(errno));
     if (fstat(in, &sb) != 0 || !same_input(impl, &sb)) {
         close(in);
-        return getme_doc_fail(doc, GETME_IO_ERR_WRITE,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_WRITE,
                               "%s: the input file changed since it was read; "
                               "nothing written", doc->path);
     }
@@ -204,7 +204,7 @@ static getme_io_status copy_input(getme_doc *doc, const cgns_impl *impl,
         (void)fchmod(out, sb.st_mode & 07777);
     buf = malloc(COPY_CHUNK);
     if (out < 0 || !buf) {
-        st = out < 0 ? getme_doc_fail(doc, GETME_IO_ERR_WRITE, "%s: %s", tmp,
+        st = out < 0 ? getme_doc_fail(doc, GETME_FORMATS_ERR_WRITE, "%s: %s", tmp,
                                       strerror(errno))
                      : oom(doc);
         goto done;
@@ -214,20 +214,20 @@ static getme_io_status copy_input(getme_doc *doc, const cgns_impl *impl,
         if (r < 0 && errno == EINTR)
             continue;
         if (r < 0) {
-            st = getme_doc_fail(doc, GETME_IO_ERR_OPEN, "%s: %s", doc->path,
+            st = getme_doc_fail(doc, GETME_FORMATS_ERR_OPEN, "%s: %s", doc->path,
                                 strerror(errno));
             break;
         }
         if (r == 0)
             break;
-        if ((st = write_all(doc, out, buf, (size_t)r, tmp)) != GETME_IO_OK)
+        if ((st = write_all(doc, out, buf, (size_t)r, tmp)) != GETME_FORMATS_OK)
             break;
     }
 done:
     free(buf);
     close(in);
-    if (out >= 0 && close(out) != 0 && st == GETME_IO_OK)
-        st = getme_doc_fail(doc, GETME_IO_ERR_WRITE, "%s: %s", tmp,
+    if (out >= 0 && close(out) != 0 && st == GETME_FORMATS_OK)
+        st = getme_doc_fail(doc, GETME_FORMATS_ERR_WRITE, "%s: %s", tmp,
                             strerror(errno));
     return st;
 }
@@ -246,16 +246,16 @@ static void pack(const cgns_zone *zone, int k, const double *xyz, void *buf)
     }
 }
 
-static getme_io_status cgio_fail(getme_doc *doc, const char *tmp,
+static getme_formats_status cgio_fail(getme_doc *doc, const char *tmp,
                                  const char *what)
 {
     char msg[CGIO_MAX_ERROR_LENGTH + 1] = "";
     cgio_error_message(msg);
-    return getme_doc_fail(doc, GETME_IO_ERR_WRITE, "%s: %s: %s", tmp, what,
+    return getme_doc_fail(doc, GETME_FORMATS_ERR_WRITE, "%s: %s: %s", tmp, what,
                           msg[0] ? msg : "cgio error");
 }
 
-static getme_io_status write_array(getme_doc *doc, const cgns_zone *zone,
+static getme_formats_status write_array(getme_doc *doc, const cgns_zone *zone,
                                    int k, int cg, double root, const char *tmp,
                                    void *buf, const double *xyz)
 {
@@ -273,14 +273,14 @@ static getme_io_status write_array(getme_doc *doc, const cgns_zone *zone,
         cgio_get_dimensions(cg, id, &ndim, dims) != 0)
         return cgio_fail(doc, tmp, path);
     if (strcmp(type, want) != 0 || ndim != 1 || dims[0] != zone->num_nodes)
-        return getme_doc_fail(doc, GETME_IO_ERR_WRITE,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_WRITE,
                               "%s: %s is not the %s array of %ld values that "
                               "was read", tmp, path, want,
                               (long)zone->num_nodes);
     pack(zone, k, xyz, buf);
     if (cgio_write_all_data(cg, id, buf) != 0)
         return cgio_fail(doc, tmp, path);
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 static size_t max_zone_nodes(const cgns_impl *impl)
@@ -292,12 +292,12 @@ static size_t max_zone_nodes(const cgns_impl *impl)
     return n;
 }
 
-static getme_io_status write_coords(getme_doc *doc, const cgns_impl *impl,
+static getme_formats_status write_coords(getme_doc *doc, const cgns_impl *impl,
                                     const char *tmp, const double *xyz)
 {
     int cg;
     double root;
-    getme_io_status st = GETME_IO_OK;
+    getme_formats_status st = GETME_FORMATS_OK;
     void *buf = malloc(max_zone_nodes(impl) * sizeof(double));
 
     if (!buf)
@@ -308,10 +308,10 @@ static getme_io_status write_coords(getme_doc *doc, const cgns_impl *impl,
     }
     if (cgio_get_root_id(cg, &root) != 0)
         st = cgio_fail(doc, tmp, "no root node");
-    for (int z = 0; z < impl->num_zones && st == GETME_IO_OK; z++)
-        for (int k = 0; k < impl->zones[z].num_coords && st == GETME_IO_OK; k++)
+    for (int z = 0; z < impl->num_zones && st == GETME_FORMATS_OK; z++)
+        for (int k = 0; k < impl->zones[z].num_coords && st == GETME_FORMATS_OK; k++)
             st = write_array(doc, &impl->zones[z], k, cg, root, tmp, buf, xyz);
-    if (cgio_close_file(cg) != 0 && st == GETME_IO_OK)
+    if (cgio_close_file(cg) != 0 && st == GETME_FORMATS_OK)
         st = cgio_fail(doc, tmp, "close");
     free(buf);
     return st;
@@ -319,12 +319,12 @@ static getme_io_status write_coords(getme_doc *doc, const cgns_impl *impl,
 
 /* Read the copy back through the mid-level library: it must open, and its
    coordinates must be exactly what we wrote. */
-static getme_io_status verify(getme_doc *doc, const cgns_impl *impl,
+static getme_formats_status verify(getme_doc *doc, const cgns_impl *impl,
                               const char *tmp, const double *xyz)
 {
     size_t n = max_zone_nodes(impl);
     void *want = malloc(n * sizeof(double)), *got = malloc(n * sizeof(double));
-    getme_io_status st = GETME_IO_OK;
+    getme_formats_status st = GETME_FORMATS_OK;
     int fn;
 
     if (!want || !got) {
@@ -333,22 +333,22 @@ static getme_io_status verify(getme_doc *doc, const cgns_impl *impl,
         return oom(doc);
     }
     if (cg_open(tmp, CG_MODE_READ, &fn) != CG_OK) {
-        st = getme_doc_fail(doc, GETME_IO_ERR_WRITE,
+        st = getme_doc_fail(doc, GETME_FORMATS_ERR_WRITE,
                             "%s: the written file does not open: %s", tmp,
                             cgns_error());
         goto done;
     }
-    for (int z = 0; z < impl->num_zones && st == GETME_IO_OK; z++) {
+    for (int z = 0; z < impl->num_zones && st == GETME_FORMATS_OK; z++) {
         const cgns_zone *zone = &impl->zones[z];
         cgsize_t one = 1, nn = zone->num_nodes;
-        for (int k = 0; k < zone->num_coords && st == GETME_IO_OK; k++) {
+        for (int k = 0; k < zone->num_coords && st == GETME_FORMATS_OK; k++) {
             size_t bytes = (size_t)nn * (zone->coord_type[k] ==
                                          CGNS_ENUMV(RealSingle) ? 4 : 8);
             pack(zone, k, xyz, want);
             if (cg_coord_read(fn, zone->base, zone->zone, coord_names[k],
                               zone->coord_type[k], &one, &nn, got) != CG_OK ||
                 memcmp(want, got, bytes) != 0)
-                st = getme_doc_fail(doc, GETME_IO_ERR_WRITE,
+                st = getme_doc_fail(doc, GETME_FORMATS_ERR_WRITE,
                                     "%s: /%s/%s/GridCoordinates/%s does not "
                                     "read back as written", tmp,
                                     zone->base_name, zone->name,
@@ -362,37 +362,37 @@ done:
     return st;
 }
 
-static getme_io_status sync_file(getme_doc *doc, const char *tmp)
+static getme_formats_status sync_file(getme_doc *doc, const char *tmp)
 {
     int fd = open(tmp, O_RDONLY | O_CLOEXEC);
     if (fd < 0 || fsync(fd) != 0) {
         int err = errno;
         if (fd >= 0)
             close(fd);
-        return getme_doc_fail(doc, GETME_IO_ERR_WRITE, "%s: %s", tmp,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_WRITE, "%s: %s", tmp,
                               strerror(err));
     }
     close(fd);
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* ---- the adapter's write ------------------------------------------------ */
 
-getme_io_status cgns_write(getme_doc *doc, const char *out_path)
+getme_formats_status cgns_write(getme_doc *doc, const char *out_path)
 {
     cgns_impl *impl = doc->impl;
     int32_t n = getme_mesh_num_nodes(doc->mesh), restored = 0;
     char tmp[4096];
-    getme_io_status st;
+    getme_formats_status st;
 
     cgns_quiet();
     if (getme_io_same_file(doc->path, out_path))
-        return getme_doc_fail(doc, GETME_IO_ERR_USAGE,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_ARGUMENT,
                               "%s: the output is the input file; getme never "
                               "overwrites its input", out_path);
     errno = 0;
     if (getme_io_tmp_path(out_path, tmp, sizeof tmp) != 0)
-        return getme_doc_fail(doc, GETME_IO_ERR_WRITE,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_WRITE,
                               "%s: cannot create a temporary file next to "
                               "it: %s", out_path,
                               errno ? strerror(errno) : "path too long");
@@ -403,21 +403,21 @@ getme_io_status cgns_write(getme_doc *doc, const char *out_path)
     }
     restored = round_single(impl, xyz);
     st = copy_input(doc, impl, tmp);
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = write_coords(doc, impl, tmp, xyz);
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = verify(doc, impl, tmp, xyz);
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = sync_file(doc, tmp);
-    if (st == GETME_IO_OK && getme_io_commit(tmp, out_path) != 0)
-        st = getme_doc_fail(doc, GETME_IO_ERR_WRITE, "%s: cannot rename %s: %s",
+    if (st == GETME_FORMATS_OK && getme_io_commit(tmp, out_path) != 0)
+        st = getme_doc_fail(doc, GETME_FORMATS_ERR_WRITE, "%s: cannot rename %s: %s",
                             out_path, tmp, strerror(errno));
-    if (st != GETME_IO_OK)
+    if (st != GETME_FORMATS_OK)
         unlink(tmp); /* no partial output; ENOENT after a failed commit */
     /* The mesh now holds exactly what the file holds (rounded floats). */
-    if (st == GETME_IO_OK && impl->orig)
+    if (st == GETME_FORMATS_OK && impl->orig)
         getme_mesh_set_coords(doc->mesh, xyz);
-    if (st == GETME_IO_OK && restored > 0) {
+    if (st == GETME_FORMATS_OK && restored > 0) {
         size_t len = strlen(doc->info);
         snprintf(doc->info + len, sizeof doc->info - len,
                  "; %ld nodes kept at their input position so that no element "

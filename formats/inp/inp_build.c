@@ -68,13 +68,13 @@ static size_t nblock_of(const inp_deck *d, int32_t n)
 
 /* ---- id maps -------------------------------------------------------------- */
 
-static getme_io_status build_maps(builder *b)
+static getme_formats_status build_maps(builder *b)
 {
     inp_deck *d = b->d;
     size_t nr = d->nnblocks > d->neblocks ? d->nnblocks : d->neblocks;
     inp_run *runs = malloc((nr ? nr : 1) * sizeof *runs);
     if (!runs)
-        return getme_doc_fail(b->doc, GETME_IO_ERR_INTERNAL, "out of memory");
+        return getme_doc_fail(b->doc, GETME_FORMATS_ERR_INTERNAL, "out of memory");
     for (size_t i = 0; i < d->nnblocks; i++)
         runs[i] = (inp_run){d->nblocks[i].scope, d->nblocks[i].first,
                             d->nblocks[i].count};
@@ -85,7 +85,7 @@ static getme_io_status build_maps(builder *b)
     if (rc == 1) {
         free(runs);
         return getme_doc_fail(
-            b->doc, GETME_IO_ERR_PARSE, "%s: node %d defined twice (first at %s)",
+            b->doc, GETME_FORMATS_ERR_PARSE, "%s: node %d defined twice (first at %s)",
             where(d, d->nblocks[nblock_of(d, c)].file, d->node_line[c], w1,
                   sizeof w1),
             d->node_id[c],
@@ -101,7 +101,7 @@ static getme_io_status build_maps(builder *b)
     free(runs);
     if (rc == 1)
         return getme_doc_fail(
-            b->doc, GETME_IO_ERR_PARSE,
+            b->doc, GETME_FORMATS_ERR_PARSE,
             "%s: element %d defined twice (first at %s)",
             where(d, d->eblocks[block_of(d, c)].file, d->elem_line[c], w1,
                   sizeof w1),
@@ -109,16 +109,16 @@ static getme_io_status build_maps(builder *b)
             where(d, d->eblocks[block_of(d, a)].file, d->elem_line[a], w2,
                   sizeof w2));
     if (rc < 0)
-        return getme_doc_fail(b->doc, GETME_IO_ERR_INTERNAL, "out of memory");
-    return GETME_IO_OK;
+        return getme_doc_fail(b->doc, GETME_FORMATS_ERR_INTERNAL, "out of memory");
+    return GETME_FORMATS_OK;
 }
 
 /* Element e of block k whose conn starts at p references a missing node. */
-static getme_io_status undefined_node(builder *b, size_t k, int32_t e,
+static getme_formats_status undefined_node(builder *b, size_t k, int32_t e,
                                       int32_t node)
 {
     char w[600];
-    return getme_doc_fail(b->doc, GETME_IO_ERR_PARSE,
+    return getme_doc_fail(b->doc, GETME_FORMATS_ERR_PARSE,
                           "%s: element %d (%s) references undefined node %d",
                           where(b->d, b->d->eblocks[k].file,
                                 b->d->elem_line[e], w, sizeof w),
@@ -126,7 +126,7 @@ static getme_io_status undefined_node(builder *b, size_t k, int32_t e,
 }
 
 /* Raw node ids in conn -> node indices, in place. */
-static getme_io_status resolve_conn(builder *b)
+static getme_formats_status resolve_conn(builder *b)
 {
     inp_deck *d = b->d;
     for (size_t k = 0; k < d->neblocks; k++) {
@@ -142,35 +142,35 @@ static getme_io_status resolve_conn(builder *b)
             }
         }
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* ---- dimension ------------------------------------------------------------ */
 
-static getme_io_status choose_kind(builder *b)
+static getme_formats_status choose_kind(builder *b)
 {
     inp_deck *d = b->d;
     char w[600];
     if (d->nnodes == 0)
-        return getme_doc_fail(b->doc, GETME_IO_ERR_PARSE,
+        return getme_doc_fail(b->doc, GETME_FORMATS_ERR_PARSE,
                               "%s: no *NODE data: not a mesh",
                               inp_file_name(d, 0));
     if (d->count_kind[INP_KIND_SOLID] > 0) {
         b->smooth = INP_KIND_SOLID;
-        return GETME_IO_OK;
+        return GETME_FORMATS_OK;
     }
     if (d->planar2_line)
         return getme_doc_fail(
-            b->doc, GETME_IO_ERR_UNSUPPORTED,
+            b->doc, GETME_FORMATS_ERR_UNSUPPORTED,
             "%s: element type %s is second order: getme smooths linear "
             "elements only",
             where(d, d->planar2_file, d->planar2_line, w, sizeof w),
             d->planar2_type);
     if (d->count_kind[INP_KIND_PLANAR] > 0) {
         b->smooth = INP_KIND_PLANAR;
-        return GETME_IO_OK;
+        return GETME_FORMATS_OK;
     }
-    return getme_doc_fail(b->doc, GETME_IO_ERR_UNSUPPORTED,
+    return getme_doc_fail(b->doc, GETME_FORMATS_ERR_UNSUPPORTED,
                           "%s: no linear solid (C3D4/C3D5/C3D6/C3D8) or planar "
                           "(CPS3/CPS4/CPE3/CPE4/S3/S4...) elements to smooth "
                           "(%d other elements)",
@@ -179,7 +179,7 @@ static getme_io_status choose_kind(builder *b)
 
 /* Planar meshes are smoothed in the xy plane: all their nodes need the
    same z. */
-static getme_io_status check_plane(builder *b)
+static getme_formats_status check_plane(builder *b)
 {
     inp_deck *d = b->d;
     int have = 0;
@@ -197,7 +197,7 @@ static getme_io_status check_plane(builder *b)
                 int32_t e = eb->first + (int32_t)((p - eb->conn_beg) / eb->nv);
                 char w[600];
                 return getme_doc_fail(
-                    b->doc, GETME_IO_ERR_UNSUPPORTED,
+                    b->doc, GETME_FORMATS_ERR_UNSUPPORTED,
                     "%s: element %d (%s) is not in the plane z = %g of the "
                     "other planar elements: getme smooths planar meshes in "
                     "the xy plane only",
@@ -206,18 +206,18 @@ static getme_io_status check_plane(builder *b)
             }
         }
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* ---- sets ----------------------------------------------------------------- */
 
-typedef getme_io_status (*member_fn)(builder *b, int32_t index, void *arg);
+typedef getme_formats_status (*member_fn)(builder *b, int32_t index, void *arg);
 
-static getme_io_status unknown_member(builder *b, const inp_chunk *c, int kind,
+static getme_formats_status unknown_member(builder *b, const inp_chunk *c, int kind,
                                       int32_t set, int32_t id)
 {
     char w[600];
-    return getme_doc_fail(b->doc, GETME_IO_ERR_PARSE,
+    return getme_doc_fail(b->doc, GETME_FORMATS_ERR_PARSE,
                           "%s: %s set '%s' lists undefined %s %d",
                           where(b->d, c->file, c->line, w, sizeof w),
                           kind == INP_SET_NODE ? "node" : "element",
@@ -225,13 +225,13 @@ static getme_io_status unknown_member(builder *b, const inp_chunk *c, int kind,
                           kind == INP_SET_NODE ? "node" : "element", id);
 }
 
-static getme_io_status visit_wide_range(builder *b, int kind, int scope,
+static getme_formats_status visit_wide_range(builder *b, int kind, int scope,
                                         int64_t first, int64_t last,
                                         int64_t step, member_fn fn, void *arg)
 {
     const inp_deck *d = b->d;
     size_t nb = kind == INP_SET_NODE ? d->nnblocks : d->neblocks;
-    getme_io_status st;
+    getme_formats_status st;
     for (size_t k = 0; k < nb; k++) {
         int sc = kind == INP_SET_NODE ? d->nblocks[k].scope : d->eblocks[k].scope;
         int32_t beg = kind == INP_SET_NODE ? d->nblocks[k].first
@@ -246,16 +246,16 @@ static getme_io_status visit_wide_range(builder *b, int kind, int scope,
                 (ids[i] - first) % step == 0 && (st = fn(b, i, arg)))
                 return st;
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-static getme_io_status visit_ids(builder *b, int32_t set, const inp_chunk *c,
+static getme_formats_status visit_ids(builder *b, int32_t set, const inp_chunk *c,
                                  member_fn fn, void *arg)
 {
     inp_deck *d = b->d;
     int kind = d->sets[set].kind;
     const inp_ids *m = kind == INP_SET_NODE ? &b->nodes : &b->elems;
-    getme_io_status st;
+    getme_formats_status st;
     for (int64_t i = c->beg; i < c->end; i++) {
         if (d->items[i] > 0) {
             int32_t idx = inp_ids_get(m, c->scope, d->items[i]);
@@ -284,10 +284,10 @@ static getme_io_status visit_ids(builder *b, int32_t set, const inp_chunk *c,
                 return st;
         }
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-static getme_io_status for_each_member(builder *b, int32_t set, member_fn fn,
+static getme_formats_status for_each_member(builder *b, int32_t set, member_fn fn,
                                        void *arg, int depth);
 
 typedef struct elem_nodes_arg {
@@ -296,27 +296,27 @@ typedef struct elem_nodes_arg {
 } elem_nodes_arg;
 
 /* The nodes of smoothed element e (others have all their nodes fixed). */
-static getme_io_status elem_nodes(builder *b, int32_t e, void *varg)
+static getme_formats_status elem_nodes(builder *b, int32_t e, void *varg)
 {
     const elem_nodes_arg *a = varg;
     const inp_deck *d = b->d;
     const inp_elem_block *eb = &d->eblocks[block_of(d, e)];
     if (!eb->nv)
-        return GETME_IO_OK;
+        return GETME_FORMATS_OK;
     const int32_t *c = d->conn + eb->conn_beg + (int64_t)(e - eb->first) * eb->nv;
-    getme_io_status st;
+    getme_formats_status st;
     for (int j = 0; j < eb->nv; j++)
         if ((st = a->fn(b, c[j], a->arg)))
             return st;
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-static getme_io_status visit_chunk(builder *b, int32_t set,
+static getme_formats_status visit_chunk(builder *b, int32_t set,
                                    const inp_chunk *c, member_fn fn, void *arg,
                                    int depth)
 {
     const inp_deck *d = b->d;
-    getme_io_status st;
+    getme_formats_status st;
     if (c->nblock >= 0) {
         const inp_node_block *nb = &d->nblocks[c->nblock];
         for (int32_t i = nb->first; i < nb->first + nb->count; i++)
@@ -335,12 +335,12 @@ static getme_io_status visit_chunk(builder *b, int32_t set,
     } else if ((st = visit_ids(b, set, c, fn, arg))) {
         return st;
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* Every member of set, following set references; each referenced set is
    visited once (an explicit stack: reference chains can be long). */
-static getme_io_status for_each_member(builder *b, int32_t set, member_fn fn,
+static getme_formats_status for_each_member(builder *b, int32_t set, member_fn fn,
                                        void *arg, int depth)
 {
     inp_deck *d = b->d;
@@ -348,7 +348,7 @@ static getme_io_status for_each_member(builder *b, int32_t set, member_fn fn,
         b->stamp[depth] = calloc(d->nsets, sizeof *b->stamp[depth]);
         b->stack[depth] = malloc(d->nsets * sizeof *b->stack[depth]);
         if (!b->stamp[depth] || !b->stack[depth])
-            return getme_doc_fail(b->doc, GETME_IO_ERR_INTERNAL,
+            return getme_doc_fail(b->doc, GETME_FORMATS_ERR_INTERNAL,
                                   "out of memory");
     }
     uint32_t *stamp = b->stamp[depth];
@@ -368,12 +368,12 @@ static getme_io_status for_each_member(builder *b, int32_t set, member_fn fn,
                 }
                 continue;
             }
-            getme_io_status st = visit_chunk(b, s, c, fn, arg, depth);
+            getme_formats_status st = visit_chunk(b, s, c, fn, arg, depth);
             if (st)
                 return st;
         }
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* ---- regions -------------------------------------------------------------- */
@@ -386,12 +386,12 @@ static int32_t smoothed_index(const builder *b, int32_t e)
     return b->sfirst[k] + (e - b->d->eblocks[k].first);
 }
 
-static getme_io_status set_region(builder *b, int32_t e, void *arg)
+static getme_formats_status set_region(builder *b, int32_t e, void *arg)
 {
     int32_t s = smoothed_index(b, e);
     if (s >= 0)
         ((int32_t *)arg)[s] = ((int32_t *)arg)[b->nsmooth];
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 static int32_t find_section_set(const inp_deck *d, const inp_section *s)
@@ -405,7 +405,7 @@ static int32_t find_section_set(const inp_deck *d, const inp_section *s)
 }
 
 /* region[nsmooth] is scratch: the region being assigned. */
-static getme_io_status regions(builder *b, int32_t *region)
+static getme_formats_status regions(builder *b, int32_t *region)
 {
     inp_deck *d = b->d;
     for (size_t k = 0; k < d->neblocks; k++) {
@@ -421,29 +421,29 @@ static getme_io_status regions(builder *b, int32_t *region)
         if (set < 0) {
             char w[600];
             return getme_doc_fail(
-                b->doc, GETME_IO_ERR_PARSE,
+                b->doc, GETME_FORMATS_ERR_PARSE,
                 "%s: *SOLID SECTION refers to unknown element set '%s'",
                 where(d, d->sections[s].file, d->sections[s].line, w, sizeof w),
                 inp_str(&d->names, d->sections[s].elset));
         }
         region[b->nsmooth] = 1 + (int32_t)s;
-        getme_io_status st = for_each_member(b, set, set_region, region, 0);
+        getme_formats_status st = for_each_member(b, set, set_region, region, 0);
         if (st)
             return st;
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* ---- fixed nodes ---------------------------------------------------------- */
 
-static getme_io_status fix_node(builder *b, int32_t n, void *arg)
+static getme_formats_status fix_node(builder *b, int32_t n, void *arg)
 {
     (void)arg;
     b->fixed[n] = 1;
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-static getme_io_status fix_elem(builder *b, int32_t e, void *arg)
+static getme_formats_status fix_elem(builder *b, int32_t e, void *arg)
 {
     (void)arg;
     elem_nodes_arg a = {fix_node, NULL};
@@ -495,11 +495,11 @@ static void list_sets(const inp_deck *d, char *buf, size_t sz)
 /* The sets called name: their nodes are fixed (fix = 1) or only looked up
    (--free: nothing is fixed by name in a deck, but an unknown name is
    still an error). */
-static getme_io_status fix_named(builder *b, const char *name, int fix)
+static getme_formats_status fix_named(builder *b, const char *name, int fix)
 {
     inp_deck *d = b->d;
     int found = 0;
-    getme_io_status st;
+    getme_formats_status st;
     int32_t id = inp_str_find(&d->names, name);
     const char *dot = strrchr(name, '.');
     int qscope = -1;
@@ -537,30 +537,30 @@ static getme_io_status fix_named(builder *b, const char *name, int fix)
     if (!found) {
         char avail[700];
         list_sets(d, avail, sizeof avail);
-        return getme_doc_fail(b->doc, GETME_IO_ERR_USAGE,
+        return getme_doc_fail(b->doc, GETME_FORMATS_ERR_ARGUMENT,
                               "%s: no node or element set named '%s' to %s "
                               "(available: %s)",
                               inp_file_name(d, 0), name, fix ? "fix" : "free",
                               avail);
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-static getme_io_status fix_nodes(builder *b, const getme_doc_options *opts,
+static getme_formats_status fix_nodes(builder *b, const getme_doc_options *opts,
                                  getme_mesh *mesh, int32_t *nfixed)
 {
     inp_deck *d = b->d;
     b->fixed = calloc((size_t)d->nnodes, 1);
     if (!b->fixed)
-        return getme_doc_fail(b->doc, GETME_IO_ERR_INTERNAL, "out of memory");
+        return getme_doc_fail(b->doc, GETME_FORMATS_ERR_INTERNAL, "out of memory");
     fix_other_elements(b);
     for (int i = 0; i < opts->num_fix; i++) {
-        getme_io_status st = fix_named(b, opts->fix[i], 1);
+        getme_formats_status st = fix_named(b, opts->fix[i], 1);
         if (st)
             return st;
     }
     for (int i = 0; i < opts->num_free; i++) {
-        getme_io_status st = fix_named(b, opts->free_sets[i], 0);
+        getme_formats_status st = fix_named(b, opts->free_sets[i], 0);
         if (st)
             return st;
     }
@@ -570,9 +570,9 @@ static getme_io_status fix_nodes(builder *b, const getme_doc_options *opts,
     if (gs == GETME_OK)
         gs = getme_mesh_fix_boundary(mesh, flags, nfixed);
     if (gs != GETME_OK)
-        return getme_doc_fail(b->doc, GETME_IO_ERR_INTERNAL, "%s: %s",
+        return getme_doc_fail(b->doc, GETME_FORMATS_ERR_INTERNAL, "%s: %s",
                               inp_file_name(d, 0), getme_mesh_error(mesh));
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* ---- the mesh --------------------------------------------------------------- */
@@ -595,13 +595,13 @@ static getme_status inp_add_ho(getme_mesh *mesh, getme_ho_type type,
     return st;
 }
 
-static getme_io_status add_blocks(builder *b, getme_mesh *mesh)
+static getme_formats_status add_blocks(builder *b, getme_mesh *mesh)
 {
     inp_deck *d = b->d;
     int32_t *region = malloc(((size_t)b->nsmooth + 1) * sizeof *region);
     if (!region)
-        return getme_doc_fail(b->doc, GETME_IO_ERR_INTERNAL, "out of memory");
-    getme_io_status st = regions(b, region);
+        return getme_doc_fail(b->doc, GETME_FORMATS_ERR_INTERNAL, "out of memory");
+    getme_formats_status st = regions(b, region);
     for (size_t k = 0; !st && k < d->neblocks; k++) {
         const inp_elem_block *eb = &d->eblocks[k];
         if (eb->kind != b->smooth || eb->count == 0)
@@ -616,7 +616,7 @@ static getme_io_status add_blocks(builder *b, getme_mesh *mesh)
                     if (c[i] == c[j]) {
                         char w[600];
                         st = getme_doc_fail(
-                            b->doc, GETME_IO_ERR_INVALID,
+                            b->doc, GETME_FORMATS_ERR_INVALID,
                             "%s: element %lld is degenerate: node %lld "
                             "appears twice; getme smooths valid meshes only",
                             where(d, eb->file, d->elem_line[eb->first + e], w,
@@ -636,8 +636,8 @@ static getme_io_status add_blocks(builder *b, getme_mesh *mesh)
         if (gs != GETME_OK) {
             char w[600];
             st = getme_doc_fail(b->doc, gs == GETME_ERR_NOMEM
-                                            ? GETME_IO_ERR_INTERNAL
-                                            : GETME_IO_ERR_PARSE,
+                                            ? GETME_FORMATS_ERR_INTERNAL
+                                            : GETME_FORMATS_ERR_PARSE,
                                 "%s: %s",
                                 where(d, eb->file, d->elem_line[eb->first], w,
                                       sizeof w),
@@ -648,12 +648,12 @@ static getme_io_status add_blocks(builder *b, getme_mesh *mesh)
     return st;
 }
 
-static getme_io_status make_ids(builder *b)
+static getme_formats_status make_ids(builder *b)
 {
     inp_deck *d = b->d;
     b->doc->elem_ids = malloc(((size_t)b->nsmooth + 1) * sizeof(int64_t));
     if (!b->doc->elem_ids)
-        return getme_doc_fail(b->doc, GETME_IO_ERR_INTERNAL, "out of memory");
+        return getme_doc_fail(b->doc, GETME_FORMATS_ERR_INTERNAL, "out of memory");
     for (size_t k = 0; k < d->neblocks; k++) {
         const inp_elem_block *eb = &d->eblocks[k];
         if (eb->kind != b->smooth)
@@ -661,7 +661,7 @@ static getme_io_status make_ids(builder *b)
         for (int32_t i = 0; i < eb->count; i++)
             b->doc->elem_ids[b->sfirst[k] + i] = d->elem_id[eb->first + i];
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 static void info(builder *b, getme_mesh *mesh, int32_t nfixed)
@@ -688,12 +688,12 @@ static void info(builder *b, getme_mesh *mesh, int32_t nfixed)
 }
 
 /* Hand the writer what it needs and nothing else. */
-static getme_io_status keep_for_writer(builder *b)
+static getme_formats_status keep_for_writer(builder *b)
 {
     inp_deck *d = b->d;
     inp_doc *st = calloc(1, sizeof *st);
     if (!st)
-        return getme_doc_fail(b->doc, GETME_IO_ERR_INTERNAL, "out of memory");
+        return getme_doc_fail(b->doc, GETME_FORMATS_ERR_INTERNAL, "out of memory");
     st->files = d->files;
     st->nfiles = d->nfiles;
     st->incs = d->incs;
@@ -708,20 +708,20 @@ static getme_io_status keep_for_writer(builder *b)
     d->nblocks = NULL;
     d->node_id = NULL;
     b->doc->impl = st;
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-static getme_io_status build_mesh(builder *b, const getme_doc_options *opts)
+static getme_formats_status build_mesh(builder *b, const getme_doc_options *opts)
 {
     inp_deck *d = b->d;
-    getme_io_status st;
+    getme_formats_status st;
     if ((st = choose_kind(b)) || (st = build_maps(b)) || (st = resolve_conn(b)))
         return st;
     if (b->smooth == INP_KIND_PLANAR && (st = check_plane(b)))
         return st;
     b->sfirst = malloc((d->neblocks ? d->neblocks : 1) * sizeof *b->sfirst);
     if (!b->sfirst)
-        return getme_doc_fail(b->doc, GETME_IO_ERR_INTERNAL, "out of memory");
+        return getme_doc_fail(b->doc, GETME_FORMATS_ERR_INTERNAL, "out of memory");
     for (size_t k = 0; k < d->neblocks; k++) {
         b->sfirst[k] = b->nsmooth;
         if (d->eblocks[k].kind == b->smooth)
@@ -731,7 +731,7 @@ static getme_io_status build_mesh(builder *b, const getme_doc_options *opts)
     getme_status gs = getme_mesh_create(
         &mesh, b->smooth == INP_KIND_SOLID ? 3 : 2, d->nnodes, d->xyz);
     if (gs != GETME_OK)
-        return getme_doc_fail(b->doc, GETME_IO_ERR_INTERNAL, "%s: %s",
+        return getme_doc_fail(b->doc, GETME_FORMATS_ERR_INTERNAL, "%s: %s",
                               inp_file_name(d, 0), getme_status_string(gs));
     b->doc->mesh = mesh;
     free(d->xyz); /* the mesh has its own copy */
@@ -744,14 +744,14 @@ static getme_io_status build_mesh(builder *b, const getme_doc_options *opts)
     return keep_for_writer(b);
 }
 
-getme_io_status inp_build(inp_deck *d, getme_doc *doc,
+getme_formats_status inp_build(inp_deck *d, getme_doc *doc,
                           const getme_doc_options *opts)
 {
     builder b;
     memset(&b, 0, sizeof b);
     b.d = d;
     b.doc = doc;
-    getme_io_status st = build_mesh(&b, opts);
+    getme_formats_status st = build_mesh(&b, opts);
     inp_ids_free(&b.nodes);
     inp_ids_free(&b.elems);
     free(b.sfirst);

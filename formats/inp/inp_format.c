@@ -33,7 +33,7 @@ static int inp_probe(const char *path)
     return i < n && buf[i] == '*';
 }
 
-static getme_io_status inp_open(getme_doc *doc, const getme_doc_options *opts)
+static getme_formats_status inp_open(getme_doc *doc, const getme_doc_options *opts)
 {
     getme_doc_options defaults;
     if (!opts) {
@@ -42,14 +42,14 @@ static getme_io_status inp_open(getme_doc *doc, const getme_doc_options *opts)
     }
     inp_deck deck;
     memset(&deck, 0, sizeof deck);
-    getme_io_status st = inp_read(&deck, doc->path, doc);
-    if (st == GETME_IO_OK)
+    getme_formats_status st = inp_read(&deck, doc->path, doc);
+    if (st == GETME_FORMATS_OK)
         st = inp_build(&deck, doc, opts);
     inp_deck_free(&deck);
     return st;
 }
 
-static getme_io_status inp_write_doc(getme_doc *doc, const char *out_path)
+static getme_formats_status inp_write_doc(getme_doc *doc, const char *out_path)
 {
     return inp_write(doc, doc->impl, out_path);
 }

@@ -269,7 +269,7 @@ int64_t inp_lookup_key(int what, int scope, int32_t name);
 
 /* Read path and its includes into deck.  On failure the message (one line,
    "file:line: ...") is in doc->error. */
-getme_io_status inp_read(inp_deck *deck, const char *path, getme_doc *doc);
+getme_formats_status inp_read(inp_deck *deck, const char *path, getme_doc *doc);
 void inp_deck_free(inp_deck *deck);
 
 /* Where an element / node was read, for messages: "file:line". */
@@ -313,9 +313,9 @@ typedef struct inp_doc {
     int32_t nnodes;
 } inp_doc;
 
-getme_io_status inp_build(inp_deck *deck, getme_doc *doc,
+getme_formats_status inp_build(inp_deck *deck, getme_doc *doc,
                           const getme_doc_options *opts);
-getme_io_status inp_write(getme_doc *doc, const inp_doc *st,
+getme_formats_status inp_write(getme_doc *doc, const inp_doc *st,
                           const char *out_path);
 void inp_doc_free(inp_doc *st);
 

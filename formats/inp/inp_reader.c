@@ -54,14 +54,14 @@ typedef struct reader {
     ino_t ino[INP_MAX_DEPTH + 1];
 } reader;
 
-static getme_io_status fail(reader *rd, getme_io_status st, const char *fmt,
+static getme_formats_status fail(reader *rd, getme_formats_status st, const char *fmt,
                             ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
 
-static getme_io_status fail(reader *rd, getme_io_status st, const char *fmt,
+static getme_formats_status fail(reader *rd, getme_formats_status st, const char *fmt,
                             ...)
 {
     char msg[768];
@@ -73,9 +73,9 @@ static getme_io_status fail(reader *rd, getme_io_status st, const char *fmt,
                           inp_file_name(rd->d, rd->file), rd->line, msg);
 }
 
-static getme_io_status nomem(reader *rd)
+static getme_formats_status nomem(reader *rd)
 {
-    return fail(rd, GETME_IO_ERR_INTERNAL, "out of memory");
+    return fail(rd, GETME_FORMATS_ERR_INTERNAL, "out of memory");
 }
 
 const char *inp_file_name(const inp_deck *deck, int file)
@@ -163,7 +163,7 @@ static int push_item(reader *rd, int32_t v)
 
 /* ---- nodes ---------------------------------------------------------------- */
 
-static getme_io_status open_node_block(reader *rd, int64_t offset)
+static getme_formats_status open_node_block(reader *rd, int64_t offset)
 {
     inp_deck *d = rd->d;
     if (INP_RESERVE(d->nblocks, d->cap_nblocks, d->nnblocks + 1))
@@ -177,10 +177,10 @@ static getme_io_status open_node_block(reader *rd, int64_t offset)
             return nomem(rd);
         d->chunks[c].nblock = rd->nblock;
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-static getme_io_status node_line(reader *rd, const char *text, size_t len,
+static getme_formats_status node_line(reader *rd, const char *text, size_t len,
                                  int64_t offset)
 {
     inp_deck *d = rd->d;
@@ -190,21 +190,21 @@ static getme_io_status node_line(reader *rd, const char *text, size_t len,
     int64_t id;
     inp_next_field(&p, end, &f, &last);
     if (inp_parse_int(&f, &id) || id < 1 || id > INT32_MAX)
-        return fail(rd, GETME_IO_ERR_PARSE, "bad node number '%.*s'",
+        return fail(rd, GETME_FORMATS_ERR_PARSE, "bad node number '%.*s'",
                     (int)(f.n > 40 ? 40 : f.n), f.s);
     double x[3] = {0, 0, 0};
     for (int k = 0; k < 3 && !last && inp_next_field(&p, end, &f, &last); k++)
         if (inp_parse_real(&f, &x[k]))
-            return fail(rd, GETME_IO_ERR_PARSE,
+            return fail(rd, GETME_FORMATS_ERR_PARSE,
                         "node %lld: bad coordinate '%.*s'", (long long)id,
                         (int)(f.n > 40 ? 40 : f.n), f.s);
     if (rd->nblock < 0 || d->nblocks[rd->nblock].file != rd->file) {
-        getme_io_status st = open_node_block(rd, offset);
+        getme_formats_status st = open_node_block(rd, offset);
         if (st)
             return st;
     }
     if (d->nnodes >= INT32_MAX / 3 - 1)
-        return fail(rd, GETME_IO_ERR_UNSUPPORTED, "more than %d nodes",
+        return fail(rd, GETME_FORMATS_ERR_UNSUPPORTED, "more than %d nodes",
                     INT32_MAX / 3 - 1);
     size_t n = (size_t)d->nnodes;
     size_t cap = d->cap_nodes;
@@ -225,12 +225,12 @@ static getme_io_status node_line(reader *rd, const char *text, size_t len,
     memcpy(&d->xyz[3 * n], x, sizeof x);
     d->nnodes++;
     d->nblocks[rd->nblock].count++;
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* ---- elements ------------------------------------------------------------- */
 
-static getme_io_status open_elem_block(reader *rd)
+static getme_formats_status open_elem_block(reader *rd)
 {
     inp_deck *d = rd->d;
     if (INP_RESERVE(d->eblocks, d->cap_eblocks, d->neblocks + 1))
@@ -253,7 +253,7 @@ static getme_io_status open_elem_block(reader *rd)
             return nomem(rd);
         d->chunks[c].eblock = rd->eblock;
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 static int push_conn(inp_deck *d, int32_t v)
@@ -265,20 +265,20 @@ static int push_conn(inp_deck *d, int32_t v)
     return 0;
 }
 
-static getme_io_status start_element(reader *rd, const inp_field *f)
+static getme_formats_status start_element(reader *rd, const inp_field *f)
 {
     inp_deck *d = rd->d;
     int64_t id;
     if (inp_parse_int(f, &id) || id < 1 || id > INT32_MAX)
-        return fail(rd, GETME_IO_ERR_PARSE, "bad element number '%.*s'",
+        return fail(rd, GETME_FORMATS_ERR_PARSE, "bad element number '%.*s'",
                     (int)(f->n > 40 ? 40 : f->n), f->s);
     if (rd->eblock < 0 || d->eblocks[rd->eblock].file != rd->file) {
-        getme_io_status st = open_elem_block(rd);
+        getme_formats_status st = open_elem_block(rd);
         if (st)
             return st;
     }
     if (d->nelems >= INT32_MAX - 1)
-        return fail(rd, GETME_IO_ERR_UNSUPPORTED, "too many elements");
+        return fail(rd, GETME_FORMATS_ERR_UNSUPPORTED, "too many elements");
     size_t n = (size_t)d->nelems;
     if (n + 1 > d->cap_elems) {
         size_t c1 = d->cap_elems, c2 = d->cap_elems;
@@ -299,14 +299,14 @@ static getme_io_status start_element(reader *rd, const inp_field *f)
         if (push_conn(d, 0))
             return nomem(rd);
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-static getme_io_status finish_element(reader *rd)
+static getme_formats_status finish_element(reader *rd)
 {
     inp_deck *d = rd->d;
     if (rd->nv && rd->pending != rd->nv)
-        return fail(rd, GETME_IO_ERR_PARSE,
+        return fail(rd, GETME_FORMATS_ERR_PARSE,
                     "element %d of type %s has %d nodes, %s needs %d",
                     d->elem_id[d->nelems - 1], rd->type, rd->pending, rd->type,
                     rd->nv);
@@ -314,16 +314,16 @@ static getme_io_status finish_element(reader *rd)
         d->conn[rd->count_pos] = rd->pending;
     d->eblocks[rd->eblock].conn_end = d->nconn;
     rd->pending = -1;
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-static getme_io_status element_line(reader *rd, const char *text, size_t len)
+static getme_formats_status element_line(reader *rd, const char *text, size_t len)
 {
     inp_deck *d = rd->d;
     const char *p = text, *end = text + len;
     inp_field f;
     int last = 0;
-    getme_io_status st;
+    getme_formats_status st;
     if (rd->pending < 0) {
         inp_next_field(&p, end, &f, &last);
         if ((st = start_element(rd, &f)))
@@ -339,14 +339,14 @@ static getme_io_status element_line(reader *rd, const char *text, size_t len)
         if (rd->nv == 0 && (f.n == 0 || memchr(f.s, '.', f.n)))
             continue; /* "instance.node" of an assembly-level element */
         if (inp_parse_int(&f, &id) || id < 0 || id > INT32_MAX)
-            return fail(rd, GETME_IO_ERR_PARSE,
+            return fail(rd, GETME_FORMATS_ERR_PARSE,
                         "element %d: bad node number '%.*s'",
                         d->elem_id[d->nelems - 1],
                         (int)(f.n > 40 ? 40 : f.n), f.s);
         if (rd->nv == 0 && id == 0)
             continue; /* "no node" in connector-like elements */
         if (id == 0)
-            return fail(rd, GETME_IO_ERR_PARSE,
+            return fail(rd, GETME_FORMATS_ERR_PARSE,
                         "element %d: node number 0",
                         d->elem_id[d->nelems - 1]);
         if (rd->nv && rd->pending == rd->nv) {
@@ -366,21 +366,21 @@ static getme_io_status element_line(reader *rd, const char *text, size_t len)
         rd->pending++;
     }
     if (continues && !(rd->nv && rd->pending == rd->nv))
-        return GETME_IO_OK;
+        return GETME_FORMATS_OK;
     return finish_element(rd);
 }
 
 /* ---- sets ----------------------------------------------------------------- */
 
 /* A set named in a data line: a reference chunk (a set made of sets). */
-static getme_io_status copy_set(reader *rd, int32_t src)
+static getme_formats_status copy_set(reader *rd, int32_t src)
 {
     int32_t n = add_chunk(rd, rd->set, rd->d->sets[src].ns);
     if (n < 0)
-        return fail(rd, GETME_IO_ERR_UNSUPPORTED, "too many set references");
+        return fail(rd, GETME_FORMATS_ERR_UNSUPPORTED, "too many set references");
     rd->d->chunks[n].setref = src;
     rd->chunk = -1;
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* The scope an instance name refers to, or -1. */
@@ -394,7 +394,7 @@ static int instance_scope(const inp_deck *d, const char *name)
 
 /* A set name in a data line: "Name" or "instance.Name"; or a qualified
    id "instance.17". */
-static getme_io_status set_reference(reader *rd, const inp_field *f)
+static getme_formats_status set_reference(reader *rd, const inp_field *f)
 {
     inp_deck *d = rd->d;
     int kind = rd->mode == M_NSET ? INP_SET_NODE : INP_SET_ELEM;
@@ -416,14 +416,14 @@ static getme_io_status set_reference(reader *rd, const inp_field *f)
         int64_t num;
         if (ps >= 0 && inp_parse_int(&rest, &num) == 0) {
             if (num < 1 || num > INT32_MAX)
-                return fail(rd, GETME_IO_ERR_PARSE, "bad %s number '%.*s'",
+                return fail(rd, GETME_FORMATS_ERR_PARSE, "bad %s number '%.*s'",
                             what, (int)f->n, f->s);
             int32_t c = add_chunk(rd, rd->set, ps);
             if (c < 0 || push_item(rd, (int32_t)num))
                 return nomem(rd);
             d->chunks[c].end = d->nitems;
             rd->chunk = -1;
-            return GETME_IO_OK;
+            return GETME_FORMATS_OK;
         }
         int32_t sid = inp_str_find(&d->names, dot + 1);
         if (ps >= 0 && sid >= 0)
@@ -431,11 +431,11 @@ static getme_io_status set_reference(reader *rd, const inp_field *f)
         *dot = '.';
     }
     if (s < 0)
-        return fail(rd, GETME_IO_ERR_PARSE, "unknown %s set '%s'", what, name);
+        return fail(rd, GETME_FORMATS_ERR_PARSE, "unknown %s set '%s'", what, name);
     return copy_set(rd, s);
 }
 
-static getme_io_status set_item(reader *rd, int32_t v)
+static getme_formats_status set_item(reader *rd, int32_t v)
 {
     inp_deck *d = rd->d;
     if (rd->chunk < 0 || d->chunks[rd->chunk].file != rd->file) {
@@ -446,10 +446,10 @@ static getme_io_status set_item(reader *rd, int32_t v)
     if (push_item(rd, v))
         return nomem(rd);
     d->chunks[rd->chunk].end = d->nitems;
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-static getme_io_status generate_line(reader *rd, const char *text, size_t len)
+static getme_formats_status generate_line(reader *rd, const char *text, size_t len)
 {
     const char *p = text, *end = text + len;
     inp_field f;
@@ -459,30 +459,30 @@ static getme_io_status generate_line(reader *rd, const char *text, size_t len)
         if (f.n == 0 && last)
             break;
         if (n == 3 || inp_parse_int(&f, &v[n]))
-            return fail(rd, GETME_IO_ERR_PARSE,
+            return fail(rd, GETME_FORMATS_ERR_PARSE,
                         "GENERATE needs 'first, last[, step]'");
         n++;
     }
     if (n < 2 || v[0] < 1 || v[1] < v[0] || v[1] > INT32_MAX || v[2] < 1 ||
         v[2] > INT32_MAX)
-        return fail(rd, GETME_IO_ERR_PARSE,
+        return fail(rd, GETME_FORMATS_ERR_PARSE,
                     "GENERATE needs 'first, last[, step]' with 1 <= first <= "
                     "last and step >= 1");
-    getme_io_status st;
+    getme_formats_status st;
     if ((st = set_item(rd, (int32_t)-v[0])) || (st = set_item(rd, (int32_t)v[1])) ||
         (st = set_item(rd, (int32_t)v[2])))
         return st;
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-static getme_io_status set_line(reader *rd, const char *text, size_t len)
+static getme_formats_status set_line(reader *rd, const char *text, size_t len)
 {
     if (rd->generate)
         return generate_line(rd, text, len);
     const char *p = text, *end = text + len;
     inp_field f;
     int last = 0;
-    getme_io_status st;
+    getme_formats_status st;
     while (!last && inp_next_field(&p, end, &f, &last)) {
         if (f.n == 0)
             continue;
@@ -493,33 +493,33 @@ static getme_io_status set_line(reader *rd, const char *text, size_t len)
         }
         int64_t id;
         if (inp_parse_int(&f, &id) || id < 1 || id > INT32_MAX)
-            return fail(rd, GETME_IO_ERR_PARSE, "bad %s number '%.*s'",
+            return fail(rd, GETME_FORMATS_ERR_PARSE, "bad %s number '%.*s'",
                         rd->mode == M_NSET ? "node" : "element",
                         (int)(f.n > 40 ? 40 : f.n), f.s);
         if ((st = set_item(rd, (int32_t)id)))
             return st;
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* ---- keywords ------------------------------------------------------------- */
 
-static const char *required(reader *rd, const char *key, getme_io_status *st)
+static const char *required(reader *rd, const char *key, getme_formats_status *st)
 {
     const char *v = inp_keyword_get(&rd->kw, key);
     if (!v || !v[0]) {
-        *st = fail(rd, GETME_IO_ERR_PARSE, "*%s without %s=", rd->kw.name, key);
+        *st = fail(rd, GETME_FORMATS_ERR_PARSE, "*%s without %s=", rd->kw.name, key);
         return NULL;
     }
-    *st = GETME_IO_OK;
+    *st = GETME_FORMATS_OK;
     return v;
 }
 
-static getme_io_status kw_node(reader *rd)
+static getme_formats_status kw_node(reader *rd)
 {
     const char *sys = inp_keyword_get(&rd->kw, "SYSTEM");
     if (sys && !inp_name_eq(sys, "R"))
-        return fail(rd, GETME_IO_ERR_UNSUPPORTED,
+        return fail(rd, GETME_FORMATS_ERR_UNSUPPORTED,
                     "*NODE, SYSTEM=%s (non-rectangular coordinates) is not "
                     "supported",
                     sys);
@@ -527,19 +527,19 @@ static getme_io_status kw_node(reader *rd)
     if (nset && nset[0] && (rd->set = get_set(rd, INP_SET_NODE, rd->ns, nset)) < 0)
         return nomem(rd);
     rd->mode = M_NODE;
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-static getme_io_status kw_element(reader *rd)
+static getme_formats_status kw_element(reader *rd)
 {
-    getme_io_status st;
+    getme_formats_status st;
     const char *type = required(rd, "TYPE", &st);
     if (!type)
         return st;
     char up[24];
     size_t n = strlen(type);
     if (n >= sizeof up)
-        return fail(rd, GETME_IO_ERR_UNSUPPORTED, "unknown element type '%s'",
+        return fail(rd, GETME_FORMATS_ERR_UNSUPPORTED, "unknown element type '%s'",
                     type);
     for (size_t i = 0; i <= n; i++)
         up[i] = (char)(type[i] >= 'a' && type[i] <= 'z' ? type[i] - 32 : type[i]);
@@ -548,7 +548,7 @@ static getme_io_status kw_element(reader *rd)
     /* 13 nodes: a second-order pyramid, which neither Abaqus (C3D5 is its
        only pyramid) nor CalculiX defines, so no deck fixes its node order */
     if (rd->kind == INP_KIND_SOLID2)
-        return fail(rd, GETME_IO_ERR_UNSUPPORTED,
+        return fail(rd, GETME_FORMATS_ERR_UNSUPPORTED,
                     "element type %s is second order (%d nodes)%s: getme "
                     "smooths linear elements (C3D4, C3D5, C3D6, C3D8, CPS3, "
                     "CPS4...) and C3D10, C3D15, C3D20",
@@ -569,12 +569,12 @@ static getme_io_status kw_element(reader *rd)
         rd->elset_name = rd->d->sets[rd->set].name;
     }
     rd->mode = M_ELEMENT;
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-static getme_io_status kw_set(reader *rd, int kind)
+static getme_formats_status kw_set(reader *rd, int kind)
 {
-    getme_io_status st;
+    getme_formats_status st;
     const char *key = kind == INP_SET_NODE ? "NSET" : "ELSET";
     const char *name = required(rd, key, &st);
     if (!name)
@@ -587,7 +587,7 @@ static getme_io_status kw_set(reader *rd, int kind)
     if (inst) {
         int is = instance_scope(rd->d, inst);
         if (is < 0)
-            return fail(rd, GETME_IO_ERR_PARSE, "unknown instance '%s'", inst);
+            return fail(rd, GETME_FORMATS_ERR_PARSE, "unknown instance '%s'", inst);
         rd->set_scope = rd->d->scopes[is].node_scope;
     }
     const char *elset = kind == INP_SET_NODE ? inp_keyword_get(&rd->kw, "ELSET")
@@ -596,22 +596,22 @@ static getme_io_status kw_set(reader *rd, int kind)
         int32_t id = inp_str_find(&rd->d->names, elset);
         int32_t e = id < 0 ? -1 : find_set(rd->d, INP_SET_ELEM, rd->ns, id);
         if (e < 0)
-            return fail(rd, GETME_IO_ERR_PARSE, "unknown element set '%s'",
+            return fail(rd, GETME_FORMATS_ERR_PARSE, "unknown element set '%s'",
                         elset);
         int32_t c = add_chunk(rd, rd->set, rd->set_scope);
         if (c < 0)
             return nomem(rd);
         rd->d->chunks[c].elset = e;
         rd->mode = M_SKIP;
-        return GETME_IO_OK;
+        return GETME_FORMATS_OK;
     }
     rd->mode = kind == INP_SET_NODE ? M_NSET : M_ELSET;
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* A new part or instance scope named by NAME=; its index, or -1 with *st
    set. */
-static int named_scope(reader *rd, int kind, int what, getme_io_status *st)
+static int named_scope(reader *rd, int kind, int what, getme_formats_status *st)
 {
     const char *name = required(rd, "NAME", st);
     if (!name)
@@ -627,16 +627,16 @@ static int named_scope(reader *rd, int kind, int what, getme_io_status *st)
         return -1;
     }
     if (rc == 1) {
-        *st = fail(rd, GETME_IO_ERR_PARSE, "%s '%s' defined twice",
+        *st = fail(rd, GETME_FORMATS_ERR_PARSE, "%s '%s' defined twice",
                    what == INP_LOOKUP_PART ? "part" : "instance", name);
         return -1;
     }
     return sc;
 }
 
-static getme_io_status kw_instance(reader *rd)
+static getme_formats_status kw_instance(reader *rd)
 {
-    getme_io_status st;
+    getme_formats_status st;
     int sc = named_scope(rd, INP_SCOPE_INSTANCE, INP_LOOKUP_INSTANCE, &st);
     if (sc < 0)
         return st;
@@ -648,7 +648,7 @@ static getme_io_status kw_instance(reader *rd)
                         : inp_hash_get(&d->lookup,
                                        inp_lookup_key(INP_LOOKUP_PART, 0, id));
         if (ps < 0)
-            return fail(rd, GETME_IO_ERR_PARSE,
+            return fail(rd, GETME_FORMATS_ERR_PARSE,
                         "*INSTANCE refers to unknown part '%s'", part);
         /* An instance's node and element ids are those of its part: the
            part is smoothed once, in its own coordinates, and every
@@ -658,19 +658,19 @@ static getme_io_status kw_instance(reader *rd)
     rd->outer_ns = rd->ns;
     rd->ns = sc;
     rd->mode = M_SKIP; /* data lines: translation and rotation */
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-static getme_io_status read_file(reader *rd, const char *path, int parent);
+static getme_formats_status read_file(reader *rd, const char *path, int parent);
 
-static getme_io_status kw_include(reader *rd, int64_t offset)
+static getme_formats_status kw_include(reader *rd, int64_t offset)
 {
-    getme_io_status st;
+    getme_formats_status st;
     const char *input = required(rd, "INPUT", &st);
     if (!input)
         return st;
     if (rd->pending >= 0)
-        return fail(rd, GETME_IO_ERR_PARSE,
+        return fail(rd, GETME_FORMATS_ERR_PARSE,
                     "element %d continues into an *INCLUDE",
                     rd->d->elem_id[rd->d->nelems - 1]);
     const inp_param *prm = inp_keyword_param(&rd->kw, "INPUT");
@@ -684,9 +684,9 @@ static getme_io_status kw_include(reader *rd, int64_t offset)
         n = snprintf(path, sizeof path, "%.*s/%s", (int)(slash - cur), cur,
                      input);
     if (n < 0 || (size_t)n >= sizeof path)
-        return fail(rd, GETME_IO_ERR_OPEN, "*INCLUDE path too long");
+        return fail(rd, GETME_FORMATS_ERR_OPEN, "*INCLUDE path too long");
     if (rd->depth >= INP_MAX_DEPTH)
-        return fail(rd, GETME_IO_ERR_PARSE, "*INCLUDE nested more than %d deep",
+        return fail(rd, GETME_FORMATS_ERR_PARSE, "*INCLUDE nested more than %d deep",
                     INP_MAX_DEPTH);
     inp_deck *d = rd->d;
     if (INP_RESERVE(d->incs, d->cap_incs, d->nincs + 1))
@@ -712,26 +712,26 @@ static getme_io_status kw_include(reader *rd, int64_t offset)
     return st;
 }
 
-static getme_io_status unsupported_keyword(reader *rd)
+static getme_formats_status unsupported_keyword(reader *rd)
 {
     static const char *const gen[] = {"NGEN", "NFILL", "NCOPY", "NMAP",
                                       "ELGEN", "ELCOPY", "SYSTEM", "NODEINPUT",
                                       NULL};
     for (int i = 0; gen[i]; i++)
         if (strcmp(rd->kw.name, gen[i]) == 0)
-            return fail(rd, GETME_IO_ERR_UNSUPPORTED,
+            return fail(rd, GETME_FORMATS_ERR_UNSUPPORTED,
                         "*%s is not supported: nodes/elements generated or "
                         "transformed by keywords cannot be written back; "
                         "give them explicitly with *NODE / *ELEMENT",
                         gen[i]);
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* The keyword in rd->kw is complete: act on it. */
-static getme_io_status keyword(reader *rd, int64_t offset)
+static getme_formats_status keyword(reader *rd, int64_t offset)
 {
     const char *k = rd->kw.name;
-    getme_io_status st;
+    getme_formats_status st;
     if (strcmp(k, "INCLUDE") == 0)
         return kw_include(rd, offset);
     if (rd->pending >= 0 && (st = finish_element(rd)))
@@ -744,7 +744,7 @@ static getme_io_status keyword(reader *rd, int64_t offset)
     if ((strcmp(k, "NODE") == 0 || strcmp(k, "ELEMENT") == 0 ||
          strcmp(k, "NSET") == 0 || strcmp(k, "ELSET") == 0) &&
         inp_keyword_get(&rd->kw, "INPUT"))
-        return fail(rd, GETME_IO_ERR_UNSUPPORTED,
+        return fail(rd, GETME_FORMATS_ERR_UNSUPPORTED,
                     "*%s, INPUT= is not supported: use *INCLUDE, INPUT= "
                     "after the keyword line",
                     k);
@@ -761,24 +761,24 @@ static getme_io_status keyword(reader *rd, int64_t offset)
         if (sc < 0)
             return st;
         rd->ns = sc;
-        return GETME_IO_OK;
+        return GETME_FORMATS_OK;
     }
     if (strcmp(k, "ENDPART") == 0 || strcmp(k, "ENDASSEMBLY") == 0) {
         rd->ns = 0;
-        return GETME_IO_OK;
+        return GETME_FORMATS_OK;
     }
     if (strcmp(k, "ASSEMBLY") == 0) {
         int sc = new_scope(rd, INP_SCOPE_ASSEMBLY, -1);
         if (sc < 0)
             return nomem(rd);
         rd->ns = sc;
-        return GETME_IO_OK;
+        return GETME_FORMATS_OK;
     }
     if (strcmp(k, "INSTANCE") == 0)
         return kw_instance(rd);
     if (strcmp(k, "ENDINSTANCE") == 0) {
         rd->ns = rd->outer_ns;
-        return GETME_IO_OK;
+        return GETME_FORMATS_OK;
     }
     if (strcmp(k, "SOLIDSECTION") == 0) {
         const char *elset = required(rd, "ELSET", &st);
@@ -792,67 +792,67 @@ static getme_io_status keyword(reader *rd, int64_t offset)
         d->sections[d->nsections++] =
             (inp_section){rd->ns, id, rd->file, rd->line};
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-static getme_io_status data_line(reader *rd, const char *text, size_t len,
+static getme_formats_status data_line(reader *rd, const char *text, size_t len,
                                  int64_t offset)
 {
     switch (rd->mode) {
     case M_NONE:
-        return fail(rd, GETME_IO_ERR_PARSE,
+        return fail(rd, GETME_FORMATS_ERR_PARSE,
                     "data line before the first keyword (not an Abaqus input "
                     "file?)");
     case M_NODE: return node_line(rd, text, len, offset);
     case M_ELEMENT: return element_line(rd, text, len);
     case M_NSET:
     case M_ELSET: return set_line(rd, text, len);
-    default: return GETME_IO_OK;
+    default: return GETME_FORMATS_OK;
     }
 }
 
-static getme_io_status line(reader *rd, inp_lines *in)
+static getme_formats_status line(reader *rd, inp_lines *in)
 {
     int kind = inp_line_kind(in->text, in->len);
     char err[256];
     if (kind == INP_LINE_BLANK || kind == INP_LINE_COMMENT)
-        return GETME_IO_OK;
+        return GETME_FORMATS_OK;
     if (rd->kw_open) {
         rd->kw_open = 0;
         if (kind == INP_LINE_DATA) {
             if (inp_keyword_parse(&rd->kw, in->text, in->len, in->offset, 0,
                                   err, sizeof err))
-                return fail(rd, GETME_IO_ERR_PARSE, "%s", err);
+                return fail(rd, GETME_FORMATS_ERR_PARSE, "%s", err);
             rd->kw_open = rd->kw.continued;
-            return rd->kw_open ? GETME_IO_OK : keyword(rd, in->offset);
+            return rd->kw_open ? GETME_FORMATS_OK : keyword(rd, in->offset);
         }
         /* A keyword after a trailing comma: the last one was complete. */
-        getme_io_status st = keyword(rd, in->offset);
+        getme_formats_status st = keyword(rd, in->offset);
         if (st)
             return st;
     }
     if (kind == INP_LINE_KEYWORD) {
         if (inp_keyword_parse(&rd->kw, in->text, in->len, in->offset, 1, err,
                               sizeof err))
-            return fail(rd, GETME_IO_ERR_PARSE, "%s", err);
+            return fail(rd, GETME_FORMATS_ERR_PARSE, "%s", err);
         rd->kw_open = rd->kw.continued;
-        return rd->kw_open ? GETME_IO_OK : keyword(rd, in->offset);
+        return rd->kw_open ? GETME_FORMATS_OK : keyword(rd, in->offset);
     }
     if (memchr(in->text, '\0', in->len))
-        return fail(rd, GETME_IO_ERR_PARSE, "NUL byte in a data line");
+        return fail(rd, GETME_FORMATS_ERR_PARSE, "NUL byte in a data line");
     return data_line(rd, in->text, in->len, in->offset);
 }
 
-static getme_io_status add_file(reader *rd, const char *path, int parent,
+static getme_formats_status add_file(reader *rd, const char *path, int parent,
                                 inp_lines *in)
 {
     inp_deck *d = rd->d;
     struct stat sb;
     if (fstat(fileno(in->fp), &sb) != 0 || !S_ISREG(sb.st_mode))
-        return fail(rd, GETME_IO_ERR_OPEN, "'%s' is not a regular file", path);
+        return fail(rd, GETME_FORMATS_ERR_OPEN, "'%s' is not a regular file", path);
     for (int i = 0; i < rd->depth; i++)
         if (rd->dev[i] == sb.st_dev && rd->ino[i] == sb.st_ino)
-            return fail(rd, GETME_IO_ERR_PARSE,
+            return fail(rd, GETME_FORMATS_ERR_PARSE,
                         "*INCLUDE cycle: '%s' is already being read", path);
     rd->dev[rd->depth] = sb.st_dev;
     rd->ino[rd->depth] = sb.st_ino;
@@ -871,21 +871,21 @@ static getme_io_status add_file(reader *rd, const char *path, int parent,
     f->mtime_nsec = (int64_t)sb.st_mtim.tv_nsec;
     rd->file = (int)d->nfiles++;
     rd->line = 0;
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-static getme_io_status read_file(reader *rd, const char *path, int parent)
+static getme_formats_status read_file(reader *rd, const char *path, int parent)
 {
     inp_lines in;
     if (inp_lines_open(&in, path) != 0) {
         const char *why = strerror(errno);
         if (parent < 0)
-            return getme_doc_fail(rd->doc, GETME_IO_ERR_OPEN,
+            return getme_doc_fail(rd->doc, GETME_FORMATS_ERR_OPEN,
                                   "cannot open '%s': %s", path, why);
-        return fail(rd, GETME_IO_ERR_OPEN, "cannot open *INCLUDE file '%s': %s",
+        return fail(rd, GETME_FORMATS_ERR_OPEN, "cannot open *INCLUDE file '%s': %s",
                     path, why);
     }
-    getme_io_status st = add_file(rd, path, parent, &in);
+    getme_formats_status st = add_file(rd, path, parent, &in);
     if (st) {
         inp_lines_close(&in);
         return st;
@@ -898,12 +898,12 @@ static getme_io_status read_file(reader *rd, const char *path, int parent)
             break;
     }
     if (!st && rc == -1)
-        st = fail(rd, GETME_IO_ERR_OPEN, "read error: %s", strerror(errno));
+        st = fail(rd, GETME_FORMATS_ERR_OPEN, "read error: %s", strerror(errno));
     if (!st && rc == -2)
-        st = fail(rd, GETME_IO_ERR_PARSE, "line %u longer than %d bytes",
+        st = fail(rd, GETME_FORMATS_ERR_PARSE, "line %u longer than %d bytes",
                   in.lineno + 1, INP_MAX_LINE);
     if (!st && rd->pending >= 0)
-        st = fail(rd, GETME_IO_ERR_PARSE,
+        st = fail(rd, GETME_FORMATS_ERR_PARSE,
                   "file ends inside element %d (line ended with ',')",
                   rd->d->elem_id[rd->d->nelems - 1]);
     if (!st && rd->kw_open && parent < 0) {
@@ -915,11 +915,11 @@ static getme_io_status read_file(reader *rd, const char *path, int parent)
     return st;
 }
 
-getme_io_status inp_read(inp_deck *d, const char *path, getme_doc *doc)
+getme_formats_status inp_read(inp_deck *d, const char *path, getme_doc *doc)
 {
     reader *rd = calloc(1, sizeof *rd);
     if (!rd)
-        return getme_doc_fail(doc, GETME_IO_ERR_INTERNAL, "out of memory");
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL, "out of memory");
     rd->d = d;
     rd->doc = doc;
     rd->file = -1;
@@ -927,7 +927,7 @@ getme_io_status inp_read(inp_deck *d, const char *path, getme_doc *doc)
     rd->nblock = rd->eblock = -1;
     rd->set = rd->chunk = -1;
     rd->pending = -1;
-    getme_io_status st = GETME_IO_OK;
+    getme_formats_status st = GETME_FORMATS_OK;
     if (new_scope(rd, INP_SCOPE_MODEL, -1) != 0)
         st = nomem(rd);
     if (!st)

@@ -49,7 +49,7 @@ static const char *base_name(const char *p)
 }
 
 /* Output names: the deck to out_path, includes next to it. */
-static getme_io_status name_outputs(writer *w, const char *out_path)
+static getme_formats_status name_outputs(writer *w, const char *out_path)
 {
     const inp_doc *st = w->st;
     const char *base = base_name(out_path);
@@ -57,7 +57,7 @@ static getme_io_status name_outputs(writer *w, const char *out_path)
     const char *dot = strrchr(base, '.');
     size_t stemlen = dot && dot != base ? (size_t)(dot - base) : strlen(base);
     if (strlen(out_path) >= PATH_BUF - 64)
-        return getme_doc_fail(w->doc, GETME_IO_ERR_WRITE, "%s: path too long",
+        return getme_doc_fail(w->doc, GETME_FORMATS_ERR_WRITE, "%s: path too long",
                               out_path);
     snprintf(w->out[0], PATH_BUF, "%s", out_path);
     for (size_t i = 1; i < st->nfiles; i++) {
@@ -73,7 +73,7 @@ static getme_io_status name_outputs(writer *w, const char *out_path)
                                (int)dirlen, out_path, (int)stemlen, base,
                                (int)ilen, inc, suffix, ext);
             if (len < 0 || len >= PATH_BUF)
-                return getme_doc_fail(w->doc, GETME_IO_ERR_WRITE,
+                return getme_doc_fail(w->doc, GETME_FORMATS_ERR_WRITE,
                                       "%s: path too long", out_path);
             int clash = 0;
             for (size_t j = 0; j < i && !clash; j++)
@@ -87,7 +87,7 @@ static getme_io_status name_outputs(writer *w, const char *out_path)
     for (size_t i = 1; i < st->nfiles; i++) {
         struct stat sb;
         if (lstat(w->out[i], &sb) == 0 && !S_ISREG(sb.st_mode))
-            return getme_doc_fail(w->doc, GETME_IO_ERR_USAGE,
+            return getme_doc_fail(w->doc, GETME_FORMATS_ERR_ARGUMENT,
                                   "output '%s' (the copy of included '%s') "
                                   "exists and is not a regular file",
                                   w->out[i], st->files[i].path);
@@ -96,10 +96,10 @@ static getme_io_status name_outputs(writer *w, const char *out_path)
     for (size_t i = 0; i < st->nfiles; i++)
         for (size_t j = 0; j < st->nfiles; j++)
             if (getme_io_same_file(w->out[i], st->files[j].path))
-                return getme_doc_fail(w->doc, GETME_IO_ERR_USAGE,
+                return getme_doc_fail(w->doc, GETME_FORMATS_ERR_ARGUMENT,
                                       "output '%s' would overwrite input '%s'",
                                       w->out[i], st->files[j].path);
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* ---- one node line ---------------------------------------------------------- */
@@ -180,9 +180,9 @@ static int include_line(writer *w, FILE *out, const inp_lines *in,
     return 0;
 }
 
-static getme_io_status changed(writer *w, int file)
+static getme_formats_status changed(writer *w, int file)
 {
-    return getme_doc_fail(w->doc, GETME_IO_ERR_WRITE,
+    return getme_doc_fail(w->doc, GETME_FORMATS_ERR_WRITE,
                           "'%s' changed since it was read: not writing",
                           w->st->files[file].path);
 }
@@ -250,7 +250,7 @@ static int copy_line(writer *w, FILE *out, const inp_lines *in, int file,
     return put(out, in->term, strlen(in->term));
 }
 
-static getme_io_status write_file(writer *w, int file)
+static getme_formats_status write_file(writer *w, int file)
 {
     const inp_doc *st = w->st;
     const char *path = st->files[file].path;
@@ -258,13 +258,13 @@ static getme_io_status write_file(writer *w, int file)
         return changed(w, file);
     inp_lines in;
     if (inp_lines_open(&in, path))
-        return getme_doc_fail(w->doc, GETME_IO_ERR_OPEN, "cannot reopen '%s': %s",
+        return getme_doc_fail(w->doc, GETME_FORMATS_ERR_OPEN, "cannot reopen '%s': %s",
                               path, strerror(errno));
     FILE *out = fopen(w->tmp[file], "wb");
     if (!out) {
         int e = errno;
         inp_lines_close(&in);
-        return getme_doc_fail(w->doc, GETME_IO_ERR_WRITE, "cannot write '%s': %s",
+        return getme_doc_fail(w->doc, GETME_FORMATS_ERR_WRITE, "cannot write '%s': %s",
                               w->out[file], strerror(e));
     }
     static const size_t outbuf = 1 << 20;
@@ -280,23 +280,23 @@ static getme_io_status write_file(writer *w, int file)
         werr = 1;
     inp_lines_close(&in);
     if (werr)
-        return getme_doc_fail(w->doc, GETME_IO_ERR_WRITE, "cannot write '%s': %s",
+        return getme_doc_fail(w->doc, GETME_FORMATS_ERR_WRITE, "cannot write '%s': %s",
                               w->out[file], strerror(errno ? errno : EIO));
     if (rc)
         return changed(w, file);
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-static getme_io_status write_all(writer *w, const char *out_path)
+static getme_formats_status write_all(writer *w, const char *out_path)
 {
     const inp_doc *st = w->st;
-    getme_io_status s = name_outputs(w, out_path);
+    getme_formats_status s = name_outputs(w, out_path);
     if (s)
         return s;
     size_t made = 0;
     for (; made < st->nfiles && !s; made++)
         if (getme_io_tmp_path(w->out[made], w->tmp[made], PATH_BUF))
-            s = getme_doc_fail(w->doc, GETME_IO_ERR_WRITE,
+            s = getme_doc_fail(w->doc, GETME_FORMATS_ERR_WRITE,
                                "cannot create a temporary file next to '%s': %s",
                                w->out[made], strerror(errno));
     if (s)
@@ -315,11 +315,11 @@ static getme_io_status write_all(writer *w, const char *out_path)
             int e = errno;
             for (size_t j = 0; j < i; j++)
                 remove(w->tmp[j]);
-            return getme_doc_fail(w->doc, GETME_IO_ERR_WRITE,
+            return getme_doc_fail(w->doc, GETME_FORMATS_ERR_WRITE,
                                   "cannot write '%s': %s", w->out[i],
                                   strerror(e));
         }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* Smoothing can move a node that is already where it belongs by a
@@ -346,13 +346,13 @@ static double keep_tolerance(const double *xyz, int32_t n)
     return INP_KEEP_REL * sqrt(d2);
 }
 
-getme_io_status inp_write(getme_doc *doc, const inp_doc *st,
+getme_formats_status inp_write(getme_doc *doc, const inp_doc *st,
                           const char *out_path)
 {
     if (!st || !doc->mesh)
-        return getme_doc_fail(doc, GETME_IO_ERR_INTERNAL, "document not open");
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL, "document not open");
     if (getme_mesh_num_nodes(doc->mesh) != st->nnodes)
-        return getme_doc_fail(doc, GETME_IO_ERR_INTERNAL,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL,
                               "mesh and deck differ in node count");
     writer w;
     memset(&w, 0, sizeof w);
@@ -363,9 +363,9 @@ getme_io_status inp_write(getme_doc *doc, const inp_doc *st,
     w.keep_tol = keep_tolerance(w.xyz, st->nnodes);
     w.out = malloc(st->nfiles * sizeof *w.out);
     w.tmp = malloc(st->nfiles * sizeof *w.tmp);
-    getme_io_status s = w.out && w.tmp
+    getme_formats_status s = w.out && w.tmp
                             ? write_all(&w, out_path)
-                            : getme_doc_fail(doc, GETME_IO_ERR_INTERNAL,
+                            : getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL,
                                              "out of memory");
     free(w.out);
     free(w.tmp);

@@ -13,31 +13,31 @@
 #include <stdlib.h>
 #include <string.h>
 
-static getme_io_status oom(msh41_reader *r)
+static getme_formats_status oom(msh41_reader *r)
 {
-    return getme_doc_fail(r->doc, GETME_IO_ERR_INTERNAL,
+    return getme_doc_fail(r->doc, GETME_FORMATS_ERR_INTERNAL,
                           "'%s': out of memory", r->doc->path);
 }
 
 /* ---- node tag map ------------------------------------------------------- */
 
-getme_io_status msh41_map_build(msh41_reader *r, msh41_nodemap *map,
+getme_formats_status msh41_map_build(msh41_reader *r, msh41_nodemap *map,
                                 const uint64_t *tags, size_t n)
 {
     memset(map, 0, sizeof *map);
     for (size_t i = 0; i < n; i++)
         if (tags[i] == 0)
-            return getme_doc_fail(r->doc, GETME_IO_ERR_PARSE,
+            return getme_doc_fail(r->doc, GETME_FORMATS_ERR_PARSE,
                                   "'%s': node tag 0 in $Nodes (tags start "
                                   "at 1)",
                                   r->doc->path);
     uint64_t repeated = 0;
     getme_status st = getme__nodemap_build(map, tags, n, &repeated);
     if (st == GETME_ERR_ARGUMENT)
-        return getme_doc_fail(r->doc, GETME_IO_ERR_PARSE,
+        return getme_doc_fail(r->doc, GETME_FORMATS_ERR_PARSE,
                               "'%s': node %llu appears twice in $Nodes",
                               r->doc->path, (unsigned long long)repeated);
-    return st == GETME_OK ? GETME_IO_OK : oom(r);
+    return st == GETME_OK ? GETME_FORMATS_OK : oom(r);
 }
 
 /* ---- block order and type checks ---------------------------------------- */
@@ -65,7 +65,7 @@ static int cmp_key(const void *a, const void *b)
                 (long long)y->pos);
 }
 
-static getme_io_status sort_blocks(msh41_reader *r)
+static getme_formats_status sort_blocks(msh41_reader *r)
 {
     size_t n = r->neb;
     block_key *key = malloc((n ? n : 1) * sizeof *key);
@@ -83,7 +83,7 @@ static getme_io_status sort_blocks(msh41_reader *r)
     memcpy(r->eb, sorted, n * sizeof *sorted);
     free(key);
     free(sorted);
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* ---- nodes -------------------------------------------------------------- */
@@ -149,7 +149,7 @@ static void describe_groups(const msh41_reader *r, char *buf, size_t size)
     free(pairs);
 }
 
-static getme_io_status check_fix_names(msh41_reader *r)
+static getme_formats_status check_fix_names(msh41_reader *r)
 {
     int nfix = r->opts ? r->opts->num_fix : 0;
     int nfree = r->opts ? r->opts->num_free : 0;
@@ -158,14 +158,14 @@ static getme_io_status check_fix_names(msh41_reader *r)
             continue;
         char known[300];
         describe_groups(r, known, sizeof known);
-        return getme_doc_fail(r->doc, GETME_IO_ERR_USAGE,
+        return getme_doc_fail(r->doc, GETME_FORMATS_ERR_ARGUMENT,
                               "'%s': Unknown physical group '%s' to %s (%s)",
                               r->doc->path,
                               w < nfix ? r->opts->fix[w]
                                        : r->opts->free_sets[w - nfix],
                               w < nfix ? "fix" : "free", known);
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* "MSH 4.1 binary, model 'box': 2 volumes, ..." as the Gmsh path says. */
@@ -189,21 +189,21 @@ static void describe(msh41_reader *r, size_t num_entities)
 
 /* ---- build -------------------------------------------------------------- */
 
-static getme_io_status model_fail(msh41_reader *r, getme_status st,
+static getme_formats_status model_fail(msh41_reader *r, getme_status st,
                                   const char *msg)
 {
     /* the Gmsh path's mapping (plugin/src/gmsh_format.c) */
-    getme_io_status io = st == GETME_ERR_ARGUMENT ? GETME_IO_ERR_USAGE
+    getme_formats_status io = st == GETME_ERR_ARGUMENT ? GETME_FORMATS_ERR_ARGUMENT
                          : st == GETME_ERR_TOPOLOGY || st == GETME_ERR_STATE
-                             ? GETME_IO_ERR_UNSUPPORTED
-                         : st == GETME_ERR_INVALID_MESH ? GETME_IO_ERR_INVALID
-                                                        : GETME_IO_ERR_INTERNAL;
+                             ? GETME_FORMATS_ERR_UNSUPPORTED
+                         : st == GETME_ERR_INVALID_MESH ? GETME_FORMATS_ERR_INVALID
+                                                        : GETME_FORMATS_ERR_INTERNAL;
     return getme_doc_fail(r->doc, io, "'%s': %s", r->doc->path, msg);
 }
 
 /* The builder's input: entities (distinct block tags) with their physical
    tags, node blocks in Gmsh's order with the classification flag. */
-static getme_io_status make_input(msh41_reader *r, getme__model_in *in,
+static getme_formats_status make_input(msh41_reader *r, getme__model_in *in,
                                   getme__node_range **ranges, int ***phys,
                                   size_t **nphys)
 {
@@ -244,13 +244,13 @@ static getme_io_status make_input(msh41_reader *r, getme__model_in *in,
         .z_plane_only = 1,
         .fix_flags = (o && !o->fix_skin ? 0u : GETME_FIX_SKIN) |
                      (o && !o->fix_interfaces ? 0u : GETME_FIX_INTERFACES)};
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-getme_io_status msh41_build(msh41_reader *r, msh41_doc *m)
+getme_formats_status msh41_build(msh41_reader *r, msh41_doc *m)
 {
     if (r->top_dim < 2 || !r->neb)
-        return getme_doc_fail(r->doc, GETME_IO_ERR_UNSUPPORTED,
+        return getme_doc_fail(r->doc, GETME_FORMATS_ERR_UNSUPPORTED,
                               "'%s': No volume or surface mesh in the "
                               "current model: generate the mesh or open a "
                               "mesh file first",
@@ -261,16 +261,16 @@ getme_io_status msh41_build(msh41_reader *r, msh41_doc *m)
     int **phys = NULL;
     size_t *nphys = NULL;
     memset(&out, 0, sizeof out);
-    getme_io_status st = sort_blocks(r);
-    if (st == GETME_IO_OK)
+    getme_formats_status st = sort_blocks(r);
+    if (st == GETME_FORMATS_OK)
         st = make_input(r, &in, &ranges, &phys, &nphys);
     getme_status gs = GETME_OK;
-    if (st == GETME_IO_OK) {
+    if (st == GETME_FORMATS_OK) {
         gs = getme__model_number(&in, &out);
         if (gs != GETME_OK)
             st = model_fail(r, gs, out.msg);
     }
-    if (st == GETME_IO_OK) {
+    if (st == GETME_FORMATS_OK) {
         getme__nodemap_relabel(&r->map, out.loc);
         /* The file-order arrays are no longer needed: free them before the
            mesh copies the coordinates. */
@@ -284,9 +284,9 @@ getme_io_status msh41_build(msh41_reader *r, msh41_doc *m)
         else if (out.declined)
             st = msh41_decline(r, "planar mesh not in a plane z = const");
     }
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = check_fix_names(r);
-    if (st == GETME_IO_OK) {
+    if (st == GETME_FORMATS_OK) {
         r->doc->mesh = out.mesh;
         r->doc->elem_ids = out.elem_ids;
         out.mesh = NULL;

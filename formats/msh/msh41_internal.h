@@ -96,12 +96,12 @@ typedef struct msh41_doc {
  * Read doc->path (MSH 4.1, header already checked by the caller) into
  * doc->mesh / doc->elem_ids / doc->info and *out.  If the file is outside
  * what this reader handles, *eligible is set to 0, why says what, the
- * document is left as it was and GETME_IO_OK is returned.
+ * document is left as it was and GETME_FORMATS_OK is returned.
  */
-getme_io_status msh41_open(getme_doc *doc, const getme_doc_options *opts,
+getme_formats_status msh41_open(getme_doc *doc, const getme_doc_options *opts,
                            msh41_doc **out, int *eligible, char *why,
                            size_t why_size);
-getme_io_status msh41_write(getme_doc *doc, const msh41_doc *m,
+getme_formats_status msh41_write(getme_doc *doc, const msh41_doc *m,
                             const char *out_path);
 void msh41_free(msh41_doc *m);
 
@@ -110,7 +110,7 @@ void msh41_free(msh41_doc *m);
 
 /* Status of a reader step that declines the file (not an error: the
    caller falls back to Gmsh's reader). */
-#define MSH41_DECLINED ((getme_io_status)99)
+#define MSH41_DECLINED ((getme_formats_status)99)
 
 typedef struct msh41_pname {  /* $PhysicalNames entry */
     int dim, tag;
@@ -175,20 +175,20 @@ typedef struct msh41_reader {
 
 /* Error at the current position: "'file', line N: ..." (ASCII) or
    "'file': ... (byte N)" (binary). */
-getme_io_status msh41_fail(msh41_reader *r, getme_io_status st,
+getme_formats_status msh41_fail(msh41_reader *r, getme_formats_status st,
                            const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
-getme_io_status msh41_decline(msh41_reader *r, const char *why);
+getme_formats_status msh41_decline(msh41_reader *r, const char *why);
 msh41_entity *msh41_find_entity(const msh41_reader *r, int dim, int tag);
 /* $PhysicalNames name of group (dim, tag), NULL if it has none. */
 const char *msh41_group_name(const msh41_reader *r, int dim, int tag);
 /* Everything after parsing: mesh, fixed nodes, regions, ids, info. */
-getme_io_status msh41_build(msh41_reader *r, msh41_doc *m);
+getme_formats_status msh41_build(msh41_reader *r, msh41_doc *m);
 /* Node tag -> index of tags[0..n) (tag 0 and repeated tags refused). */
-getme_io_status msh41_map_build(msh41_reader *r, msh41_nodemap *map,
+getme_formats_status msh41_map_build(msh41_reader *r, msh41_nodemap *map,
                                 const uint64_t *tags, size_t n);
 
 #endif /* GETME_MSH41_INTERNAL_H */

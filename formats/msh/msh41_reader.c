@@ -27,7 +27,7 @@
 
 /* ---- messages ----------------------------------------------------------- */
 
-getme_io_status msh41_fail(msh41_reader *r, getme_io_status st,
+getme_formats_status msh41_fail(msh41_reader *r, getme_formats_status st,
                            const char *fmt, ...)
 {
     char msg[768];
@@ -43,7 +43,7 @@ getme_io_status msh41_fail(msh41_reader *r, getme_io_status st,
                           r->in.line, msg);
 }
 
-getme_io_status msh41_decline(msh41_reader *r, const char *why)
+getme_formats_status msh41_decline(msh41_reader *r, const char *why)
 {
     snprintf(r->why, sizeof r->why, "%s", why);
     return MSH41_DECLINED;
@@ -51,7 +51,7 @@ getme_io_status msh41_decline(msh41_reader *r, const char *why)
 
 /* For checks made after a whole line was read: name that line, not the
    next one. */
-static getme_io_status line_fail(msh41_reader *r, getme_io_status st,
+static getme_formats_status line_fail(msh41_reader *r, getme_formats_status st,
                                  const char *msg)
 {
     long saved = r->in.line;
@@ -61,16 +61,16 @@ static getme_io_status line_fail(msh41_reader *r, getme_io_status st,
     return st;
 }
 
-static getme_io_status eof_error(msh41_reader *r)
+static getme_formats_status eof_error(msh41_reader *r)
 {
-    return msh41_fail(r, GETME_IO_ERR_PARSE,
+    return msh41_fail(r, GETME_FORMATS_ERR_PARSE,
                       "unexpected end of file in $%s (truncated file?)",
                       r->section);
 }
 
-static getme_io_status oom(msh41_reader *r)
+static getme_formats_status oom(msh41_reader *r)
 {
-    return getme_doc_fail(r->doc, GETME_IO_ERR_INTERNAL,
+    return getme_doc_fail(r->doc, GETME_FORMATS_ERR_INTERNAL,
                           "'%s': out of memory", r->doc->path);
 }
 
@@ -92,15 +92,15 @@ static int32_t le32(const unsigned char *b)
 }
 
 /* The next ASCII token, or an error naming what was expected. */
-static getme_io_status token(msh41_reader *r, char *tok, const char *what)
+static getme_formats_status token(msh41_reader *r, char *tok, const char *what)
 {
     int n = msh41_in_token(&r->in, tok, TOK);
     if (n == 0)
         return eof_error(r);
     if (n < 0)
-        return msh41_fail(r, GETME_IO_ERR_PARSE, "%s too long in $%s", what,
+        return msh41_fail(r, GETME_FORMATS_ERR_PARSE, "%s too long in $%s", what,
                           r->section);
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 static int parse_u64(const char *s, uint64_t *v)
@@ -119,7 +119,7 @@ static int parse_u64(const char *s, uint64_t *v)
     return 0;
 }
 
-static getme_io_status read_u64(msh41_reader *r, uint64_t *v,
+static getme_formats_status read_u64(msh41_reader *r, uint64_t *v,
                                 const char *what)
 {
     if (r->binary) {
@@ -127,39 +127,39 @@ static getme_io_status read_u64(msh41_reader *r, uint64_t *v,
         if (msh41_in_read(&r->in, b, 8))
             return eof_error(r);
         *v = le64(b);
-        return GETME_IO_OK;
+        return GETME_FORMATS_OK;
     }
     char tok[TOK];
-    getme_io_status st = token(r, tok, what);
-    if (st == GETME_IO_OK && parse_u64(tok, v))
-        st = msh41_fail(r, GETME_IO_ERR_PARSE, "bad %s '%s' in $%s", what,
+    getme_formats_status st = token(r, tok, what);
+    if (st == GETME_FORMATS_OK && parse_u64(tok, v))
+        st = msh41_fail(r, GETME_FORMATS_ERR_PARSE, "bad %s '%s' in $%s", what,
                         tok, r->section);
     return st;
 }
 
-static getme_io_status read_int(msh41_reader *r, int *v, const char *what)
+static getme_formats_status read_int(msh41_reader *r, int *v, const char *what)
 {
     if (r->binary) {
         unsigned char b[4];
         if (msh41_in_read(&r->in, b, 4))
             return eof_error(r);
         *v = le32(b);
-        return GETME_IO_OK;
+        return GETME_FORMATS_OK;
     }
     char tok[TOK];
-    getme_io_status st = token(r, tok, what);
-    if (st != GETME_IO_OK)
+    getme_formats_status st = token(r, tok, what);
+    if (st != GETME_FORMATS_OK)
         return st;
     uint64_t x;
     int neg = tok[0] == '-';
     if (parse_u64(tok + neg, &x) || x > (uint64_t)INT32_MAX)
-        return msh41_fail(r, GETME_IO_ERR_PARSE, "bad %s '%s' in $%s", what,
+        return msh41_fail(r, GETME_FORMATS_ERR_PARSE, "bad %s '%s' in $%s", what,
                           tok, r->section);
     *v = neg ? -(int)x : (int)x;
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-static getme_io_status read_double(msh41_reader *r, double *v)
+static getme_formats_status read_double(msh41_reader *r, double *v)
 {
     if (r->binary) {
         unsigned char b[8];
@@ -167,28 +167,28 @@ static getme_io_status read_double(msh41_reader *r, double *v)
             return eof_error(r);
         uint64_t bits = le64(b);
         memcpy(v, &bits, sizeof *v);
-        return GETME_IO_OK;
+        return GETME_FORMATS_OK;
     }
     char tok[TOK], *end;
-    getme_io_status st = token(r, tok, "number");
-    if (st != GETME_IO_OK)
+    getme_formats_status st = token(r, tok, "number");
+    if (st != GETME_FORMATS_OK)
         return st;
     errno = 0;
     *v = numparse_strtod(tok, &end);
     if (*end || end == tok)
-        return msh41_fail(r, GETME_IO_ERR_PARSE, "bad number '%s' in $%s",
+        return msh41_fail(r, GETME_FORMATS_ERR_PARSE, "bad number '%s' in $%s",
                           tok, r->section);
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* A count that must fit in the file (each item takes at least min_bytes):
    refuses absurd counts before anything is allocated for them. */
-static getme_io_status read_count(msh41_reader *r, uint64_t *v,
+static getme_formats_status read_count(msh41_reader *r, uint64_t *v,
                                   const char *what, uint64_t min_bytes)
 {
-    getme_io_status st = read_u64(r, v, what);
-    if (st == GETME_IO_OK && *v > (uint64_t)r->file_size / min_bytes)
-        st = msh41_fail(r, GETME_IO_ERR_PARSE,
+    getme_formats_status st = read_u64(r, v, what);
+    if (st == GETME_FORMATS_OK && *v > (uint64_t)r->file_size / min_bytes)
+        st = msh41_fail(r, GETME_FORMATS_ERR_PARSE,
                         "%s %llu is more than the file can hold", what,
                         (unsigned long long)*v);
     return st;
@@ -198,7 +198,7 @@ static getme_io_status read_count(msh41_reader *r, uint64_t *v,
 
 /* After a section's data: the "$End<name>" line (binary data ends with a
    newline before it). */
-static getme_io_status expect_end(msh41_reader *r)
+static getme_formats_status expect_end(msh41_reader *r)
 {
     char line[TOK], want[64];
     snprintf(want, sizeof want, "$End%s", r->section);
@@ -208,9 +208,9 @@ static getme_io_status expect_end(msh41_reader *r)
         snprintf(msg, sizeof msg,
                  "expected %s (wrong count or truncated data in $%s)", want,
                  r->section);
-        return line_fail(r, GETME_IO_ERR_PARSE, msg);
+        return line_fail(r, GETME_FORMATS_ERR_PARSE, msg);
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* Sections we do not need ($Periodic, $NodeData, $GhostElements...): scan
@@ -218,20 +218,20 @@ static getme_io_status expect_end(msh41_reader *r)
    a payload holding exactly "\n$EndName\n" is not a concern in practice,
    and computing the size of every kind of section would tie this reader
    to each of their layouts. */
-static getme_io_status skip_section(msh41_reader *r, const char *name)
+static getme_formats_status skip_section(msh41_reader *r, const char *name)
 {
     char line[TOK], want[TOK + 8];
     snprintf(want, sizeof want, "$End%s", name);
     while (msh41_in_line(&r->in, line, sizeof line) == 0)
         if (strcmp(line, want) == 0)
-            return GETME_IO_OK;
-    return msh41_fail(r, GETME_IO_ERR_PARSE, "no %s before the end of the file",
+            return GETME_FORMATS_OK;
+    return msh41_fail(r, GETME_FORMATS_ERR_PARSE, "no %s before the end of the file",
                       want);
 }
 
 /* ---- $MeshFormat -------------------------------------------------------- */
 
-static getme_io_status read_format(msh41_reader *r)
+static getme_formats_status read_format(msh41_reader *r)
 {
     char line[TOK];
     double version = 0;
@@ -242,14 +242,14 @@ static getme_io_status read_format(msh41_reader *r)
         msh41_in_line(&r->in, line, sizeof line) ||
         sscanf(line, "%lf %d %d", &version, &file_type, &data_size) != 3 ||
         (file_type != 0 && file_type != 1))
-        return line_fail(r, GETME_IO_ERR_PARSE,
+        return line_fail(r, GETME_FORMATS_ERR_PARSE,
                          "bad $MeshFormat header (want \"4.1 0|1 8\")");
     if (version != 4.1 && version != 2.2)
         return msh41_decline(r, "not MSH 4.1 or 2.2");
     r->v22 = version == 2.2;
     r->binary = file_type == 1;
     if (r->binary && data_size != 8)
-        return msh41_fail(r, GETME_IO_ERR_UNSUPPORTED,
+        return msh41_fail(r, GETME_FORMATS_ERR_UNSUPPORTED,
                           "binary MSH with data size %d: only 8-byte size_t "
                           "is supported",
                           data_size);
@@ -260,7 +260,7 @@ static getme_io_status read_format(msh41_reader *r)
         if (le32(one) == 0x01000000)
             return msh41_decline(r, "big-endian binary file");
         if (le32(one) != 1)
-            return msh41_fail(r, GETME_IO_ERR_PARSE,
+            return msh41_fail(r, GETME_FORMATS_ERR_PARSE,
                               "bad endianness marker in $MeshFormat");
     }
     return expect_end(r);
@@ -268,7 +268,7 @@ static getme_io_status read_format(msh41_reader *r)
 
 /* ---- $PhysicalNames (ASCII in both flavours) ----------------------------- */
 
-static getme_io_status read_name(msh41_reader *r, msh41_pname *p)
+static getme_formats_status read_name(msh41_reader *r, msh41_pname *p)
 {
     char line[1024];
     msh41_in_skip_space(&r->in);
@@ -278,40 +278,40 @@ static getme_io_status read_name(msh41_reader *r, msh41_pname *p)
     char *q1 = strchr(line, '"'), *q2 = q1 ? strrchr(line, '"') : NULL;
     if (sscanf(line, "%d %d %n", &p->dim, &p->tag, &used) < 2 || !q1 ||
         q2 == q1)
-        return line_fail(r, GETME_IO_ERR_PARSE,
+        return line_fail(r, GETME_FORMATS_ERR_PARSE,
                          "bad physical name line (want: dim tag \"name\")");
     p->name = malloc((size_t)(q2 - q1));
     if (!p->name)
         return oom(r);
     memcpy(p->name, q1 + 1, (size_t)(q2 - q1 - 1));
     p->name[q2 - q1 - 1] = 0;
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-static getme_io_status read_physical_names(msh41_reader *r)
+static getme_formats_status read_physical_names(msh41_reader *r)
 {
     char line[TOK];
     unsigned long long n = 0;
     r->section = "PhysicalNames";
     int save = r->binary;
     r->binary = 0; /* text even in binary files */
-    getme_io_status st = GETME_IO_OK;
+    getme_formats_status st = GETME_FORMATS_OK;
     msh41_in_skip_space(&r->in);
     if (msh41_in_line(&r->in, line, sizeof line) ||
         sscanf(line, "%llu", &n) != 1 || n > (uint64_t)r->file_size / 6)
-        st = line_fail(r, GETME_IO_ERR_PARSE, "bad number of names");
-    if (st == GETME_IO_OK && r->names == NULL && n > 0) {
+        st = line_fail(r, GETME_FORMATS_ERR_PARSE, "bad number of names");
+    if (st == GETME_FORMATS_OK && r->names == NULL && n > 0) {
         r->names = calloc((size_t)n, sizeof *r->names);
         if (!r->names)
             st = oom(r);
-    } else if (st == GETME_IO_OK && n > 0) {
-        st = msh41_fail(r, GETME_IO_ERR_PARSE, "second $PhysicalNames");
+    } else if (st == GETME_FORMATS_OK && n > 0) {
+        st = msh41_fail(r, GETME_FORMATS_ERR_PARSE, "second $PhysicalNames");
     }
-    for (size_t i = 0; st == GETME_IO_OK && i < n; i++) {
+    for (size_t i = 0; st == GETME_FORMATS_OK && i < n; i++) {
         st = read_name(r, &r->names[i]);
-        r->nnames += st == GETME_IO_OK;
+        r->nnames += st == GETME_FORMATS_OK;
     }
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = expect_end(r);
     r->binary = save;
     return st;
@@ -319,7 +319,7 @@ static getme_io_status read_physical_names(msh41_reader *r)
 
 /* ---- $Entities ---------------------------------------------------------- */
 
-static getme_io_status add_phys(msh41_reader *r, int tag, size_t *cap)
+static getme_formats_status add_phys(msh41_reader *r, int tag, size_t *cap)
 {
     if (r->nphys == *cap) {
         size_t ncap = *cap ? 2 * *cap : 64;
@@ -330,33 +330,33 @@ static getme_io_status add_phys(msh41_reader *r, int tag, size_t *cap)
         *cap = ncap;
     }
     r->phys[r->nphys++] = tag;
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* One entity: tag, box (a point for dim 0), physical tags, bounding
    entities (skipped). */
-static getme_io_status read_entity(msh41_reader *r, int dim, msh41_entity *e,
+static getme_formats_status read_entity(msh41_reader *r, int dim, msh41_entity *e,
                                    size_t *cap)
 {
     uint64_t n = 0;
     double skip;
     e->dim = dim;
-    getme_io_status st = read_int(r, &e->tag, "entity tag");
-    for (int k = 0; k < (dim ? 6 : 3) && st == GETME_IO_OK; k++)
+    getme_formats_status st = read_int(r, &e->tag, "entity tag");
+    for (int k = 0; k < (dim ? 6 : 3) && st == GETME_FORMATS_OK; k++)
         st = read_double(r, &skip);
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = read_count(r, &n, "number of physical tags", 2);
     e->phys_first = r->nphys;
     e->phys_count = (size_t)n;
-    for (uint64_t i = 0; i < n && st == GETME_IO_OK; i++) {
+    for (uint64_t i = 0; i < n && st == GETME_FORMATS_OK; i++) {
         int tag = 0;
         st = read_int(r, &tag, "physical tag");
-        if (st == GETME_IO_OK)
+        if (st == GETME_FORMATS_OK)
             st = add_phys(r, tag, cap);
     }
-    if (dim > 0 && st == GETME_IO_OK)
+    if (dim > 0 && st == GETME_FORMATS_OK)
         st = read_count(r, &n, "number of bounding entities", 2);
-    for (uint64_t i = 0; dim > 0 && i < n && st == GETME_IO_OK; i++) {
+    for (uint64_t i = 0; dim > 0 && i < n && st == GETME_FORMATS_OK; i++) {
         int tag = 0;
         st = read_int(r, &tag, "bounding entity tag");
     }
@@ -380,35 +380,35 @@ msh41_entity *msh41_find_entity(const msh41_reader *r, int dim, int tag)
                     : NULL;
 }
 
-static getme_io_status read_entities(msh41_reader *r)
+static getme_formats_status read_entities(msh41_reader *r)
 {
     uint64_t count[4], total = 0;
     size_t cap = 0;
     r->section = "Entities";
     if (r->ents || r->have_nodes)
         return msh41_decline(r, "$Entities repeated or after $Nodes");
-    getme_io_status st = GETME_IO_OK;
-    for (int d = 0; d < 4 && st == GETME_IO_OK; d++) {
+    getme_formats_status st = GETME_FORMATS_OK;
+    for (int d = 0; d < 4 && st == GETME_FORMATS_OK; d++) {
         st = read_count(r, &count[d], "number of entities", 8);
-        total += st == GETME_IO_OK ? count[d] : 0;
+        total += st == GETME_FORMATS_OK ? count[d] : 0;
     }
-    if (st == GETME_IO_OK && total > 0) {
+    if (st == GETME_FORMATS_OK && total > 0) {
         r->ents = calloc((size_t)total, sizeof *r->ents);
         if (!r->ents)
             st = oom(r);
     }
-    for (int d = 0; d < 4 && st == GETME_IO_OK; d++)
-        for (uint64_t i = 0; i < count[d] && st == GETME_IO_OK; i++) {
+    for (int d = 0; d < 4 && st == GETME_FORMATS_OK; d++)
+        for (uint64_t i = 0; i < count[d] && st == GETME_FORMATS_OK; i++) {
             st = read_entity(r, d, &r->ents[r->nents], &cap);
-            r->nents += st == GETME_IO_OK;
+            r->nents += st == GETME_FORMATS_OK;
         }
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = expect_end(r);
-    if (st == GETME_IO_OK && r->nents) {
+    if (st == GETME_FORMATS_OK && r->nents) {
         qsort(r->ents, r->nents, sizeof *r->ents, cmp_entity);
         for (size_t i = 1; i < r->nents; i++)
             if (cmp_entity(&r->ents[i - 1], &r->ents[i]) == 0)
-                return msh41_fail(r, GETME_IO_ERR_PARSE,
+                return msh41_fail(r, GETME_FORMATS_ERR_PARSE,
                                   "entity (%d, %d) is defined twice",
                                   r->ents[i].dim, r->ents[i].tag);
     }
@@ -428,13 +428,13 @@ const char *msh41_group_name(const msh41_reader *r, int dim, int tag)
 
 /* Mark the entities of the groups each --fix word names (groups are
    (dim, physical tag) pairs that some entity carries). */
-static getme_io_status prepare_groups(msh41_reader *r)
+static getme_formats_status prepare_groups(msh41_reader *r)
 {
     int nfix = r->opts ? r->opts->num_fix : 0;
     int nfree = r->opts ? r->opts->num_free : 0;
     if (r->groups_ready || nfix + nfree == 0) {
         r->groups_ready = 1;
-        return GETME_IO_OK;
+        return GETME_FORMATS_OK;
     }
     r->groups_ready = 1;
     /* --fix words first, then --free words (only looked up: no physical
@@ -463,16 +463,16 @@ static getme_io_status prepare_groups(msh41_reader *r)
             }
         }
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* ---- $Nodes ------------------------------------------------------------- */
 
-static getme_io_status alloc_nodes(msh41_reader *r, uint64_t nblocks,
+static getme_formats_status alloc_nodes(msh41_reader *r, uint64_t nblocks,
                                    uint64_t n)
 {
     if (n > (uint64_t)INT32_MAX)
-        return msh41_fail(r, GETME_IO_ERR_UNSUPPORTED,
+        return msh41_fail(r, GETME_FORMATS_ERR_UNSUPPORTED,
                           "%llu nodes: more than 2^31-1 are not supported",
                           (unsigned long long)n);
     size_t k = n ? (size_t)n : 1;
@@ -482,16 +482,16 @@ static getme_io_status alloc_nodes(msh41_reader *r, uint64_t nblocks,
     r->nb = malloc((nblocks ? (size_t)nblocks : 1) * sizeof *r->nb);
     if (!r->tags || !r->xyz || !r->flag || !r->nb)
         return oom(r);
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* Node tags of one block: binary as one array, decoded in place. */
-static getme_io_status read_node_tags(msh41_reader *r, uint64_t *tags,
+static getme_formats_status read_node_tags(msh41_reader *r, uint64_t *tags,
                                       size_t n)
 {
     if (!r->binary) {
-        getme_io_status st = GETME_IO_OK;
-        for (size_t i = 0; i < n && st == GETME_IO_OK; i++)
+        getme_formats_status st = GETME_FORMATS_OK;
+        for (size_t i = 0; i < n && st == GETME_FORMATS_OK; i++)
             st = read_u64(r, &tags[i], "node tag");
         return st;
     }
@@ -499,15 +499,15 @@ static getme_io_status read_node_tags(msh41_reader *r, uint64_t *tags,
         return eof_error(r);
     for (size_t i = 0; i < n; i++)
         tags[i] = le64((const unsigned char *)&tags[i]);
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* Coordinates of one block.  ASCII: one node per line, which the writer
    relies on (anything else is declined). */
-static getme_io_status not_finite(msh41_reader *r, uint64_t tag,
+static getme_formats_status not_finite(msh41_reader *r, uint64_t tag,
                                   const double *x)
 {
-    return msh41_fail(r, GETME_IO_ERR_PARSE,
+    return msh41_fail(r, GETME_FORMATS_ERR_PARSE,
                       "node %llu has a coordinate that is not a finite "
                       "number (%g %g %g)",
                       (unsigned long long)tag, x[0], x[1], x[2]);
@@ -518,7 +518,7 @@ static int finite3(const double *x)
     return isfinite(x[0]) && isfinite(x[1]) && isfinite(x[2]);
 }
 
-static getme_io_status read_node_coords(msh41_reader *r, double *xyz,
+static getme_formats_status read_node_coords(msh41_reader *r, double *xyz,
                                         const uint64_t *tags, size_t n)
 {
     if (r->binary) {
@@ -531,61 +531,61 @@ static getme_io_status read_node_coords(msh41_reader *r, double *xyz,
         for (size_t i = 0; i < n; i++)
             if (!finite3(xyz + 3 * i))
                 return not_finite(r, tags[i], xyz + 3 * i);
-        return GETME_IO_OK;
+        return GETME_FORMATS_OK;
     }
-    getme_io_status st = GETME_IO_OK;
-    for (size_t i = 0; i < n && st == GETME_IO_OK; i++) {
-        for (int k = 0; k < 3 && st == GETME_IO_OK; k++)
+    getme_formats_status st = GETME_FORMATS_OK;
+    for (size_t i = 0; i < n && st == GETME_FORMATS_OK; i++) {
+        for (int k = 0; k < 3 && st == GETME_FORMATS_OK; k++)
             st = read_double(r, &xyz[3 * i + k]);
-        if (st == GETME_IO_OK && !finite3(xyz + 3 * i))
+        if (st == GETME_FORMATS_OK && !finite3(xyz + 3 * i))
             st = not_finite(r, tags[i], xyz + 3 * i);
-        if (st == GETME_IO_OK && !msh41_in_eol(&r->in))
+        if (st == GETME_FORMATS_OK && !msh41_in_eol(&r->in))
             st = msh41_decline(r, "node coordinates not one node per line");
     }
     return st;
 }
 
-static getme_io_status read_node_block(msh41_reader *r, size_t *filled)
+static getme_formats_status read_node_block(msh41_reader *r, size_t *filled)
 {
     msh41_nblock *b = &r->nb[r->nnb];
     int param = 0;
     uint64_t count = 0;
-    getme_io_status st = read_int(r, &b->dim, "entity dimension");
-    if (st == GETME_IO_OK)
+    getme_formats_status st = read_int(r, &b->dim, "entity dimension");
+    if (st == GETME_FORMATS_OK)
         st = read_int(r, &b->tag, "entity tag");
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = read_int(r, &param, "parametric flag");
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = read_u64(r, &count, "number of nodes in block");
-    if (st != GETME_IO_OK)
+    if (st != GETME_FORMATS_OK)
         return st;
     if (b->dim < 0 || b->dim > 3 || param < 0 || param > 1)
-        return msh41_fail(r, GETME_IO_ERR_PARSE,
+        return msh41_fail(r, GETME_FORMATS_ERR_PARSE,
                           "bad node block header (dimension %d, parametric "
                           "%d)",
                           b->dim, param);
     if (param)
         return msh41_decline(r, "parametric nodes");
     if (count > r->nnodes - *filled)
-        return msh41_fail(r, GETME_IO_ERR_PARSE,
+        return msh41_fail(r, GETME_FORMATS_ERR_PARSE,
                           "node blocks hold more nodes than the %zu declared",
                           r->nnodes);
     b->first = *filled;
     b->count = (size_t)count;
     st = read_node_tags(r, r->tags + b->first, b->count);
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = read_node_coords(r, r->xyz + 3 * b->first, r->tags + b->first,
                               b->count);
     /* A point's group fixes the point's node (Gmsh: mesh_vertices[0]). */
     const msh41_entity *e = msh41_find_entity(r, b->dim, b->tag);
-    if (st == GETME_IO_OK && b->dim == 0 && e && e->fix && b->count)
+    if (st == GETME_FORMATS_OK && b->dim == 0 && e && e->fix && b->count)
         r->flag[b->first] |= MSH41_FIXGRP;
     *filled += b->count;
     r->nnb++;
     return st;
 }
 
-static getme_io_status read_nodes(msh41_reader *r)
+static getme_formats_status read_nodes(msh41_reader *r)
 {
     uint64_t nblocks = 0, n = 0, lo, hi;
     r->section = "Nodes";
@@ -593,28 +593,28 @@ static getme_io_status read_nodes(msh41_reader *r)
         return msh41_decline(r, "several $Nodes sections");
     r->have_nodes = 1;
     r->nodes_offset = msh41_in_offset(&r->in);
-    getme_io_status st = prepare_groups(r);
-    if (st == GETME_IO_OK)
+    getme_formats_status st = prepare_groups(r);
+    if (st == GETME_FORMATS_OK)
         st = read_count(r, &nblocks, "number of node blocks", 8);
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = read_count(r, &n, "number of nodes", 8);
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = read_u64(r, &lo, "minimum node tag");
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = read_u64(r, &hi, "maximum node tag");
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = alloc_nodes(r, nblocks, n);
-    r->nnodes = st == GETME_IO_OK ? (size_t)n : 0;
+    r->nnodes = st == GETME_FORMATS_OK ? (size_t)n : 0;
     size_t filled = 0;
-    for (uint64_t b = 0; b < nblocks && st == GETME_IO_OK; b++)
+    for (uint64_t b = 0; b < nblocks && st == GETME_FORMATS_OK; b++)
         st = read_node_block(r, &filled);
-    if (st == GETME_IO_OK && filled != r->nnodes)
-        st = msh41_fail(r, GETME_IO_ERR_PARSE,
+    if (st == GETME_FORMATS_OK && filled != r->nnodes)
+        st = msh41_fail(r, GETME_FORMATS_ERR_PARSE,
                         "$Nodes declares %zu nodes, its blocks hold %zu",
                         r->nnodes, filled);
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = expect_end(r);
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = msh41_map_build(r, &r->map, r->tags, r->nnodes);
     return st;
 }
@@ -632,7 +632,7 @@ static void drop_blocks(msh41_reader *r)
 
 /* A block of the (so far) highest dimension, with room for its elements
    if GETMe can smooth its type. */
-static getme_io_status new_eblock(msh41_reader *r, int dim, int tag,
+static getme_formats_status new_eblock(msh41_reader *r, int dim, int tag,
                                   int type, uint64_t count, int nv,
                                   msh41_eblock **out)
 {
@@ -648,7 +648,7 @@ static getme_io_status new_eblock(msh41_reader *r, int dim, int tag,
         r->cap_eb = cap;
     }
     if (count > (uint64_t)INT32_MAX)
-        return msh41_fail(r, GETME_IO_ERR_UNSUPPORTED,
+        return msh41_fail(r, GETME_FORMATS_ERR_UNSUPPORTED,
                           "More than 2^31-1 elements are not supported");
     msh41_eblock *b = &r->eb[r->neb++];
     memset(b, 0, sizeof *b);
@@ -666,19 +666,19 @@ static getme_io_status new_eblock(msh41_reader *r, int dim, int tag,
             return oom(r);
     }
     *out = b;
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* One element: rec = tag + nv node tags.  Nodes must exist (as for Gmsh's
    reader); kept blocks store file indices, --fix groups flag nodes. */
-static getme_io_status take_element(msh41_reader *r, msh41_eblock *b,
+static getme_formats_status take_element(msh41_reader *r, msh41_eblock *b,
                                     size_t i, const uint64_t *rec, int nv,
                                     int fix)
 {
     for (int k = 0; k < nv; k++) {
         for (int j = 0; b && b->conn && j < k; j++)
             if (rec[1 + j] == rec[1 + k])
-                return msh41_fail(r, GETME_IO_ERR_INVALID,
+                return msh41_fail(r, GETME_FORMATS_ERR_INVALID,
                                   "element %llu is degenerate: node %llu "
                                   "appears twice; getme smooths valid meshes "
                                   "only",
@@ -686,7 +686,7 @@ static getme_io_status take_element(msh41_reader *r, msh41_eblock *b,
                                   (unsigned long long)rec[1 + k]);
         int32_t idx = msh41_map_find(&r->map, rec[1 + k]);
         if (idx < 0)
-            return msh41_fail(r, GETME_IO_ERR_PARSE,
+            return msh41_fail(r, GETME_FORMATS_ERR_PARSE,
                               "element %llu uses node %llu, which is not in "
                               "$Nodes",
                               (unsigned long long)rec[0],
@@ -698,21 +698,21 @@ static getme_io_status take_element(msh41_reader *r, msh41_eblock *b,
     }
     if (b && b->ids)
         b->ids[i] = (int64_t)rec[0];
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* Binary elements are read a chunk of records at a time. */
 #define REC_CHUNK 4096
 
-static getme_io_status read_binary_elements(msh41_reader *r, msh41_eblock *b,
+static getme_formats_status read_binary_elements(msh41_reader *r, msh41_eblock *b,
                                             uint64_t count, int nv, int fix)
 {
     size_t rec = (size_t)nv + 1;
     uint64_t *buf = malloc(REC_CHUNK * rec * sizeof *buf);
     if (!buf)
         return oom(r);
-    getme_io_status st = GETME_IO_OK;
-    for (uint64_t i0 = 0; i0 < count && st == GETME_IO_OK; i0 += REC_CHUNK) {
+    getme_formats_status st = GETME_FORMATS_OK;
+    for (uint64_t i0 = 0; i0 < count && st == GETME_FORMATS_OK; i0 += REC_CHUNK) {
         size_t k = count - i0 < REC_CHUNK ? (size_t)(count - i0) : REC_CHUNK;
         if (msh41_in_read(&r->in, buf, k * rec * 8)) {
             st = eof_error(r);
@@ -720,23 +720,23 @@ static getme_io_status read_binary_elements(msh41_reader *r, msh41_eblock *b,
         }
         for (size_t j = 0; j < k * rec; j++)
             buf[j] = le64((const unsigned char *)&buf[j]);
-        for (size_t j = 0; j < k && st == GETME_IO_OK; j++)
+        for (size_t j = 0; j < k && st == GETME_FORMATS_OK; j++)
             st = take_element(r, b, (size_t)i0 + j, buf + j * rec, nv, fix);
     }
     free(buf);
     return st;
 }
 
-static getme_io_status read_ascii_elements(msh41_reader *r, msh41_eblock *b,
+static getme_formats_status read_ascii_elements(msh41_reader *r, msh41_eblock *b,
                                            uint64_t count, int nv, int fix)
 {
     uint64_t rec[128];
-    getme_io_status st = GETME_IO_OK;
-    for (uint64_t i = 0; i < count && st == GETME_IO_OK; i++) {
+    getme_formats_status st = GETME_FORMATS_OK;
+    for (uint64_t i = 0; i < count && st == GETME_FORMATS_OK; i++) {
         st = read_u64(r, &rec[0], "element tag");
-        for (int k = 0; k < nv && st == GETME_IO_OK; k++)
+        for (int k = 0; k < nv && st == GETME_FORMATS_OK; k++)
             st = read_u64(r, &rec[1 + k], "node tag");
-        if (st == GETME_IO_OK)
+        if (st == GETME_FORMATS_OK)
             st = take_element(r, b, (size_t)i, rec, nv, fix);
     }
     return st;
@@ -752,37 +752,37 @@ static int node_block_entity(const msh41_reader *r, int dim, int tag)
     return 0;
 }
 
-static getme_io_status read_element_block(msh41_reader *r)
+static getme_formats_status read_element_block(msh41_reader *r)
 {
     int dim = 0, tag = 0, type = 0;
     uint64_t count = 0;
-    getme_io_status st = read_int(r, &dim, "entity dimension");
-    if (st == GETME_IO_OK)
+    getme_formats_status st = read_int(r, &dim, "entity dimension");
+    if (st == GETME_FORMATS_OK)
         st = read_int(r, &tag, "entity tag");
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = read_int(r, &type, "element type");
-    if (st != GETME_IO_OK)
+    if (st != GETME_FORMATS_OK)
         return st;
     int nv = msh41_type_nodes(type, NULL);
     if (nv == 0)
         return msh41_decline(r, "an element type this reader does not know");
     st = read_count(r, &count, "number of elements in block",
                     (uint64_t)(nv + 1) * (r->binary ? 8 : 2));
-    if (st != GETME_IO_OK)
+    if (st != GETME_FORMATS_OK)
         return st;
     if (dim < 0 || dim > 3)
-        return msh41_fail(r, GETME_IO_ERR_PARSE,
+        return msh41_fail(r, GETME_FORMATS_ERR_PARSE,
                           "bad element block dimension %d", dim);
     const msh41_entity *e = msh41_find_entity(r, dim, tag);
     if (!e && !node_block_entity(r, dim, tag))
-        return msh41_fail(r, GETME_IO_ERR_PARSE,
+        return msh41_fail(r, GETME_FORMATS_ERR_PARSE,
                           "element block of entity %d (dimension %d): no "
                           "such entity in $Entities or $Nodes",
                           tag, dim);
     msh41_eblock *b = NULL;
     if (dim >= 2 && dim >= r->top_dim && count > 0)
         st = new_eblock(r, dim, tag, type, count, nv, &b);
-    if (st != GETME_IO_OK)
+    if (st != GETME_FORMATS_OK)
         return st;
     int fix = e && e->fix;
     return r->binary ? read_binary_elements(r, b, count, nv, fix)
@@ -790,32 +790,32 @@ static getme_io_status read_element_block(msh41_reader *r)
 }
 
 /* Entering $Elements (both versions): after $Nodes, only once. */
-static getme_io_status elements_begin(msh41_reader *r)
+static getme_formats_status elements_begin(msh41_reader *r)
 {
     r->section = "Elements";
     if (!r->have_nodes)
-        return msh41_fail(r, GETME_IO_ERR_PARSE, "$Elements before $Nodes");
+        return msh41_fail(r, GETME_FORMATS_ERR_PARSE, "$Elements before $Nodes");
     if (r->have_elements)
         return msh41_decline(r, "several $Elements sections");
     r->have_elements = 1;
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-static getme_io_status read_elements(msh41_reader *r)
+static getme_formats_status read_elements(msh41_reader *r)
 {
     uint64_t nblocks = 0, n, lo, hi;
-    getme_io_status st = elements_begin(r);
-    if (st == GETME_IO_OK)
+    getme_formats_status st = elements_begin(r);
+    if (st == GETME_FORMATS_OK)
         st = read_count(r, &nblocks, "number of element blocks", 8);
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = read_count(r, &n, "number of elements", 8);
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = read_u64(r, &lo, "minimum element tag");
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = read_u64(r, &hi, "maximum element tag");
-    for (uint64_t b = 0; b < nblocks && st == GETME_IO_OK; b++)
+    for (uint64_t b = 0; b < nblocks && st == GETME_FORMATS_OK; b++)
         st = read_element_block(r);
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = expect_end(r);
     return st;
 }
@@ -831,20 +831,20 @@ static getme_io_status read_elements(msh41_reader *r)
  * using it, and inside an entity nodes go by tag: Gmsh's MSH 2 reader. */
 
 /* The count line of a 2.2 section (text even in binary files). */
-static getme_io_status read_count22(msh41_reader *r, uint64_t *n,
+static getme_formats_status read_count22(msh41_reader *r, uint64_t *n,
                                     const char *what, uint64_t min_bytes)
 {
     int save = r->binary;
     r->binary = 0;
-    getme_io_status st = read_count(r, n, what, min_bytes);
+    getme_formats_status st = read_count(r, n, what, min_bytes);
     r->binary = save;
-    if (st == GETME_IO_OK && save && !msh41_in_eol(&r->in))
-        st = msh41_fail(r, GETME_IO_ERR_PARSE, "bad %s line in $%s", what,
+    if (st == GETME_FORMATS_OK && save && !msh41_in_eol(&r->in))
+        st = msh41_fail(r, GETME_FORMATS_ERR_PARSE, "bad %s line in $%s", what,
                         r->section);
     return st;
 }
 
-static getme_io_status read_nodes22(msh41_reader *r)
+static getme_formats_status read_nodes22(msh41_reader *r)
 {
     uint64_t n = 0;
     r->section = "Nodes";
@@ -852,11 +852,11 @@ static getme_io_status read_nodes22(msh41_reader *r)
         return msh41_decline(r, "several $Nodes sections");
     r->have_nodes = 1;
     r->nodes_offset = msh41_in_offset(&r->in);
-    getme_io_status st = read_count22(r, &n, "number of nodes", 8);
-    if (st == GETME_IO_OK)
+    getme_formats_status st = read_count22(r, &n, "number of nodes", 8);
+    if (st == GETME_FORMATS_OK)
         st = alloc_nodes(r, 0, n);
-    r->nnodes = st == GETME_IO_OK ? (size_t)n : 0;
-    if (st == GETME_IO_OK) {
+    r->nnodes = st == GETME_FORMATS_OK ? (size_t)n : 0;
+    if (st == GETME_FORMATS_OK) {
         r->ndim = malloc(r->nnodes ? r->nnodes : 1);
         r->netag = malloc((r->nnodes ? r->nnodes : 1) * sizeof *r->netag);
         if (!r->ndim || !r->netag)
@@ -864,27 +864,27 @@ static getme_io_status read_nodes22(msh41_reader *r)
         else
             memset(r->ndim, 4, r->nnodes);
     }
-    for (size_t i = 0; i < r->nnodes && st == GETME_IO_OK; i++) {
+    for (size_t i = 0; i < r->nnodes && st == GETME_FORMATS_OK; i++) {
         double *x = r->xyz + 3 * i;
         if (r->binary) {
             int tag = 0;
             st = read_int(r, &tag, "node tag");
-            if (st == GETME_IO_OK && tag <= 0)
-                st = msh41_fail(r, GETME_IO_ERR_PARSE, "bad node tag %d", tag);
+            if (st == GETME_FORMATS_OK && tag <= 0)
+                st = msh41_fail(r, GETME_FORMATS_ERR_PARSE, "bad node tag %d", tag);
             r->tags[i] = (uint64_t)(tag > 0 ? tag : 0);
         } else {
             st = read_u64(r, &r->tags[i], "node tag");
         }
-        for (int k = 0; k < 3 && st == GETME_IO_OK; k++)
+        for (int k = 0; k < 3 && st == GETME_FORMATS_OK; k++)
             st = read_double(r, &x[k]);
-        if (st == GETME_IO_OK && !finite3(x))
+        if (st == GETME_FORMATS_OK && !finite3(x))
             st = not_finite(r, r->tags[i], x);
-        if (st == GETME_IO_OK && !r->binary && !msh41_in_eol(&r->in))
+        if (st == GETME_FORMATS_OK && !r->binary && !msh41_in_eol(&r->in))
             st = msh41_decline(r, "node coordinates not one node per line");
     }
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = expect_end(r);
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = msh41_map_build(r, &r->map, r->tags, r->nnodes);
     return st;
 }
@@ -918,13 +918,13 @@ static int fix_group22(msh41_reader *r, int dim, int phys)
 
 /* The element block an element of (tag, type) of the top dimension goes
    to: the last one if it is the same (entity, type), else a new one. */
-static getme_io_status block22(msh41_reader *r, int dim, int etag, int type,
+static getme_formats_status block22(msh41_reader *r, int dim, int etag, int type,
                                int nv, msh41_eblock **out)
 {
     msh41_eblock *b = r->neb ? &r->eb[r->neb - 1] : NULL;
     if (!b || dim > r->top_dim || b->tag != etag || b->type != type) {
-        getme_io_status st = new_eblock(r, dim, etag, type, 1, nv, &b);
-        if (st != GETME_IO_OK)
+        getme_formats_status st = new_eblock(r, dim, etag, type, 1, nv, &b);
+        if (st != GETME_FORMATS_OK)
             return st;
         b->count = 0; /* room for 1, grown below */
         r->cap_cur = 1;
@@ -942,14 +942,14 @@ static getme_io_status block22(msh41_reader *r, int dim, int etag, int type,
         r->cap_cur = cap;
     }
     if (b->count == INT32_MAX)
-        return msh41_fail(r, GETME_IO_ERR_UNSUPPORTED,
+        return msh41_fail(r, GETME_FORMATS_ERR_UNSUPPORTED,
                           "More than 2^31-1 elements are not supported");
     *out = b;
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* One element: rec = tag + nv node tags; tags = physical, elementary. */
-static getme_io_status element22(msh41_reader *r, int type, int ntags,
+static getme_formats_status element22(msh41_reader *r, int type, int ntags,
                                  const int *tags, const uint64_t *rec)
 {
     int order = 0, nv = msh41_type_nodes(type, &order), dim = type_dim(type);
@@ -977,13 +977,13 @@ static getme_io_status element22(msh41_reader *r, int type, int ntags,
         r->ent22[r->nent22++][2] = phys;
     }
     msh41_eblock *b = NULL;
-    getme_io_status st = GETME_IO_OK;
+    getme_formats_status st = GETME_FORMATS_OK;
     if (dim >= 2 && dim >= r->top_dim)
         st = block22(r, dim, etag, type, nv, &b);
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = take_element(r, b, b ? (size_t)b->count : 0, rec, nv,
                           fix_group22(r, dim, phys));
-    if (st != GETME_IO_OK)
+    if (st != GETME_FORMATS_OK)
         return st;
     if (b)
         b->count++;
@@ -994,75 +994,75 @@ static getme_io_status element22(msh41_reader *r, int type, int ntags,
             r->netag[i] = etag;
         }
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 enum { MAX_TAGS22 = 64, MAX_NODES22 = 128 };
 
-static getme_io_status ascii_element22(msh41_reader *r)
+static getme_formats_status ascii_element22(msh41_reader *r)
 {
     uint64_t rec[1 + MAX_NODES22];
     int type = 0, ntags = 0, tags[MAX_TAGS22];
-    getme_io_status st = read_u64(r, &rec[0], "element tag");
-    if (st == GETME_IO_OK)
+    getme_formats_status st = read_u64(r, &rec[0], "element tag");
+    if (st == GETME_FORMATS_OK)
         st = read_int(r, &type, "element type");
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = read_int(r, &ntags, "number of tags");
-    if (st == GETME_IO_OK && (ntags < 0 || ntags > MAX_TAGS22))
-        st = msh41_fail(r, GETME_IO_ERR_PARSE, "bad number of tags %d", ntags);
-    for (int k = 0; k < ntags && st == GETME_IO_OK; k++)
+    if (st == GETME_FORMATS_OK && (ntags < 0 || ntags > MAX_TAGS22))
+        st = msh41_fail(r, GETME_FORMATS_ERR_PARSE, "bad number of tags %d", ntags);
+    for (int k = 0; k < ntags && st == GETME_FORMATS_OK; k++)
         st = read_int(r, &tags[k], "element tag");
     int nv = msh41_type_nodes(type, NULL);
-    if (st == GETME_IO_OK && (nv == 0 || nv > MAX_NODES22))
+    if (st == GETME_FORMATS_OK && (nv == 0 || nv > MAX_NODES22))
         return msh41_decline(r, "an element type this reader does not know");
-    for (int k = 0; k < nv && st == GETME_IO_OK; k++)
+    for (int k = 0; k < nv && st == GETME_FORMATS_OK; k++)
         st = read_u64(r, &rec[1 + k], "node tag");
-    if (st == GETME_IO_OK && !msh41_in_eol(&r->in))
+    if (st == GETME_FORMATS_OK && !msh41_in_eol(&r->in))
         st = msh41_decline(r, "elements not one per line");
-    return st == GETME_IO_OK ? element22(r, type, ntags, tags, rec) : st;
+    return st == GETME_FORMATS_OK ? element22(r, type, ntags, tags, rec) : st;
 }
 
-static getme_io_status binary_block22(msh41_reader *r, uint64_t *left)
+static getme_formats_status binary_block22(msh41_reader *r, uint64_t *left)
 {
     int head[3], vals[1 + MAX_TAGS22 + MAX_NODES22];
-    getme_io_status st = GETME_IO_OK;
-    for (int k = 0; k < 3 && st == GETME_IO_OK; k++)
+    getme_formats_status st = GETME_FORMATS_OK;
+    for (int k = 0; k < 3 && st == GETME_FORMATS_OK; k++)
         st = read_int(r, &head[k], "element block header");
-    if (st != GETME_IO_OK)
+    if (st != GETME_FORMATS_OK)
         return st;
     int type = head[0], nv = msh41_type_nodes(type, NULL), ntags = head[2];
     if (nv == 0 || nv > MAX_NODES22)
         return msh41_decline(r, "an element type this reader does not know");
     if (head[1] < 0 || (uint64_t)head[1] > *left || ntags < 0 ||
         ntags > MAX_TAGS22)
-        return msh41_fail(r, GETME_IO_ERR_PARSE,
+        return msh41_fail(r, GETME_FORMATS_ERR_PARSE,
                           "bad element block header (type %d, %d elements, "
                           "%d tags)",
                           type, head[1], ntags);
     *left -= (uint64_t)head[1];
-    for (int e = 0; e < head[1] && st == GETME_IO_OK; e++) {
-        for (int k = 0; k < 1 + ntags + nv && st == GETME_IO_OK; k++)
+    for (int e = 0; e < head[1] && st == GETME_FORMATS_OK; e++) {
+        for (int k = 0; k < 1 + ntags + nv && st == GETME_FORMATS_OK; k++)
             st = read_int(r, &vals[k], "element data");
         uint64_t rec[1 + MAX_NODES22];
-        for (int k = 0; k <= nv && st == GETME_IO_OK; k++) {
+        for (int k = 0; k <= nv && st == GETME_FORMATS_OK; k++) {
             int v = vals[k == 0 ? 0 : ntags + k];
             if (v <= 0)
-                return msh41_fail(r, GETME_IO_ERR_PARSE,
+                return msh41_fail(r, GETME_FORMATS_ERR_PARSE,
                                   "bad %s %d in $Elements",
                                   k ? "node tag" : "element tag", v);
             rec[k] = (uint64_t)v;
         }
-        if (st == GETME_IO_OK)
+        if (st == GETME_FORMATS_OK)
             st = element22(r, type, ntags, vals + 1, rec);
     }
     return st;
 }
 
-static getme_io_status read_elements22(msh41_reader *r)
+static getme_formats_status read_elements22(msh41_reader *r)
 {
     uint64_t n = 0;
-    getme_io_status st = elements_begin(r);
-    if (st != GETME_IO_OK)
+    getme_formats_status st = elements_begin(r);
+    if (st != GETME_FORMATS_OK)
         return st;
     int nw = r->opts ? r->opts->num_fix + r->opts->num_free : 0;
     if (nw && !r->fix_found &&
@@ -1070,12 +1070,12 @@ static getme_io_status read_elements22(msh41_reader *r)
         return oom(r);
     st = read_count22(r, &n, "number of elements", 8);
     if (r->binary)
-        for (uint64_t left = n; st == GETME_IO_OK && left > 0;)
+        for (uint64_t left = n; st == GETME_FORMATS_OK && left > 0;)
             st = binary_block22(r, &left);
     else
-        for (uint64_t i = 0; st == GETME_IO_OK && i < n; i++)
+        for (uint64_t i = 0; st == GETME_FORMATS_OK && i < n; i++)
             st = ascii_element22(r);
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = expect_end(r);
     return st;
 }
@@ -1090,7 +1090,7 @@ static int cmp_triple(const void *a, const void *b)
 }
 
 /* $Entities as the elements define them. */
-static getme_io_status entities22(msh41_reader *r)
+static getme_formats_status entities22(msh41_reader *r)
 {
     qsort(r->ent22, r->nent22, sizeof *r->ent22, cmp_triple);
     r->ents = malloc((r->nent22 ? r->nent22 : 1) * sizeof *r->ents);
@@ -1114,7 +1114,7 @@ static getme_io_status entities22(msh41_reader *r)
             e->phys_count++;
         }
     }
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* Node order by (dimension, entity, tag), one node block per entity. */
@@ -1133,7 +1133,7 @@ static int cmp_node22(const void *a, const void *b)
     return (r->tags[i] > r->tags[j]) - (r->tags[i] < r->tags[j]);
 }
 
-static getme_io_status nodes22(msh41_reader *r)
+static getme_formats_status nodes22(msh41_reader *r)
 {
     size_t n = r->nnodes;
     size_t *order = malloc((n ? n : 1) * sizeof *order);
@@ -1142,9 +1142,9 @@ static getme_io_status nodes22(msh41_reader *r)
     double *xyz = malloc((n ? n : 1) * 3 * sizeof *xyz);
     uint8_t *flag = malloc(n ? n : 1);
     msh41_nblock *nb = malloc((n ? n : 1) * sizeof *nb);
-    getme_io_status st =
-        order && pos && tags && xyz && flag && nb ? GETME_IO_OK : oom(r);
-    if (st == GETME_IO_OK) {
+    getme_formats_status st =
+        order && pos && tags && xyz && flag && nb ? GETME_FORMATS_OK : oom(r);
+    if (st == GETME_FORMATS_OK) {
         for (size_t i = 0; i < n; i++)
             order[i] = i;
         order_reader = r; /* qsort has no context argument in C11 */
@@ -1194,17 +1194,17 @@ static getme_io_status nodes22(msh41_reader *r)
 }
 
 /* After the file: entities and node blocks, as MSH 4.1 would have them. */
-static getme_io_status finish22(msh41_reader *r)
+static getme_formats_status finish22(msh41_reader *r)
 {
     if (!r->have_nodes || !r->have_elements)
-        return GETME_IO_OK; /* msh41_build says there is no mesh */
-    getme_io_status st = entities22(r);
-    return st == GETME_IO_OK ? nodes22(r) : st;
+        return GETME_FORMATS_OK; /* msh41_build says there is no mesh */
+    getme_formats_status st = entities22(r);
+    return st == GETME_FORMATS_OK ? nodes22(r) : st;
 }
 
 /* ---- the file ----------------------------------------------------------- */
 
-static getme_io_status read_section(msh41_reader *r, const char *name)
+static getme_formats_status read_section(msh41_reader *r, const char *name)
 {
     if (strcmp(name, "PhysicalNames") == 0)
         return read_physical_names(r);
@@ -1218,16 +1218,16 @@ static getme_io_status read_section(msh41_reader *r, const char *name)
         return msh41_decline(r, "partitioned mesh");
     if (strcmp(name, "MeshFormat") == 0) {
         r->section = "MeshFormat";
-        return msh41_fail(r, GETME_IO_ERR_PARSE, "second $MeshFormat");
+        return msh41_fail(r, GETME_FORMATS_ERR_PARSE, "second $MeshFormat");
     }
     return skip_section(r, name);
 }
 
-static getme_io_status read_file(msh41_reader *r)
+static getme_formats_status read_file(msh41_reader *r)
 {
-    getme_io_status st = read_format(r);
+    getme_formats_status st = read_format(r);
     char line[TOK];
-    while (st == GETME_IO_OK && msh41_in_line(&r->in, line, sizeof line) == 0)
+    while (st == GETME_FORMATS_OK && msh41_in_line(&r->in, line, sizeof line) == 0)
         if (line[0] == '$') /* Gmsh ignores anything between sections */
             st = read_section(r, line + 1);
     return st;
@@ -1276,7 +1276,7 @@ static void reset_doc(getme_doc *doc)
     doc->error[0] = 0;
 }
 
-getme_io_status msh41_open(getme_doc *doc, const getme_doc_options *opts,
+getme_formats_status msh41_open(getme_doc *doc, const getme_doc_options *opts,
                            msh41_doc **out, int *eligible, char *why,
                            size_t why_size)
 {
@@ -1288,18 +1288,18 @@ getme_io_status msh41_open(getme_doc *doc, const getme_doc_options *opts,
     *eligible = 1;
     msh41_doc *m = calloc(1, sizeof *m);
     if (!m)
-        return getme_doc_fail(doc, GETME_IO_ERR_INTERNAL, "Out of memory");
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL, "Out of memory");
     if (msh41_in_open(&r.in, doc->path)) {
         free(m);
-        return getme_doc_fail(doc, GETME_IO_ERR_OPEN, "Cannot open '%s': %s",
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_OPEN, "Cannot open '%s': %s",
                               doc->path, strerror(errno));
     }
     remember_identity(m, r.in.f);
     r.file_size = m->size > 0 ? m->size : 1;
-    getme_io_status st = read_file(&r);
-    if (st == GETME_IO_OK && r.v22)
+    getme_formats_status st = read_file(&r);
+    if (st == GETME_FORMATS_OK && r.v22)
         st = finish22(&r);
-    if (st == GETME_IO_OK)
+    if (st == GETME_FORMATS_OK)
         st = msh41_build(&r, m);
     m->binary = r.binary;
     m->v22 = r.v22;
@@ -1309,14 +1309,14 @@ getme_io_status msh41_open(getme_doc *doc, const getme_doc_options *opts,
         *eligible = 0;
         snprintf(why, why_size, "%s", r.why);
         reset_doc(doc);
-        st = GETME_IO_OK;
+        st = GETME_FORMATS_OK;
     }
-    if (st != GETME_IO_OK || !*eligible) {
+    if (st != GETME_FORMATS_OK || !*eligible) {
         msh41_free(m);
         return st;
     }
     *out = m;
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 void msh41_free(msh41_doc *m)

@@ -293,17 +293,17 @@ static int same_input(const msh41_doc *m, const struct stat *sb)
            (uint64_t)sb->st_ino == m->ino && mtime == m->mtime_ns;
 }
 
-static getme_io_status write_tmp(writer *w, const char *tmp,
+static getme_formats_status write_tmp(writer *w, const char *tmp,
                                  const char *out_path)
 {
     getme_doc *doc = w->doc;
     struct stat sb;
     if (msh41_in_open(&w->in, doc->path))
-        return getme_doc_fail(doc, GETME_IO_ERR_OPEN, "Cannot open '%s': %s",
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_OPEN, "Cannot open '%s': %s",
                               doc->path, strerror(errno));
     if (fstat(fileno(w->in.f), &sb) != 0 || !same_input(w->m, &sb)) {
         msh41_in_close(&w->in);
-        return getme_doc_fail(doc, GETME_IO_ERR_WRITE,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_WRITE,
                               "'%s' changed since it was read: not writing",
                               doc->path);
     }
@@ -311,7 +311,7 @@ static getme_io_status write_tmp(writer *w, const char *tmp,
     if (!w->out) {
         int e = errno;
         msh41_in_close(&w->in);
-        return getme_doc_fail(doc, GETME_IO_ERR_WRITE, "Cannot write '%s': %s",
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_WRITE, "Cannot write '%s': %s",
                               out_path, strerror(e));
     }
     /* getme_io_tmp_path made it with the umask's mode: the input's instead */
@@ -325,23 +325,23 @@ static getme_io_status write_tmp(writer *w, const char *tmp,
     if (fclose(w->out) != 0)
         werr = 1;
     if (rc == -2)
-        return getme_doc_fail(doc, GETME_IO_ERR_INTERNAL, "Out of memory");
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL, "Out of memory");
     if (rc)
-        return getme_doc_fail(doc, GETME_IO_ERR_WRITE,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_WRITE,
                               "'%s' changed since it was read: not writing",
                               doc->path);
     if (werr)
-        return getme_doc_fail(doc, GETME_IO_ERR_WRITE, "Cannot write '%s': %s",
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_WRITE, "Cannot write '%s': %s",
                               out_path, strerror(e ? e : EIO));
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
-getme_io_status msh41_write(getme_doc *doc, const msh41_doc *m,
+getme_formats_status msh41_write(getme_doc *doc, const msh41_doc *m,
                             const char *out_path)
 {
     char tmp[4096];
     if (getme_io_tmp_path(out_path, tmp, sizeof tmp) != 0)
-        return getme_doc_fail(doc, GETME_IO_ERR_WRITE,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_WRITE,
                               "Cannot create a temporary file next to '%s'",
                               out_path);
     writer w;
@@ -349,13 +349,13 @@ getme_io_status msh41_write(getme_doc *doc, const msh41_doc *m,
     w.doc = doc;
     w.m = m;
     w.xyz = getme_mesh_coords(doc->mesh);
-    getme_io_status st = write_tmp(&w, tmp, out_path);
-    if (st != GETME_IO_OK) {
+    getme_formats_status st = write_tmp(&w, tmp, out_path);
+    if (st != GETME_FORMATS_OK) {
         remove(tmp);
         return st;
     }
     if (getme_io_commit(tmp, out_path) != 0)
-        return getme_doc_fail(doc, GETME_IO_ERR_WRITE, "Cannot write '%s': %s",
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_WRITE, "Cannot write '%s': %s",
                               out_path, strerror(errno));
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }

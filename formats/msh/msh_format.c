@@ -29,23 +29,23 @@ typedef struct msh_impl {
 } msh_impl;
 
 /* "$MeshFormat" then "version file-type data-size". */
-static getme_io_status read_header(getme_doc *doc, msh_impl *impl)
+static getme_formats_status read_header(getme_doc *doc, msh_impl *impl)
 {
     int rc = getme__msh_header(doc->path, &impl->version, &impl->binary);
     if (rc == -1)
-        return getme_doc_fail(doc, GETME_IO_ERR_OPEN, "Cannot open '%s': %s",
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_OPEN, "Cannot open '%s': %s",
                               doc->path, strerror(errno));
     if (rc != 0)
-        return getme_doc_fail(doc, GETME_IO_ERR_PARSE,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_PARSE,
                               "'%s', line 1: not a Gmsh MSH file (no "
                               "$MeshFormat header)",
                               doc->path);
     if (impl->version != 2.2 && impl->version != 4.0 && impl->version != 4.1)
-        return getme_doc_fail(doc, GETME_IO_ERR_UNSUPPORTED,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_UNSUPPORTED,
                               "'%s': MSH version %g is not supported (2.2, "
                               "4.0 and 4.1 are)",
                               doc->path, impl->version);
-    return GETME_IO_OK;
+    return GETME_FORMATS_OK;
 }
 
 /* GETME_MSH_READER: 'g' = gmsh only, 'n' = native only, 0 = native if it
@@ -62,7 +62,7 @@ static char reader_choice(void)
 
 /* The native reader; GETME_FORMATS_DECLINED (with the reason as the
    message) for a file it does not read. */
-static getme_io_status open_native(getme_doc *doc, msh_impl *impl,
+static getme_formats_status open_native(getme_doc *doc, msh_impl *impl,
                                    const getme_doc_options *opts, char choice)
 {
     char why[160] = "";
@@ -70,18 +70,18 @@ static getme_io_status open_native(getme_doc *doc, msh_impl *impl,
     int native = impl->version == 4.1 || impl->version == 2.2;
     if (!native)
         snprintf(why, sizeof why, "MSH %g", impl->version);
-    getme_io_status st =
+    getme_formats_status st =
         native
             ? msh41_open(doc, opts, &impl->native, &eligible, why, sizeof why)
-            : GETME_IO_OK;
+            : GETME_FORMATS_OK;
     if (native && eligible)
         return st;
     if (choice == 'n')
-        return getme_doc_fail(doc, GETME_IO_ERR_UNSUPPORTED,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_UNSUPPORTED,
                               "'%s': the native MSH reader reads MSH 4.1 and "
                               "2.2 only, without %s (GETME_MSH_READER=native)",
                               doc->path, why);
-    getme_doc_fail(doc, GETME_IO_ERR_UNSUPPORTED,
+    getme_doc_fail(doc, GETME_FORMATS_ERR_UNSUPPORTED,
                    "'%s': the native MSH reader reads MSH 4.1 and 2.2 only, "
                    "without %s; this program reads no other MSH files (it "
                    "was built without the Gmsh plugin)",
@@ -89,18 +89,18 @@ static getme_io_status open_native(getme_doc *doc, msh_impl *impl,
     return GETME_FORMATS_DECLINED;
 }
 
-static getme_io_status msh_open(getme_doc *doc, const getme_doc_options *opts)
+static getme_formats_status msh_open(getme_doc *doc, const getme_doc_options *opts)
 {
     msh_impl *impl = calloc(1, sizeof *impl);
     if (!impl)
-        return getme_doc_fail(doc, GETME_IO_ERR_INTERNAL, "Out of memory");
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL, "Out of memory");
     doc->impl = impl;
-    getme_io_status st = read_header(doc, impl);
-    if (st != GETME_IO_OK)
+    getme_formats_status st = read_header(doc, impl);
+    if (st != GETME_FORMATS_OK)
         return st;
     char choice = reader_choice();
     if (choice == 'g') {
-        getme_doc_fail(doc, GETME_IO_ERR_UNSUPPORTED,
+        getme_doc_fail(doc, GETME_FORMATS_ERR_UNSUPPORTED,
                        "'%s': GETME_MSH_READER=gmsh, but this program reads "
                        "MSH files natively only (it was built without the "
                        "Gmsh plugin)",
@@ -110,11 +110,11 @@ static getme_io_status msh_open(getme_doc *doc, const getme_doc_options *opts)
     return open_native(doc, impl, opts, choice);
 }
 
-static getme_io_status msh_write(getme_doc *doc, const char *out_path)
+static getme_formats_status msh_write(getme_doc *doc, const char *out_path)
 {
     msh_impl *impl = doc->impl;
     if (!impl || !impl->native || !doc->mesh)
-        return getme_doc_fail(doc, GETME_IO_ERR_INTERNAL,
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL,
                               "MSH document is not open");
     return msh41_write(doc, impl->native, out_path);
 }
