@@ -117,4 +117,18 @@ with tempfile.TemporaryDirectory() as tmp:
             f"an output over an input part is refused (exit {p.returncode}: "
             f"{p.stderr.strip()[-200:]}), the parts are untouched")
 
+    # A truncated part: one clear error naming it, no output part written.
+    cut = os.path.join(tmp, "cut")
+    for k, q in enumerate(parts(name), 1):
+        data = open(q, "rb").read()
+        open(f"{cut}_{k}.msh", "wb").write(data[:len(data) // 2] if k == 3 else data)
+    p = subprocess.run([MPIEXEC, "--oversubscribe", "-np", "2", GETME_MPI, "smooth",
+                        cut + "_1.msh", "-o", os.path.join(tmp, "t.msh"), "-q"],
+                       capture_output=True, text=True, env=ENV)
+    c.check(p.returncode != 0 and "cut_3.msh" in p.stderr and "truncated" in p.stderr
+            and not any(os.path.exists(os.path.join(tmp, f"t_{k}.msh"))
+                        for k in range(1, N + 1)),
+            f"a truncated part is refused (exit {p.returncode}: "
+            f"{p.stderr.strip()[:200]}), no output")
+
 sys.exit(c.summary())

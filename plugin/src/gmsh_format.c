@@ -488,7 +488,17 @@ static fstatus merge_split_parts(getme_doc *doc, msh_impl *impl)
         FILE *f = fopen(part, "rb");
         if (!f)
             break;
+        /* Gmsh's reader takes a truncated file as whole (check_msh_file) */
+        double version = 0;
+        int binary = 0;
+        int bad = getme__msh_header(part, &version, &binary) != 0 ||
+                  check_last_line(doc, f, binary) != GETME_FORMATS_OK;
         fclose(f);
+        if (bad)
+            return getme_doc_fail(doc, GETME_FORMATS_ERR_PARSE,
+                                  "'%s': not a whole MSH file (no header or "
+                                  "no closing $End line): truncated or "
+                                  "damaged split partition file", part);
         int ierr = 0;
         gmshMerge(part, &ierr);
         if (ierr)
