@@ -20,7 +20,14 @@
  * and element tags and its physical groups; only coordinates of moved nodes
  * differ.  MSH 4.x goes through Gmsh's writer (gmshWrite); when the input
  * has physical groups but also elements outside of them, Mesh.SaveAll is
- * set so that no element is dropped.  MSH 2.2 is written by copying the
+ * set so that no element is dropped.
+ *
+ * Split partition files (Mesh.PartitionSplitMeshFiles=1: NAME_1.msh ..
+ * NAME_N.msh): opening NAME_1.msh of a partitioned model merges NAME_2.msh,
+ * NAME_3.msh ... while they exist, so the document is the whole mesh
+ * (Gmsh joins the parts by node tag; partition boundaries are not fixed,
+ * gmsh_fixed.c).  Writing it to OUT.msh writes OUT_1.msh .. OUT_N.msh the
+ * same way (each through a temporary file + rename), never OUT.msh itself.  MSH 2.2 is written by copying the
  * input with new coordinates in $Nodes (see patch_msh2: Gmsh's MSH 2 writer
  * would renumber the nodes).
  */
@@ -37,6 +44,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/types.h>
 
 typedef getme_formats_status fstatus;
@@ -47,10 +55,11 @@ typedef struct msh_impl {
     double version;      /* 2.2, 4.1 ... as in $MeshFormat */
     int binary;
     int save_all;
+    int split_parts;     /* > 0: read from this many split files NAME_K.msh */
 } msh_impl;
 
 typedef struct saved_options {
-    double terminal, version, binary, save_all;
+    double terminal, version, binary, save_all, split;
 } saved_options;
 
 static double get_number(const char *name)
@@ -79,6 +88,7 @@ static void quiet_begin(saved_options *s)
     s->version = get_number("Mesh.MshFileVersion");
     s->binary = get_number("Mesh.Binary");
     s->save_all = get_number("Mesh.SaveAll");
+    s->split = get_number("Mesh.PartitionSplitMeshFiles");
     set_number("General.Terminal", 0);
 }
 
@@ -87,6 +97,7 @@ static void quiet_end(const saved_options *s)
     set_number("Mesh.MshFileVersion", s->version);
     set_number("Mesh.Binary", s->binary);
     set_number("Mesh.SaveAll", s->save_all);
+    set_number("Mesh.PartitionSplitMeshFiles", s->split);
     set_number("General.Terminal", s->terminal);
 }
 
@@ -449,9 +460,60 @@ static void describe(getme_doc *doc, const msh_impl *impl)
                        (long)getme_mesh_num_fixed(mesh));
 }
 
+/* ---- split partition files ------------------------------------------- */
+
+/* The part of path before its "_1.msh" ending in stem (length returned),
+   or -1 when path does not end so. */
+static int split_stem(const char *path, char *stem, size_t size)
+{
+    size_t n = strlen(path);
+    if (n < 6 || strcmp(path + n - 6, "_1.msh") != 0 || n - 6 + 1 > size)
+        return -1;
+    memcpy(stem, path, n - 6);
+    stem[n - 6] = '\0';
+    return (int)(n - 6);
+}
+
+/* Just opened NAME_1.msh of a partitioned model: merge NAME_2.msh,
+   NAME_3.msh ... while they exist (impl->split_parts = how many files). */
+static fstatus merge_split_parts(getme_doc *doc, msh_impl *impl)
+{
+    char stem[4096], part[4200];
+    if (split_stem(getme_doc_path(doc), stem, sizeof stem) < 0 ||
+        !gg_model_partitioned())
+        return GETME_FORMATS_OK;
+    int k = 2;
+    for (;; k++) {
+        snprintf(part, sizeof part, "%s_%d.msh", stem, k);
+        FILE *f = fopen(part, "rb");
+        if (!f)
+            break;
+        /* Gmsh's reader takes a truncated file as whole (check_msh_file) */
+        double version = 0;
+        int binary = 0;
+        int bad = getme__msh_header(part, &version, &binary) != 0 ||
+                  check_last_line(doc, f, binary) != GETME_FORMATS_OK;
+        fclose(f);
+        if (bad)
+            return getme_doc_fail(doc, GETME_FORMATS_ERR_PARSE,
+                                  "'%s': not a whole MSH file (no header or "
+                                  "no closing $End line): truncated or "
+                                  "damaged split partition file", part);
+        int ierr = 0;
+        gmshMerge(part, &ierr);
+        if (ierr)
+            return getme_doc_fail(doc, GETME_FORMATS_ERR_PARSE,
+                                  "'%s': Gmsh could not read this split "
+                                  "partition file", part);
+    }
+    impl->split_parts = k - 1;
+    return GETME_FORMATS_OK;
+}
+
 static fstatus open_model(getme_doc *doc, msh_impl *impl)
 {
     int ierr = 0;
+    fstatus st0;
     gmshOpen(getme_doc_path(doc), &ierr);
     if (ierr) {
         char *err = NULL;
@@ -462,6 +524,8 @@ static fstatus open_model(getme_doc *doc, msh_impl *impl)
         gmshFree(err);
         return st;
     }
+    if ((st0 = merge_split_parts(doc, impl)) != GETME_FORMATS_OK)
+        return st0;
     current_model(impl->model_name, sizeof impl->model_name);
     if (model_exists(impl->model_name) > 1)
         return getme_doc_fail(doc, GETME_FORMATS_ERR_ARGUMENT,
@@ -598,13 +662,137 @@ static int patch_msh2(const char *in_path, const char *out_path, int binary)
     return rc;
 }
 
+/* Whether paths a and b name the same existing file. */
+static int same_file(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev &&
+           sa.st_ino == sb.st_ino;
+}
+
+/* Write input part in_part (opened again as its own Gmsh model) with the
+   document's coordinates, by node tag, to tmp_msh; 0 or -1 (message). */
+static int write_part(msh_impl *impl, const getme__nodemap *map,
+                      const double *coords, const char *in_part,
+                      const char *tmp_msh, char *msg, size_t size)
+{
+    int ierr = 0;
+    gmshOpen(in_part, &ierr);
+    if (ierr) {
+        snprintf(msg, size, "Gmsh could not read '%.400s' again", in_part);
+        return -1;
+    }
+    size_t *tags = NULL, n = 0, nc = 0, np = 0;
+    double *xyz = NULL, *param = NULL;
+    gmshModelMeshGetNodes(&tags, &n, &xyz, &nc, &param, &np, -1, -1, 0, 0,
+                          &ierr);
+    const getme_gmsh_model *m = impl->model;
+    int rc = ierr ? -1 : 0;
+    for (size_t i = 0; i < n && rc == 0; i++) {
+        int32_t k = getme__nodemap_find(map, tags[i]);
+        if (k < 0) {
+            snprintf(msg, size, "'%.400s': node %zu is not in the mesh read",
+                     in_part, tags[i]);
+            rc = -1;
+            break;
+        }
+        const double *p = coords + 3 * (size_t)k;
+        if (memcmp(p, m->coords0 + 3 * (size_t)k, 3 * sizeof *p) == 0)
+            continue; /* unmoved: the bits as read */
+        double g[3];
+        getme__frame_to_global(&m->frame, p, g);
+        gmshModelMeshSetNode(tags[i], g, 3, NULL, 0, &ierr);
+        if (ierr) {
+            snprintf(msg, size, "'%.400s': could not set node %zu", in_part,
+                     tags[i]);
+            rc = -1;
+        }
+    }
+    gmshFree(tags);
+    gmshFree(xyz);
+    gmshFree(param);
+    if (rc == 0) {
+        set_number("Mesh.SaveAll", needs_save_all());
+        set_number("Mesh.PartitionSplitMeshFiles", 0);
+        gmshWrite(tmp_msh, &ierr);
+        if (ierr) {
+            snprintf(msg, size, "Gmsh's writer failed on '%.400s'", in_part);
+            rc = -1;
+        }
+    }
+    gmshModelRemove(&ierr);
+    return rc;
+}
+
+/* A document read from split files: each input part NAME_K.msh is opened
+   again, given the new coordinates by node tag and written to a temporary
+   file; only when all are written are they renamed to OUT_K.msh
+   (out_path = "OUT.msh"), so a failing part leaves nothing behind. */
+static fstatus write_split(getme_doc *doc, msh_impl *impl, const char *tmp,
+                           const char *out_path)
+{
+    char in_stem[4096], out_stem[4096], part[4200], in_part[4200],
+        msg[512] = "";
+    size_t n = strlen(out_path);
+    int k, nparts = impl->split_parts;
+    if (impl->version < 3 || n < 5 || strcmp(out_path + n - 4, ".msh") != 0 ||
+        n - 4 >= sizeof out_stem ||
+        split_stem(getme_doc_path(doc), in_stem, sizeof in_stem) < 0)
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_WRITE,
+                              "Cannot write '%s': split partition files are "
+                              "written as MSH 4 to an output named *.msh",
+                              out_path);
+    memcpy(out_stem, out_path, n - 4);
+    out_stem[n - 4] = '\0';
+    for (k = 1; k <= nparts; k++)
+        for (int j = 1; j <= nparts; j++) {
+            snprintf(part, sizeof part, "%s_%d.msh", out_stem, k);
+            snprintf(in_part, sizeof in_part, "%s_%d.msh", in_stem, j);
+            if (same_file(part, in_part))
+                return getme_doc_fail(doc, GETME_FORMATS_ERR_WRITE,
+                                      "Cannot write '%s': it is the input "
+                                      "part '%s'; choose another output name",
+                                      part, in_part);
+        }
+    getme__nodemap map;
+    uint64_t dup = 0;
+    const getme_gmsh_model *m = impl->model;
+    if (getme__nodemap_build(&map, (const uint64_t *)m->node_tags,
+                             (size_t)m->num_nodes, &dup) != GETME_OK)
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL, "Out of memory");
+    const double *coords = getme_mesh_coords(getme_doc_mesh(doc));
+    int rc = 0;
+    for (k = 1; k <= nparts && rc == 0; k++) {
+        snprintf(in_part, sizeof in_part, "%s_%d.msh", in_stem, k);
+        snprintf(part, sizeof part, "%s_%d.msh", tmp, k);
+        rc = write_part(impl, &map, coords, in_part, part, msg, sizeof msg);
+    }
+    getme__nodemap_free(&map);
+    int err = 0, written = rc == 0 ? nparts : k - 1;
+    for (k = 1; k <= written; k++) {
+        snprintf(part, sizeof part, "%s_%d.msh", tmp, k);
+        snprintf(in_part, sizeof in_part, "%s_%d.msh", out_stem, k);
+        if (rc != 0)
+            remove(part);
+        else if (getme_io_commit(part, in_part) != 0)
+            rc = -1, err = errno;
+    }
+    if (rc != 0)
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_WRITE,
+                              "Cannot write '%s_K.msh': %s", out_stem,
+                              msg[0] ? msg : strerror(err));
+    return GETME_FORMATS_OK;
+}
+
 static fstatus write_model(getme_doc *doc, msh_impl *impl,
                                    const char *out_path)
 {
     char msg[512] = "", tmp[4096], tmp_msh[4200];
     int ierr = 0;
     gmshModelSetCurrent(impl->model_name, &ierr);
-    getme_status gs = getme_gmsh_model_apply(
+    /* Split files: the merged model is not written (each node of a
+       partition boundary is in it once per file), the parts are. */
+    getme_status gs = impl->split_parts > 0 ? GETME_OK : getme_gmsh_model_apply(
         impl->model, getme_mesh_coords(getme_doc_mesh(doc)), NULL, msg, sizeof msg);
     if (gs != GETME_OK)
         return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL, "%s", msg);
@@ -618,6 +806,8 @@ static fstatus write_model(getme_doc *doc, msh_impl *impl,
     set_number("Mesh.MshFileVersion", impl->version);
     set_number("Mesh.Binary", impl->binary);
     set_number("Mesh.SaveAll", impl->save_all);
+    if (impl->split_parts > 0)
+        return write_split(doc, impl, tmp, out_path);
     if (impl->version < 3)
         ierr = patch_msh2(getme_doc_path(doc), tmp_msh, impl->binary) != 0;
     else

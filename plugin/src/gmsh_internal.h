@@ -55,6 +55,8 @@ const char *gg_dim_word(int dim);
 const char *gg_dim_Word(int dim);
 /* Gmsh's last error as a string (static fallback if none). */
 void gg_gmsh_last_error(char *buf, size_t size);
+/* 1 if the current model has partition entities (gmsh -part). */
+int gg_model_partitioned(void);
 
 /* ---- entity selection (gmsh_select.c) ----------------------------------- */
 

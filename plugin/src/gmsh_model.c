@@ -46,6 +46,62 @@ static void read_free(gg_read *r, int num_entities)
     free(r->num_phys);
 }
 
+typedef struct tag_at {
+    size_t tag, at;
+} tag_at;
+
+static int cmp_tag_at(const void *a, const void *b)
+{
+    const tag_at *x = a, *y = b;
+    if (x->tag != y->tag)
+        return x->tag < y->tag ? -1 : 1;
+    return (x->at > y->at) - (x->at < y->at);
+}
+
+/* Split partition files merged into one model (gmsh_format.c) each carry
+   the nodes of the partition boundaries they touch, so Gmsh lists such a
+   node once per file: keep its first occurrence, in Gmsh's order.  The
+   copies must have the same coordinates bit for bit; returns 0, or -1 with
+   *bad = a tag whose copies differ, or -2 when out of memory. */
+static int drop_repeated_nodes(gg_read *r, uint64_t *bad)
+{
+    tag_at *s = malloc((r->gn ? r->gn : 1) * sizeof *s);
+    uint8_t *drop = calloc(r->gn ? r->gn : 1, 1);
+    if (!s || !drop) {
+        free(s);
+        free(drop);
+        return -2;
+    }
+    for (size_t i = 0; i < r->gn; i++)
+        s[i].tag = r->gtags[i], s[i].at = i;
+    qsort(s, r->gn, sizeof *s, cmp_tag_at);
+    int rc = 0;
+    for (size_t i = 1; i < r->gn && rc == 0; i++) {
+        if (s[i].tag != s[i - 1].tag)
+            continue;
+        size_t k = s[i].at, first = s[i].at;
+        for (size_t j = i; j > 0 && s[j - 1].tag == s[i].tag; j--)
+            first = s[j - 1].at;
+        if (memcmp(r->gcoords + 3 * k, r->gcoords + 3 * first,
+                   3 * sizeof *r->gcoords) != 0)
+            rc = -1, *bad = s[i].tag;
+        drop[k] = 1;
+    }
+    size_t n = 0;
+    for (size_t i = 0; i < r->gn && rc == 0; i++)
+        if (!drop[i]) {
+            r->gtags[n] = r->gtags[i];
+            memmove(r->gcoords + 3 * n, r->gcoords + 3 * i,
+                    3 * sizeof *r->gcoords);
+            n++;
+        }
+    if (rc == 0)
+        r->gn = n;
+    free(s);
+    free(drop);
+    return rc;
+}
+
 static getme_status read_all_nodes(gg_read *r, gg_msg *msg)
 {
     size_t nc = 0, np = 0;
@@ -63,6 +119,15 @@ static getme_status read_all_nodes(gg_read *r, gg_msg *msg)
     if (!r->flags)
         return gg_fail(msg, GETME_ERR_NOMEM, "Out of memory");
     uint64_t repeated = 0;
+    if (gg_model_partitioned()) {
+        int rc = drop_repeated_nodes(r, &repeated);
+        if (rc == -2)
+            return gg_fail(msg, GETME_ERR_NOMEM, "Out of memory");
+        if (rc == -1)
+            return gg_fail(msg, GETME_ERR_STATE,
+                           "Node %llu appears twice with different "
+                           "coordinates", (unsigned long long)repeated);
+    }
     getme_status st = getme__nodemap_build(&r->gmap, (const uint64_t *)r->gtags,
                                            r->gn, &repeated);
     if (st == GETME_ERR_ARGUMENT)

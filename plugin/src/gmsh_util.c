@@ -45,3 +45,19 @@ void gg_gmsh_last_error(char *buf, size_t size)
     snprintf(buf, size, "%s", err && *err ? err : "unknown Gmsh error");
     gmshFree(err);
 }
+
+int gg_model_partitioned(void)
+{
+    int *dt = NULL, ierr = 0, found = 0;
+    size_t n = 0;
+    gmshModelGetEntities(&dt, &n, -1, &ierr);
+    for (size_t i = 0; !ierr && i + 1 < n && !found; i += 2) {
+        int *parts = NULL;
+        size_t np = 0;
+        gmshModelGetPartitions(dt[i], dt[i + 1], &parts, &np, &ierr);
+        found = np > 0;
+        gmshFree(parts);
+    }
+    gmshFree(dt);
+    return found;
+}
