@@ -181,6 +181,28 @@ void cli_smooth_opts_free(cli_smooth_opts *o);
 int cli_smooth_option(cli_smooth_opts *o, int argc, char **argv, int *i);
 /* The document options the smoothing options imply. */
 void cli_smooth_doc_options(const cli_smooth_opts *o, getme_doc_options *d);
+
+/* The arguments getme smooth and getme-mpi smooth take alike. */
+typedef struct cli_smooth_args {
+    const char *input, *output;
+    long worst;
+    cli_smooth_opts o;
+} cli_smooth_args;
+
+/* How one of those commands names itself in its help and messages. */
+typedef struct cli_smooth_usage {
+    const char *name;      /* "getme smooth" */
+    const char *help_cmd;  /* the command whose --help to point to */
+    const char *help_head, *help_tail; /* around the options; tail may be NULL */
+} cli_smooth_usage;
+
+/* Parse argv[first..] (a->o initialised): smoothing options, -o / --output,
+   --worst N and one input.  -1 after printing --help, 0 with an input and an
+   output, else EXIT_USAGE (printed).  One parser keeps getme-mpi smooth's
+   command line the same as getme smooth's. */
+int cli_smooth_parse_args(cli_smooth_args *a, int argc, char **argv,
+                          int first, const cli_smooth_usage *u);
+
 /* Before smoothing: progress lines and history on, the thread count
    decided, "Optimizing mesh (...)..." logged; the parameters are copied to
    *params when that is not o->params. */

@@ -43,56 +43,16 @@ static const char SMOOTH_HELP_TAIL[] =
     "8 invalid elements that could not be untangled (named by their ids in\n"
     "the file; no output unless --allow-invalid)\n";
 
-typedef struct smooth_args {
-    const char *input, *output;
-    long worst;
-    cli_smooth_opts o;
-} smooth_args;
+typedef cli_smooth_args smooth_args;
 
 static int parse(int argc, char **argv, smooth_args *a)
 {
     a->worst = 10;
     if (cli_smooth_opts_init(&a->o, argc) != 0)
         return 1;
-    for (int i = 1; i < argc; i++) {
-        const char *o = argv[i];
-        int r = cli_smooth_option(&a->o, argc, argv, &i);
-        if (r < 0)
-            return EXIT_USAGE;
-        if (r > 0)
-            continue;
-        if (!strcmp(o, "-h") || !strcmp(o, "--help")) {
-            fputs(SMOOTH_HELP_HEAD, stdout);
-            fputs(CLI_SMOOTH_OPTIONS_HELP, stdout);
-            fputs(SMOOTH_HELP_TAIL, stdout);
-            cli_print_params(stdout);
-            return -1;
-        } else if (!strcmp(o, "-o") || !strcmp(o, "--output") ||
-                   !strcmp(o, "--worst")) {
-            if (i + 1 >= argc) {
-                cli_error("%s needs a value (see getme smooth --help)", o);
-                return EXIT_USAGE;
-            }
-            if (o[2] != 'w')
-                a->output = argv[++i];
-            else if (cli_parse_int(o, argv[++i], 0, 1000000, &a->worst) != 0)
-                return EXIT_USAGE;
-        } else if (o[0] == '-' && o[1]) {
-            cli_error("unknown option '%s' (see getme smooth --help)", o);
-            return EXIT_USAGE;
-        } else if (!a->input) {
-            a->input = o;
-        } else {
-            cli_error("unexpected argument '%s': one input file only", o);
-            return EXIT_USAGE;
-        }
-    }
-    if (!a->input || !a->output) {
-        cli_error("getme smooth needs an input file and -o OUTPUT "
-                  "(see getme smooth --help)");
-        return EXIT_USAGE;
-    }
-    return 0;
+    static const cli_smooth_usage usage = {
+        "getme smooth", "getme smooth", SMOOTH_HELP_HEAD, SMOOTH_HELP_TAIL};
+    return cli_smooth_parse_args(a, argc, argv, 1, &usage);
 }
 
 /* Writing the output (termination signals held). */

@@ -243,3 +243,48 @@ void cli_smooth_done(const cli_smooth_opts *o, const getme_result *res)
              res->seconds, res->iterations_mean, res->iterations_min,
              res->cycles_min);
 }
+
+int cli_smooth_parse_args(cli_smooth_args *a, int argc, char **argv,
+                          int first, const cli_smooth_usage *u)
+{
+    for (int i = first; i < argc; i++) {
+        const char *o = argv[i];
+        int r = cli_smooth_option(&a->o, argc, argv, &i);
+        if (r < 0)
+            return EXIT_USAGE;
+        if (r > 0)
+            continue;
+        if (!strcmp(o, "-h") || !strcmp(o, "--help")) {
+            fputs(u->help_head, stdout);
+            fputs(CLI_SMOOTH_OPTIONS_HELP, stdout);
+            if (u->help_tail)
+                fputs(u->help_tail, stdout);
+            cli_print_params(stdout);
+            return -1;
+        } else if (!strcmp(o, "-o") || !strcmp(o, "--output") ||
+                   !strcmp(o, "--worst")) {
+            if (i + 1 >= argc) {
+                cli_error("%s needs a value (see %s --help)", o, u->help_cmd);
+                return EXIT_USAGE;
+            }
+            if (o[2] != 'w')
+                a->output = argv[++i];
+            else if (cli_parse_int(o, argv[++i], 0, 1000000, &a->worst) != 0)
+                return EXIT_USAGE;
+        } else if (o[0] == '-' && o[1]) {
+            cli_error("unknown option '%s' (see %s --help)", o, u->help_cmd);
+            return EXIT_USAGE;
+        } else if (!a->input) {
+            a->input = o;
+        } else {
+            cli_error("unexpected argument '%s': one input file only", o);
+            return EXIT_USAGE;
+        }
+    }
+    if (!a->input || !a->output) {
+        cli_error("%s needs an input file and -o OUTPUT (see %s --help)",
+                  u->name, u->help_cmd);
+        return EXIT_USAGE;
+    }
+    return 0;
+}

@@ -26,11 +26,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct args {
-    const char *input, *output;
-    long worst;
-    cli_smooth_opts o;
-} args;
+typedef cli_smooth_args args;
 
 typedef struct run_state {
     dist_ctx *c;
@@ -76,43 +72,11 @@ static int parse(int argc, char **argv, args *a)
                   "(see getme-mpi --help)");
         return EXIT_USAGE;
     }
-    for (int i = 2; i < argc; i++) {
-        const char *o = argv[i];
-        int r = cli_smooth_option(&a->o, argc, argv, &i);
-        if (r < 0)
-            return EXIT_USAGE;
-        if (r > 0)
-            continue;
-        if (!strcmp(o, "-h") || !strcmp(o, "--help")) {
-            fputs(HELP_HEAD, stdout);
-            fputs(CLI_SMOOTH_OPTIONS_HELP, stdout);
-            cli_print_params(stdout);
-            return -1;
-        } else if (!strcmp(o, "-o") || !strcmp(o, "--output") ||
-                   !strcmp(o, "--worst")) {
-            if (i + 1 >= argc) {
-                cli_error("%s needs a value (see getme-mpi --help)", o);
-                return EXIT_USAGE;
-            }
-            if (o[2] != 'w')
-                a->output = argv[++i];
-            else if (cli_parse_int(o, argv[++i], 0, 1000000, &a->worst) != 0)
-                return EXIT_USAGE;
-        } else if (o[0] == '-' && o[1]) {
-            cli_error("unknown option '%s' (see getme-mpi --help)", o);
-            return EXIT_USAGE;
-        } else if (!a->input) {
-            a->input = o;
-        } else {
-            cli_error("unexpected argument '%s': one input file only", o);
-            return EXIT_USAGE;
-        }
-    }
-    if (!a->input || !a->output) {
-        cli_error("getme-mpi smooth needs an input file and -o OUTPUT "
-                  "(see getme-mpi --help)");
-        return EXIT_USAGE;
-    }
+    static const cli_smooth_usage usage = {
+        "getme-mpi smooth", "getme-mpi", HELP_HEAD, NULL};
+    int st = cli_smooth_parse_args(a, argc, argv, 2, &usage);
+    if (st != 0)
+        return st;
     if (a->o.params.method != GETME_METHOD_ADAPTIVE) {
         cli_error("--method laplace: getme-mpi runs GETMe adaptive only "
                   "(use getme smooth for smart Laplace)");

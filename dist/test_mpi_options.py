@@ -22,18 +22,8 @@ import subprocess
 import sys
 import tempfile
 
-GETME_MPI, GETME, MPIEXEC, SRC = sys.argv[1:5]
-SANITIZED = "--sanitized" in sys.argv[5:]
-sys.path.insert(0, os.path.join(SRC, "bench"))
-sys.path.insert(0, os.path.join(SRC, "tests", "support"))
-import meshes  # noqa: E402
-from checks import Checks  # noqa: E402
-
-ENV = dict(os.environ, OMP_WAIT_POLICY="passive", OMPI_ALLOW_RUN_AS_ROOT="1",
-           OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_rmaps_base_oversubscribe="1")
-if SANITIZED:
-    ENV["ASAN_OPTIONS"] = "detect_leaks=0"
-c = Checks(GETME)
+import meshes
+from mpi_checks import GETME_MPI, MPIEXEC, ENV, c
 
 
 def mpirun(np, *args):

@@ -44,18 +44,6 @@ int32_t getme_mesh_num_elements_ho(const getme_mesh *mesh)
     return mesh && mesh->ho ? mesh->ho->num_elements : 0;
 }
 
-static int nodes_ok(const int32_t *c, int nv, int32_t num_nodes)
-{
-    for (int i = 0; i < nv; i++) {
-        if (c[i] < 0 || c[i] >= num_nodes)
-            return 0;
-        for (int j = 0; j < i; j++)
-            if (c[j] == c[i])
-                return 0;
-    }
-    return 1;
-}
-
 getme_status getme_mesh_add_elements_ho(getme_mesh *mesh, getme_ho_type type,
                                         int32_t count, const int32_t *conn,
                                         const int32_t *region)
@@ -72,7 +60,8 @@ getme_status getme_mesh_add_elements_ho(getme_mesh *mesh, getme_ho_type type,
     int nv = getme__ho_nv[type], lin = getme__ho_lin[type];
     int nl = getme__nv[lin];
     for (int32_t e = 0; e < count; e++)
-        if (!nodes_ok(conn + (int64_t)e * nv, nv, mesh->num_nodes))
+        if (!getme__element_nodes_ok(conn + (int64_t)e * nv, nv,
+                                     mesh->num_nodes))
             return getme__fail(mesh, GETME_ERR_TOPOLOGY,
                                "element %d (%s %d of this block): node index "
                                "out of range or repeated",

@@ -169,6 +169,10 @@ static inline void getme__prefetch_local(const getme_mesh *mesh,
 #endif
 }
 
+/* 1 if one element's nv node indices are in range and pairwise distinct
+   (mesh.c; first- and second-order elements are checked alike). */
+int getme__element_nodes_ok(const int32_t *c, int nv, int32_t num_nodes);
+
 /* Record a printf-style message on the mesh and return status. */
 getme_status getme__fail(getme_mesh *mesh, getme_status status,
                          const char *fmt, ...)

@@ -93,8 +93,8 @@ void getme_mesh_free(getme_mesh *mesh)
     free(mesh);
 }
 
-/* Check one element's node indices: in range and pairwise distinct. */
-static int element_ok(const int32_t *c, int nv, int32_t num_nodes)
+/* Shared with highorder.c (internal.h): one rule for every element kind. */
+int getme__element_nodes_ok(const int32_t *c, int nv, int32_t num_nodes)
 {
     for (int i = 0; i < nv; i++) {
         if (c[i] < 0 || c[i] >= num_nodes)
@@ -128,7 +128,8 @@ getme_status getme_mesh_add_elements(getme_mesh *mesh, getme_elem_type type,
                            "more than 2^31-1 elements");
     int nv = getme__nv[type];
     for (int32_t e = 0; e < count; e++) {
-        if (!element_ok(conn + (size_t)e * nv, nv, mesh->num_nodes))
+        if (!getme__element_nodes_ok(conn + (size_t)e * nv, nv,
+                                     mesh->num_nodes))
             return getme__fail(mesh, GETME_ERR_TOPOLOGY,
                                "element %d (%s %d of this block): node index "
                                "out of range or repeated",

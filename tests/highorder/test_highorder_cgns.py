@@ -28,10 +28,12 @@ import meshio
 import numpy as np
 
 import ho_check
+from checks import WorkChecks
 
 GETME, WRITER, WORK = sys.argv[1], sys.argv[2], sys.argv[3]
-os.makedirs(WORK, exist_ok=True)
-FAILED = []
+W = WorkChecks(GETME, WORK)
+FAILED = W.failed
+check, path, run = W.check, W.path, W.run
 
 # Gmsh type -> (SIDS name, CGNS node i is Gmsh's node perm[i], meshio's
 # name of the VTK cell)
@@ -53,23 +55,6 @@ TYPES = {
          "pyramid14"),
 }
 NC = {11: 4, 17: 8, 12: 8, 18: 6, 13: 6, 19: 5, 14: 5}
-def check(cond, what):
-    if not cond:
-        FAILED.append(what)
-        print("FAIL:", what, flush=True)
-
-
-def path(name):
-    return os.path.join(WORK, name)
-
-
-def run(*args, threads=2):
-    env = dict(os.environ, OMP_NUM_THREADS=str(threads),
-               OMP_WAIT_POLICY="passive")
-    return subprocess.run([GETME] + list(args), capture_output=True,
-                          text=True, env=env)
-
-
 def generate(gtype, n=3):
     """Nodes and {Gmsh type: 0-based connectivity} of every 3-D type in
     the mesh.  Pyramids: a hex block [0,1]^3 and a tet block [1,2]x[0,1]^2

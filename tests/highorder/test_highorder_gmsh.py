@@ -22,16 +22,12 @@ import numpy as np
 
 import ho_check
 import getme  # PYTHONPATH: the build's python directory
+from checks import WorkChecks
 
 GETME, WORK = sys.argv[1], sys.argv[2]
-os.makedirs(WORK, exist_ok=True)
-FAILED = []
-
-
-def check(cond, what):
-    if not cond:
-        FAILED.append(what)
-        print("FAIL:", what, flush=True)
+W = WorkChecks(GETME, WORK)
+FAILED = W.failed
+check = W.check
 
 
 def model(kind):

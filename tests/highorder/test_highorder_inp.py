@@ -30,28 +30,13 @@ import numpy as np
 
 import ho_check
 import inp_deck
+from checks import WorkChecks
 
 GETME, WORK = sys.argv[1], sys.argv[2]
-os.makedirs(WORK, exist_ok=True)
+W = WorkChecks(GETME, WORK)
+FAILED = W.failed
+check, path, run = W.check, W.path, W.run
 CCX_TESTS = "/usr/share/doc/calculix-ccx-test/examples/test"
-FAILED = []
-
-
-def check(cond, what):
-    if not cond:
-        FAILED.append(what)
-        print("FAIL:", what, flush=True)
-
-
-def path(name):
-    return os.path.join(WORK, name)
-
-
-def run(*args, threads=2):
-    env = dict(os.environ, OMP_NUM_THREADS=str(threads),
-               OMP_WAIT_POLICY="passive")
-    return subprocess.run([GETME] + list(args), capture_output=True,
-                          text=True, env=env)
 
 
 def midpoint_share(nodes, elems, perm, gtype):

@@ -26,11 +26,13 @@ import sys
 
 import gmsh
 import numpy as np
+from checks import WorkChecks
 
 GETME, WORK = sys.argv[1], sys.argv[-1]
 WRITER = sys.argv[2] if len(sys.argv) > 3 else None  # cgns_ho_write
-os.makedirs(WORK, exist_ok=True)
-FAILED = []
+W = WorkChecks(GETME, WORK)
+FAILED = W.failed
+check, run = W.check, W.run
 DETS = {}
 
 # Gmsh type -> (corners, mid-edge / centre nodes as (node, corners...))
@@ -39,19 +41,6 @@ TYPES = {
     16: (4, [(4, 0, 1), (5, 1, 2), (6, 2, 3), (7, 3, 0)]),
 }
 TYPES[10] = (4, TYPES[16][1] + [(8, 0, 1, 2, 3)])
-
-
-def check(cond, what):
-    if not cond:
-        FAILED.append(what)
-        print("FAIL:", what, flush=True)
-
-
-def run(*args, threads=2):
-    env = dict(os.environ, OMP_NUM_THREADS=str(threads),
-               OMP_WAIT_POLICY="passive")
-    return subprocess.run([GETME] + list(args), capture_output=True,
-                          text=True, env=env)
 
 
 def generate(kind, n=6):

@@ -22,19 +22,12 @@ import sys
 import gmsh
 import numpy as np
 
+from checks import WorkChecks  # PYTHONPATH: tests/support
+
 GETME, WORK = sys.argv[1], sys.argv[2]
-os.makedirs(WORK, exist_ok=True)
-FAILED = []
-
-
-def check(cond, what):
-    if not cond:
-        FAILED.append(what)
-        print("FAIL:", what, flush=True)
-
-
-def path(name):
-    return os.path.join(WORK, name)
+W = WorkChecks(GETME, WORK)
+FAILED = W.failed
+check, path = W.check, W.path
 
 
 # ---- mesh generation --------------------------------------------------------

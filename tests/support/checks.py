@@ -1,6 +1,7 @@
 """The check / run helpers of the Python-hosted getme command tests
-(test_cli.py, test_safety.py): count what passed, print what failed, run
-the command and check its exit code."""
+(test_cli.py, test_safety.py, the getme-mpi tests): count what passed,
+print what failed, run the command and check its exit code."""
+import os
 import subprocess
 
 
@@ -31,3 +32,32 @@ class Checks:
         """Print the counts; the exit status for sys.exit."""
         print(f"{self.passed} passed, {len(self.failures)} failed")
         return 1 if self.failures else 0
+
+
+class WorkChecks:
+    """The check / path / run helpers of the tests that write into one work
+    folder (the second-order tests, test_msh_native.py): failures are
+    printed as they happen and collected in .failed, which each test turns
+    into its exit code."""
+
+    def __init__(self, getme, work):
+        self.getme = getme
+        self.work = work
+        self.failed = []
+        os.makedirs(work, exist_ok=True)
+
+    def check(self, cond, what):
+        if not cond:
+            self.failed.append(what)
+            print("FAIL:", what, flush=True)
+
+    def path(self, name):
+        return os.path.join(self.work, name)
+
+    def run(self, *args, threads=2):
+        """getme ARGS... with THREADS OpenMP threads (passive waits: the
+        tests share the machine with other jobs)."""
+        env = dict(os.environ, OMP_NUM_THREADS=str(threads),
+                   OMP_WAIT_POLICY="passive")
+        return subprocess.run([self.getme] + list(args), capture_output=True,
+                              text=True, env=env)

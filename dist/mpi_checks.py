@@ -1,0 +1,23 @@
+"""The start every getme-mpi test (test_mpi*.py) shares: its command line,
+the environment its MPI runs need and the Checks that counts its results.
+Imported by name (dist/CMakeLists.txt puts dist/ and tests/support on
+PYTHONPATH).
+
+usage: test_mpi*.py GETME_MPI GETME MPIEXEC SOURCE_DIR [--sanitized]
+"""
+import os
+import sys
+
+from checks import Checks
+
+GETME_MPI, GETME, MPIEXEC, SRC = sys.argv[1:5]
+SANITIZED = "--sanitized" in sys.argv[5:]
+# Passive OpenMP waits keep oversubscribed ranks from spinning; the
+# OMPI_* settings let the tests run as root (CI containers) and start more
+# ranks than cores.
+ENV = dict(os.environ, OMP_WAIT_POLICY="passive", OMPI_ALLOW_RUN_AS_ROOT="1",
+           OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_rmaps_base_oversubscribe="1")
+if SANITIZED:
+    # Open MPI's own start-up allocations are never freed.
+    ENV["ASAN_OPTIONS"] = "detect_leaks=0"
+c = Checks(GETME)
