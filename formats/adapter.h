@@ -18,6 +18,9 @@ struct getme_doc {
     /* element ids as written in the file, per global element index (may be
        NULL); used in messages about invalid elements                       */
     int64_t *elem_ids;
+    /* when elem_ids was one run (id = e + 1 + elem_id_shift for every e) it
+       is freed after the read: 8 bytes per element less through smoothing */
+    int64_t elem_id_shift;
     getme_quality_stats stats; /* all elements as read (getme_doc_open)     */
     int have_stats;
     char info[1024];     /* one line the CLI may log: zones, sets, fixed...  */

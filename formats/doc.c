@@ -97,6 +97,7 @@ void getme_doc_set_mesh(getme_doc *doc, getme_mesh *mesh, int64_t *elem_ids)
     free(doc->elem_ids);
     doc->mesh = mesh;
     doc->elem_ids = elem_ids;
+    doc->elem_id_shift = 0;
 }
 
 void getme_doc_set_impl(getme_doc *doc, void *impl) { doc->impl = impl; }
@@ -134,7 +135,8 @@ const getme_quality_stats *getme_doc_stats(const getme_doc *doc)
 
 int64_t getme_doc_element_id(const getme_doc *doc, int32_t e)
 {
-    return doc->elem_ids ? doc->elem_ids[e] : (int64_t)e + 1;
+    return doc->elem_ids ? doc->elem_ids[e]
+                         : (int64_t)e + 1 + doc->elem_id_shift;
 }
 
 /* Name the first invalid elements by their ids in the file. */
@@ -210,6 +212,24 @@ static getme_formats_status open_with_adapters(getme_doc *doc,
                           doc->path, names);
 }
 
+/* Element ids that are one consecutive run (the usual case: Gmsh numbers
+   a volume's elements in order) need no table; the table is 64-bit per
+   element and would otherwise stay allocated through the smoothing. */
+static void compact_ids(getme_doc *doc)
+{
+    int32_t n = getme_mesh_num_elements(doc->mesh);
+    /* second-order meshes keep the table (their ids index it otherwise) */
+    if (!doc->elem_ids || n <= 0 || getme_mesh_num_elements_ho(doc->mesh))
+        return;
+    int64_t shift = doc->elem_ids[0] - 1;
+    for (int32_t e = 1; e < n; e++)
+        if (doc->elem_ids[e] - e - 1 != shift)
+            return;
+    free(doc->elem_ids);
+    doc->elem_ids = NULL;
+    doc->elem_id_shift = shift;
+}
+
 getme_formats_status getme_doc_open(getme_doc **out, const char *path,
                                const getme_doc_options *opts)
 {
@@ -242,6 +262,7 @@ getme_formats_status getme_doc_open(getme_doc **out, const char *path,
         return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL,
                               "%s: the %s adapter built no mesh", path,
                               doc->format->name);
+    compact_ids(doc);
     return check_valid(doc);
 }
 
