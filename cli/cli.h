@@ -245,6 +245,12 @@ int cli_worst(getme_doc *doc, int32_t max_count, unsigned flags,
 void cli_print_worst(const cli_log *log, const getme_doc *doc,
                      const cli_worst_list *w, const char *which);
 void cli_json_worst(FILE *f, const getme_doc *doc, const cli_worst_list *w);
+/* After smoothing: worst corner line, worst lists (-v) and the warning when
+   the worst elements have no free node; 0, or -1 if out of memory. */
+int cli_log_after(const cli_log *log, getme_doc *doc, int32_t max_count,
+                  const getme_quality_stats *after,
+                  const getme_result *res, cli_worst_list *worst,
+                  cli_worst_list *worst_free);
 
 /* More for the report: measures (smooth and gmsh), the worst elements
    (smooth only: they need the document); NULL members are left out. */

@@ -77,3 +77,33 @@ void cli_json_worst(FILE *f, const getme_doc *doc, const cli_worst_list *w)
     }
     fputs(w->count ? "\n  ]" : "]", f);
 }
+
+/* What getme smooth and getme-mpi print after smoothing, alike: the worst
+   corner line, the warning when the worst elements have no free node, and
+   with -v both worst lists.  The lists stay filled for the report (the
+   caller frees them).  0, or -1 if out of memory. */
+int cli_log_after(const cli_log *log, getme_doc *doc, int32_t max_count,
+                  const getme_quality_stats *after,
+                  const getme_result *res, cli_worst_list *worst,
+                  cli_worst_list *worst_free)
+{
+    if (res->corner_sj_initial < 1.0 || res->corner_sj < 1.0)
+        cli_info(log, "Worst corner scaled Jacobian (hex, prism, pyramid, "
+                      "quad): %.4f before, %.4f after",
+                 res->corner_sj_initial, res->corner_sj);
+    if (cli_worst(doc, max_count, 0, worst) != 0 ||
+        cli_worst(doc, max_count, GETME_WORST_FREE_ONLY, worst_free) != 0)
+        return -1;
+    int fixed_worst = after->num_free > 0 && after->q_min < after->q_min_star;
+    if (fixed_worst)
+        cli_warning(log, "qmin %.4f is below q*min %.4f: the worst elements "
+                         "have no free node, no node move can fix them "
+                         "(see --worst, -v)",
+                    after->q_min, after->q_min_star);
+    if (log->verbose) {
+        cli_print_worst(log, doc, worst, "");
+        if (fixed_worst)
+            cli_print_worst(log, doc, worst_free, " with a free node");
+    }
+    return 0;
+}

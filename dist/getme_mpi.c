@@ -230,28 +230,12 @@ static int finish_output(args *a, const cli_paths *paths, getme_doc *doc,
     cli_print_stats(log, "Quality after ", &after);
     cli_measures_log(log, mesh, "Measures after ", &mafter);
     cli_ho_log(log, doc, "after", NULL);
-    if (res->corner_sj_initial < 1.0 || res->corner_sj < 1.0)
-        cli_info(log, "Worst corner scaled Jacobian (hex, prism, pyramid, "
-                      "quad): %.4f before, %.4f after",
-                 res->corner_sj_initial, res->corner_sj);
     cli_worst_list worst = {0}, worst_free = {0};
     int code = 0;
-    if (cli_worst(doc, (int32_t)a->worst, 0, &worst) != 0 ||
-        cli_worst(doc, (int32_t)a->worst, GETME_WORST_FREE_ONLY,
-                  &worst_free) != 0) {
+    if (cli_log_after(log, doc, (int32_t)a->worst, &after, res, &worst,
+                      &worst_free) != 0) {
         code = CLI_EXIT_INTERNAL;
         goto out;
-    }
-    int fixed_worst = after.num_free > 0 && after.q_min < after.q_min_star;
-    if (fixed_worst)
-        cli_warning(log, "qmin %.4f is below q*min %.4f: the worst elements "
-                         "have no free node, no node move can fix them "
-                         "(see --worst, -v)",
-                    after.q_min, after.q_min_star);
-    if (log->verbose) {
-        cli_print_worst(log, doc, &worst, "");
-        if (fixed_worst)
-            cli_print_worst(log, doc, &worst_free, " with a free node");
     }
     cli_guard guard = {0};
     cli_write_guard(&guard, 1);
