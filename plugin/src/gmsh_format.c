@@ -44,7 +44,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <sys/types.h>
 
 typedef getme_formats_status fstatus;
@@ -662,14 +661,6 @@ static int patch_msh2(const char *in_path, const char *out_path, int binary)
     return rc;
 }
 
-/* Whether paths a and b name the same existing file. */
-static int same_file(const char *a, const char *b)
-{
-    struct stat sa, sb;
-    return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev &&
-           sa.st_ino == sb.st_ino;
-}
-
 /* Write input part in_part (opened again as its own Gmsh model) with the
    document's coordinates, by node tag, to tmp_msh; 0 or -1 (message). */
 static int write_part(msh_impl *impl, const getme__nodemap *map,
@@ -748,7 +739,7 @@ static fstatus write_split(getme_doc *doc, msh_impl *impl, const char *tmp,
         for (int j = 1; j <= nparts; j++) {
             snprintf(part, sizeof part, "%s_%d.msh", out_stem, k);
             snprintf(in_part, sizeof in_part, "%s_%d.msh", in_stem, j);
-            if (same_file(part, in_part))
+            if (getme_io_same_file(part, in_part))
                 return getme_doc_fail(doc, GETME_FORMATS_ERR_WRITE,
                                       "Cannot write '%s': it is the input "
                                       "part '%s'; choose another output name",
