@@ -286,7 +286,7 @@ static int simplices_only(const getme_ws *ws)
     return 1;
 }
 
-getme_status getme__adj_build(getme_adj *adj, const getme_ws *ws)
+getme_status getme__adj_build(getme_adj *adj, getme_ws *ws)
 {
     memset(adj, 0, sizeof *adj);
     size_t nn = (size_t)(ws->nn ? ws->nn : 1), ne = (size_t)(ws->ne ? ws->ne : 1);
@@ -295,7 +295,11 @@ getme_status getme__adj_build(getme_adj *adj, const getme_ws *ws)
        are an edge or a face of it), so the formula can fail only where
        build_faces sees it; other types need the check. */
     int check = !simplices_only(ws);
-    adj->fnb = malloc((size_t)(ftotal ? ftotal : 1) * sizeof *adj->fnb);
+    int have_faces = ws->faces != NULL; /* the boundary search's table */
+    adj->fnb = have_faces ? ws->faces
+                          : malloc((size_t)(ftotal ? ftotal : 1) *
+                                   sizeof *adj->fnb);
+    ws->faces = NULL;
     adj->count = malloc(ne * sizeof *adj->count);
     adj->irregular = malloc(ne);
     adj->nsum = malloc(nn * sizeof *adj->nsum);
@@ -319,7 +323,8 @@ getme_status getme__adj_build(getme_adj *adj, const getme_ws *ws)
     }
     if (check)
         node_checks(ws, rn);
-    if ((st = getme__ws_faces(ws, adj->foff, adj->fnb)) != GETME_OK)
+    if (!have_faces &&
+        (st = getme__ws_faces(ws, adj->foff, adj->fnb)) != GETME_OK)
         goto fail;
     counts_and_flags(adj, ws, edeg);
     if (check && (st = check_all(adj, ws, rn, re)) != GETME_OK)

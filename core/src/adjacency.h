@@ -65,9 +65,10 @@ typedef struct getme_adj {
     double qscale, qinv; /* 2^(61 - b) and its inverse                    */
 } getme_adj;
 
-/* Build everything above for ws (parallel, deterministic).  GETME_OK or
+/* Build everything above for ws (parallel, deterministic); takes over
+   ws->faces when the boundary search left it.  GETME_OK or
    GETME_ERR_NOMEM. */
-getme_status getme__adj_build(getme_adj *adj, const getme_ws *ws);
+getme_status getme__adj_build(getme_adj *adj, getme_ws *ws);
 void getme__adj_free(getme_adj *adj);
 
 /* S_v and S_e of every node and edge from q: a colour-ordered scatter, so

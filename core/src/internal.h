@@ -119,8 +119,15 @@ struct getme_mesh {
     int num_blocks, cap_blocks;
     int mirror;       /* planar meshes: 1 if all elements are clockwise */
     struct getme_ho_mesh *ho; /* second-order elements (highorder.h), or NULL */
+    /* The workspace (and face table) the boundary search built, kept for
+       the smoother so that it is built once (workspace.c); dropped when
+       coordinates or elements change, as its order depends on both. */
+    struct getme_ws *ws_cache;
     char error[512];  /* message of the last failure */
 };
+
+/* Free mesh->ws_cache, if any (workspace.c). */
+void getme__mesh_drop_ws(getme_mesh *mesh);
 
 /* Why a node is fixed: bits of getme_mesh.fixed.  Only the worst-element
    report (worst.c) asks; everything else tests fixed != 0. */

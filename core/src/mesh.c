@@ -88,6 +88,7 @@ void getme_mesh_free(getme_mesh *mesh)
     }
     free(mesh->blocks);
     getme__ho_mesh_free(mesh->ho);
+    getme__mesh_drop_ws(mesh);
     free(mesh->coords);
     free(mesh->fixed);
     free(mesh);
@@ -144,6 +145,7 @@ getme_status getme_mesh_add_elements(getme_mesh *mesh, getme_elem_type type,
         mesh->blocks = nb;
         mesh->cap_blocks = cap;
     }
+    getme__mesh_drop_ws(mesh);
     getme_block *b = &mesh->blocks[mesh->num_blocks];
     memset(b, 0, sizeof *b);
     b->type = type;
@@ -226,6 +228,7 @@ getme_status getme_mesh_set_coords(getme_mesh *mesh, const double *coords)
                                "node %zu: non-finite coordinate", i / 3);
     memcpy(mesh->coords, coords, (size_t)mesh->num_nodes * 3 * sizeof(double));
     mesh->mirror = -1;
+    getme__mesh_drop_ws(mesh);
     return GETME_OK;
 }
 

@@ -31,8 +31,29 @@ void getme__ws_free(getme_ws *ws)
     free(ws->block_start);
     free(ws->colour_ptr);
     free(ws->colour_blocks);
+    free(ws->faces);
     getme__ho_free(ws->ho);
     memset(ws, 0, sizeof *ws);
+}
+
+void getme__ws_keep(getme_ws *ws, getme_mesh *mesh)
+{
+    getme__mesh_drop_ws(mesh);
+    mesh->ws_cache = malloc(sizeof *mesh->ws_cache);
+    if (mesh->ws_cache)
+        *mesh->ws_cache = *ws;
+    else
+        getme__ws_free(ws);
+    memset(ws, 0, sizeof *ws);
+}
+
+void getme__mesh_drop_ws(getme_mesh *mesh)
+{
+    if (mesh->ws_cache) {
+        getme__ws_free(mesh->ws_cache);
+        free(mesh->ws_cache);
+        mesh->ws_cache = NULL;
+    }
 }
 
 /* Spread the low 10 bits of v to every third bit. */
@@ -296,10 +317,49 @@ static getme_status colour_blocks(getme_ws *ws)
     return GETME_OK;
 }
 
+/* The fixed flags and what follows from them: free elements, free nodes
+   (linear, parallel; the counts are sums of integers, so exact). */
+static void read_fixed(getme_ws *ws, const getme_mesh *mesh)
+{
+#pragma omp parallel for schedule(static) num_threads(ws->nt)
+    for (int32_t i = 0; i < ws->nn; i++)
+        ws->fixed[i] = mesh->fixed[ws->node_orig[i]] != 0;
+    int32_t nfe = 0, nfn = 0;
+    for (int t = 0; t < GETME_NUM_TYPES; t++) {
+        int nv = getme__nv[t];
+#pragma omp parallel for schedule(static) num_threads(ws->nt) \
+    reduction(+ : nfe)
+        for (int32_t e = ws->tstart[t]; e < ws->tstart[t + 1]; e++) {
+            const int32_t *c = getme__ws_nodes(ws, t, e);
+            uint8_t f = 0;
+            for (int i = 0; i < nv; i++)
+                f |= !ws->fixed[c[i]];
+            ws->free_elem[e] = f;
+            nfe += f;
+        }
+    }
+#pragma omp parallel for schedule(static) num_threads(ws->nt) \
+    reduction(+ : nfn)
+    for (int32_t i = 0; i < ws->nn; i++)
+        nfn += !ws->fixed[i] && ws->star_ptr[i + 1] > ws->star_ptr[i];
+    ws->num_free_elem = nfe;
+    ws->num_free_nodes = nfn;
+}
+
 getme_status getme__ws_build(getme_ws *ws, getme_mesh *mesh, int renumber,
                              int num_threads)
 {
     memset(ws, 0, sizeof *ws);
+    if (renumber && mesh->ws_cache) {
+        /* Built by the boundary search on the same coordinates and
+           elements (any change drops it): only the fixed flags are new. */
+        *ws = *mesh->ws_cache;
+        free(mesh->ws_cache);
+        mesh->ws_cache = NULL;
+        ws->nt = num_threads > 0 ? num_threads : 1;
+        read_fixed(ws, mesh);
+        return GETME_OK;
+    }
     if (mesh->mirror < 0)
         getme__detect_orientation(mesh);
     ws->dim = mesh->dim;
@@ -323,31 +383,16 @@ getme_status getme__ws_build(getme_ws *ws, getme_mesh *mesh, int renumber,
     if (!ws->x || !ws->fixed || !ws->free_elem)
         goto fail;
     double ysign = mesh->mirror == 1 ? -1.0 : 1.0;
+#pragma omp parallel for schedule(static) num_threads(ws->nt)
     for (int32_t i = 0; i < ws->nn; i++) {
         const double *p = mesh->coords + 3 * (int64_t)ws->node_orig[i];
         ws->x[3 * (int64_t)i] = p[0];
         ws->x[3 * (int64_t)i + 1] = ysign * p[1];
         ws->x[3 * (int64_t)i + 2] = p[2];
-        ws->fixed[i] = mesh->fixed[ws->node_orig[i]] != 0;
     }
     if ((st = build_stars(ws)) != GETME_OK)
         goto fail;
-    ws->num_free_elem = 0;
-    for (int t = 0; t < GETME_NUM_TYPES; t++) {
-        int nv = getme__nv[t];
-        for (int32_t e = ws->tstart[t]; e < ws->tstart[t + 1]; e++) {
-            const int32_t *c = getme__ws_nodes(ws, t, e);
-            uint8_t f = 0;
-            for (int i = 0; i < nv; i++)
-                f |= !ws->fixed[c[i]];
-            ws->free_elem[e] = f;
-            ws->num_free_elem += f;
-        }
-    }
-    ws->num_free_nodes = 0;
-    for (int32_t i = 0; i < ws->nn; i++)
-        ws->num_free_nodes += !ws->fixed[i] &&
-                              ws->star_ptr[i + 1] > ws->star_ptr[i];
+    read_fixed(ws, mesh);
     if ((st = colour_blocks(ws)) != GETME_OK)
         goto fail;
     return GETME_OK;
@@ -358,6 +403,7 @@ fail:
 
 void getme__ws_store(const getme_ws *ws, getme_mesh *mesh)
 {
+    getme__mesh_drop_ws(mesh); /* its order was made for the old coordinates */
     double ysign = mesh->mirror == 1 ? -1.0 : 1.0;
     for (int32_t i = 0; i < ws->nn; i++) {
         if (ws->fixed[i])

@@ -49,13 +49,23 @@ typedef struct getme_ws {
     int serial_colour;    /* colour index whose blocks must run one by one
                              (colour overflow), or -1                        */
     getme_ho_ws *ho;      /* second-order elements' dependent nodes, or NULL */
+    int32_t *faces;       /* the face table (getme__ws_faces) the boundary
+                             search computed, for getme__adj_build to take
+                             over, or NULL                                  */
 } getme_ws;
 
 /* Build the workspace; renumber: 1 for locality ordering, 0 keeps the
-   caller's order.  Returns GETME_OK or GETME_ERR_NOMEM. */
+   caller's order.  With renumber 1 it takes over the mesh's cached
+   workspace (getme__ws_keep) when there is one: the same arrays a build
+   would give, as coordinates and elements have not changed since; only
+   the fixed flags are read again.  Returns GETME_OK or GETME_ERR_NOMEM. */
 getme_status getme__ws_build(getme_ws *ws, getme_mesh *mesh, int renumber,
                              int num_threads);
 void getme__ws_free(getme_ws *ws);
+
+/* Keep ws (built with renumber 1) in mesh->ws_cache for the next
+   getme__ws_build; frees it instead if out of memory.  ws is emptied. */
+void getme__ws_keep(getme_ws *ws, getme_mesh *mesh);
 
 /* Write the workspace coordinates back to the mesh (undoing mirror/order). */
 void getme__ws_store(const getme_ws *ws, getme_mesh *mesh);
