@@ -105,7 +105,10 @@ typedef struct getme_block {
     int32_t first;   /* global index of its first element */
     int32_t count;
     int32_t *conn;   /* count * nv node indices */
-    int32_t *region; /* count region ids, or NULL */
+    int32_t *region; /* count region ids, or NULL: all are region_all */
+    int32_t region_all; /* the one region id when region is NULL (0 if the
+                           caller gave none); a block read from one volume
+                           then costs no 4 bytes per element            */
 } getme_block;
 
 struct getme_mesh {

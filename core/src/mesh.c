@@ -152,6 +152,13 @@ getme_status getme_mesh_add_elements(getme_mesh *mesh, getme_elem_type type,
     b->first = mesh->num_elements;
     b->count = count;
     b->conn = malloc((size_t)count * nv * sizeof(int32_t));
+    int32_t same = 1; /* one region for the whole block: no array */
+    for (int32_t e = 1; region && same && e < count; e++)
+        same = region[e] == region[0];
+    if (region && same) {
+        b->region_all = count ? region[0] : 0;
+        region = NULL;
+    }
     if (region)
         b->region = malloc((size_t)count * sizeof(int32_t));
     if (!b->conn || (region && !b->region)) {

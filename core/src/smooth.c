@@ -232,6 +232,7 @@ getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
     getme_adj adj;
     memset(&adj, 0, sizeof adj);
     run.ws = &ws;
+    getme__ws_lend_conn(&ws, mesh); /* back at done: */
     if (params->method == GETME_METHOD_ADAPTIVE &&
         (st = getme__adj_build(&adj, &ws)) != GETME_OK) {
         getme__fail(mesh, st, "out of memory for the neighbour sums of %d "
@@ -275,6 +276,7 @@ getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
 done:
     getme__run_free(&run);
     getme__adj_free(&adj);
+    getme__ws_return_conn(&ws, mesh); /* after the rest is freed: no peak */
     getme__ws_free(&ws);
     result->seconds = omp_get_wtime() - t0;
     return st;

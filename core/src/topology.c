@@ -20,7 +20,7 @@ static int32_t region_of(const getme_mesh *mesh, int32_t e)
 {
     int32_t local;
     const getme_block *b = getme__find_block(mesh, e, &local);
-    return b->region ? b->region[local] : 0;
+    return b->region ? b->region[local] : b->region_all;
 }
 
 /* Do all elements lie in one region?  Then no face is an interface, and
@@ -32,7 +32,7 @@ static int one_region(const getme_mesh *mesh)
     for (int b = 0; b < mesh->num_blocks; b++) {
         const getme_block *bl = &mesh->blocks[b];
         for (int32_t e = 0; e < bl->count; e++)
-            if ((bl->region ? bl->region[e] : 0) != r0)
+            if ((bl->region ? bl->region[e] : bl->region_all) != r0)
                 return 0;
     }
     return 1;

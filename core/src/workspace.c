@@ -401,6 +401,54 @@ fail:
     return st;
 }
 
+void getme__ws_lend_conn(getme_ws *ws, getme_mesh *mesh)
+{
+    if (mesh->num_blocks != 1 || ws->ho || mesh->ho)
+        return;
+    free(mesh->blocks[0].conn);
+    mesh->blocks[0].conn = NULL;
+    ws->conn_lent = 1;
+}
+
+void getme__ws_return_conn(getme_ws *ws, getme_mesh *mesh)
+{
+    if (!ws->conn_lent)
+        return;
+    getme_block *bl = &mesh->blocks[0];
+    int nv = getme__nv[bl->type];
+    int32_t *c = ws->conn, *orig = ws->elem_orig;
+    int64_t len = (int64_t)ws->ne * nv;
+#pragma omp parallel for schedule(static) num_threads(ws->nt)
+    for (int64_t k = 0; k < len; k++)
+        c[k] = ws->node_orig[c[k]];
+    /* Row e goes to row orig[e]: follow each cycle of the permutation,
+       marking the rows placed as -1 - orig (restored after). */
+    for (int32_t e = 0; e < ws->ne; e++) {
+        if (orig[e] < 0)
+            continue;
+        int32_t carry[GETME_MAX_NV], tmp[GETME_MAX_NV];
+        memcpy(carry, c + (int64_t)e * nv, (size_t)nv * sizeof *carry);
+        for (int32_t cur = e;;) {
+            int32_t d = orig[cur];
+            orig[cur] = -1 - d;
+            int32_t *row = c + (int64_t)d * nv;
+            if (d == e) {
+                memcpy(row, carry, (size_t)nv * sizeof *row);
+                break;
+            }
+            memcpy(tmp, row, (size_t)nv * sizeof *tmp);
+            memcpy(row, carry, (size_t)nv * sizeof *row);
+            memcpy(carry, tmp, (size_t)nv * sizeof *carry);
+            cur = d;
+        }
+    }
+    for (int32_t e = 0; e < ws->ne; e++)
+        orig[e] = -1 - orig[e];
+    bl->conn = c;
+    ws->conn = NULL;
+    ws->conn_lent = 0;
+}
+
 void getme__ws_store(const getme_ws *ws, getme_mesh *mesh)
 {
     getme__mesh_drop_ws(mesh); /* its order was made for the old coordinates */

@@ -49,6 +49,8 @@ typedef struct getme_ws {
     int serial_colour;    /* colour index whose blocks must run one by one
                              (colour overflow), or -1                        */
     getme_ho_ws *ho;      /* second-order elements' dependent nodes, or NULL */
+    int conn_lent;        /* the mesh's block lent its connectivity
+                             (getme__ws_lend_conn)                          */
     int32_t *faces;       /* the face table (getme__ws_faces) the boundary
                              search computed, for getme__adj_build to take
                              over, or NULL                                  */
@@ -66,6 +68,14 @@ void getme__ws_free(getme_ws *ws);
 /* Keep ws (built with renumber 1) in mesh->ws_cache for the next
    getme__ws_build; frees it instead if out of memory.  ws is emptied. */
 void getme__ws_keep(getme_ws *ws, getme_mesh *mesh);
+
+/* While the smoother runs, the connectivity of a one-block first-order
+   mesh is the workspace's in another order: the mesh frees its array
+   (16 B per tet, 32 B per hex) and getme__ws_return_conn rebuilds it in
+   place from ws->conn, which it hands over (no allocation, so it cannot
+   fail).  Nothing may read the mesh's elements in between. */
+void getme__ws_lend_conn(getme_ws *ws, getme_mesh *mesh);
+void getme__ws_return_conn(getme_ws *ws, getme_mesh *mesh);
 
 /* Write the workspace coordinates back to the mesh (undoing mirror/order). */
 void getme__ws_store(const getme_ws *ws, getme_mesh *mesh);
