@@ -150,8 +150,19 @@ void cli_write_guard(cli_guard *g, int on);
 int cli_smooth(int argc, char **argv);
 int cli_quality(int argc, char **argv);
 int cli_distort(int argc, char **argv);
-/* `getme gmsh ...` (cmd_gmsh.c, present when the Gmsh plugin is built). */
+/* `getme gmsh ...` (cmd_gmsh.c, in the program getme-gmsh, present when
+   the Gmsh plugin is built). */
 int getme_cli_gmsh(int argc, char **argv);
+
+/* The Gmsh plugin, loaded on first use (gmsh_load.c): its MSH adapter
+   (NULL if it cannot be loaded or was not built); an adapter for
+   getme_doc_options.adapters that loads it only when asked; and `getme
+   gmsh ARGS` as getme-gmsh ARGS (argv[0] is replaced; returns only on
+   failure). */
+struct getme_format;
+const struct getme_format *cli_gmsh_format(void);
+const struct getme_format *cli_gmsh_adapter(void);
+int cli_run_gmsh(char **argv);
 
 /* Report JSON (report.c). */
 typedef struct cli_history {

@@ -3,10 +3,6 @@
  */
 #include "cli.h"
 
-#ifdef GETME_HAVE_CLI_GMSH
-#include "getme_gmsh.h"
-#endif
-
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
@@ -131,11 +127,11 @@ getme_doc *cli_open(const char *path, const getme_doc_options *opts,
         with_gmsh = *opts;
     else
         getme_doc_options_init(&with_gmsh);
-#ifdef GETME_HAVE_CLI_GMSH
-    /* MSH files the native reader declines: read through the Gmsh SDK */
-    const getme_format *adapters[] = {getme_gmsh_format(), NULL};
-    with_gmsh.adapters = adapters;
-#endif
+    /* MSH files the native reader declines: read through the Gmsh SDK,
+       loaded only then (gmsh_load.c) */
+    const getme_format *adapters[] = {cli_gmsh_adapter(), NULL};
+    if (adapters[0])
+        with_gmsh.adapters = adapters;
     getme_formats_status st = getme_doc_open(&doc, path, &with_gmsh);
     *code = cli_exit_code(st);
     /* allow_invalid: inverted elements found in a complete mesh (to be

@@ -4,10 +4,6 @@
 #define _POSIX_C_SOURCE 200809L
 #include "cli.h"
 
-#ifdef GETME_HAVE_CLI_GMSH
-#include "getme_gmsh.h"
-#endif
-
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -48,9 +44,8 @@ static int list_formats(void)
     const getme_format *const *f = getme_formats();
     for (int i = 0; f[i]; i++)
         list_format(f[i]);
-#ifdef GETME_HAVE_CLI_GMSH
-    list_format(getme_gmsh_format());
-#endif
+    if (cli_gmsh_format())
+        list_format(cli_gmsh_format());
     return 0;
 }
 
@@ -94,14 +89,8 @@ int main(int argc, char **argv)
         return cli_distort(argc - 1, argv + 1);
     if (!strcmp(cmd, "formats"))
         return list_formats();
-    if (!strcmp(cmd, "gmsh")) {
-#ifdef GETME_HAVE_CLI_GMSH
-        return getme_cli_gmsh(argc - 1, argv + 1);
-#else
-        cli_error("this getme was built without the Gmsh plugin");
-        return CLI_EXIT_UNSUPPORTED;
-#endif
-    }
+    if (!strcmp(cmd, "gmsh"))
+        return cli_run_gmsh(argv + 1);
     cli_error("unknown command '%s' (see getme --help)", cmd);
     return EXIT_USAGE;
 }

@@ -36,4 +36,10 @@ assert 0 < res["q_min_star_after"] <= 1, res
 print("installed module OK:", _lib.core._name, res["q_min_star_after"])
 PY
 "$prefix/bin/getme" --version | grep -q '^getme ' || { echo "FAILED: installed getme"; exit 1; }
+# the command loads the Gmsh plugin only when needed (cli/gmsh_load.c):
+# from the installed library folder, and runs the installed getme-gmsh
+"$prefix/bin/getme" formats | grep -q 'through the Gmsh SDK' ||
+    { echo "FAILED: installed getme does not load the Gmsh plugin"; exit 1; }
+"$prefix/bin/getme" gmsh --help | grep -q '^usage: getme gmsh' ||
+    { echo "FAILED: installed getme gmsh"; exit 1; }
 echo "install prefix test passed"
