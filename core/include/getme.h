@@ -531,7 +531,9 @@ typedef struct getme_progress {
     double elapsed;         /* seconds since getme_smooth() started           */
 } getme_progress;
 
-/* Return 0 to go on, nonzero to stop (the mesh stays valid). */
+/* Return 0 to go on, nonzero to stop (the mesh stays valid).  The callback
+   must not call getme functions on the mesh being smoothed: while
+   getme_smooth() runs, the mesh's elements are lent to the smoother. */
 typedef int (*getme_progress_fn)(const getme_progress *progress,
                                  void *user_data);
 
