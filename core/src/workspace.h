@@ -57,6 +57,13 @@ getme_status getme__ws_build(getme_ws *ws, getme_mesh *mesh, int renumber,
                              int num_threads);
 void getme__ws_free(getme_ws *ws);
 
+/* The 30-bit Morton key the element order uses (renumber = 1): each
+   coordinate's (x - lo) * scale clamped to [0, 1023] and truncated, its
+   bits spread to every third bit from bit d (scale = 1023 / extent, 0 for
+   a flat axis). */
+uint32_t getme__morton(const double *x, const double lo[3],
+                       const double scale[3]);
+
 /* Write the workspace coordinates back to the mesh (undoing mirror/order). */
 void getme__ws_store(const getme_ws *ws, getme_mesh *mesh);
 
