@@ -84,6 +84,15 @@ typedef struct getme_run {
 getme_status getme__start(getme_mesh *mesh, const getme_params **params,
                           getme_params *defaults, getme_ws *ws);
 
+/* The entry of getme_smooth(), getme_smooth_part() and
+   getme_mesh_untangle(): ws zeroed; mesh and result (size bytes) must be
+   there (else GETME_ERR_ARGUMENT); result cleared, *t0 the start time; a
+   distributed run needs a volume mesh and GETMe adaptive; then
+   getme__start().  ws needs getme__ws_free() only after GETME_OK. */
+getme_status getme__enter(getme_mesh *mesh, const getme_params **params,
+                          getme_params *defaults, getme_ws *ws, void *result,
+                          size_t size, double *t0, int distributed);
+
 getme_status getme__run_alloc(getme_run *run);
 void getme__run_free(getme_run *run);
 
