@@ -22,9 +22,15 @@
  *     such a node; its owner sends it (key and node ids), with its nodes
  *     (position, fixed mark) and its rank's rest constants.
  *  4. Rank 0 runs getme_smooth_finish_sub().  If it needs more
- *     (GETME_ERR_INCOMPLETE, decided from the data alone) the margin grows
- *     fourfold and 2-4 repeat; with every free element a candidate it
- *     cannot fail.  Then rank 0 broadcasts the nodes that moved and every
+ *     (GETME_ERR_INCOMPLETE, decided from the data alone), 2-4 repeat with
+ *     twice as many candidates, at least twice the free elements at or
+ *     below the pass bound that did not fit (the next passes' bounds are
+ *     higher still), and one more ring of complete nodes around them (a
+ *     pass can lower a neighbour of a moved node below the next pass's
+ *     bound; that neighbour's nodes then need complete stars); with every
+ *     free element a candidate it
+ *     cannot fail (GETME_MPI_FINISH_FIRST=N, for tests, starts with N
+ *     candidates).  Then rank 0 broadcasts the nodes that moved and every
  *     rank updates its copies.
  */
 #include "dist.h"
@@ -33,7 +39,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { MARGIN0 = 2, GROW = 4, LEVELS = 4 };
+enum { MARGIN0 = 2 };
 
 static void *xmalloc(size_t n) { return malloc(n ? n : 1); }
 
@@ -107,11 +113,12 @@ static void *gather(dist_ctx *c, const void *mine, int n, size_t size,
     return all;
 }
 
-/* The m-th smallest (0-based) of the values of all ranks (positive
-   doubles: their bits sort like them): per level, a histogram of the next
-   16 bits among the values matching the prefix, summed over ranks. */
-static double kth_value(dist_ctx *c, const double *v, int32_t n, int64_t m,
-                        int64_t *hist)
+/* The m-th smallest (0-based) of the values v[i] with use[i] & 1 of all
+   ranks (positive doubles: their bits sort like them): per level, a
+   histogram of the next 16 bits among the values matching the prefix,
+   summed over ranks. */
+static double kth_value(dist_ctx *c, const double *v, const uint8_t *use,
+                        int32_t n, int64_t m, int64_t *hist)
 {
     uint64_t prefix = 0, mask = 0;
     for (int shift = 48; shift >= 0; shift -= 16) {
@@ -119,7 +126,7 @@ static double kth_value(dist_ctx *c, const double *v, int32_t n, int64_t m,
         for (int32_t i = 0; i < n; i++) {
             uint64_t b;
             memcpy(&b, &v[i], sizeof b);
-            if ((b & mask) == prefix)
+            if ((use[i] & 1) && (b & mask) == prefix)
                 hist[(b >> shift) & 0xffff]++;
         }
         MPI_Allreduce(MPI_IN_PLACE, hist, 65536, MPI_INT64_T, MPI_SUM,
@@ -136,39 +143,40 @@ static double kth_value(dist_ctx *c, const double *v, int32_t n, int64_t m,
     return out;
 }
 
-/* What every rank keeps over the tries. */
+enum { FREE_OWNED = 1, REST = 2 };
+
+/* What every rank keeps over the tries: 9 bytes per element, 2 per node. */
 typedef struct local {
-    int32_t nf;        /* owned free elements                            */
-    int32_t *fe;       /* their part indices                             */
-    double *fq;        /* their qualities at the loop's end              */
-    uint64_t *key;     /* ne: keys of the part's elements (owned ones)   */
-    int64_t *eoff;     /* ne + 1: offsets into c->conn                   */
+    double *q;         /* ne: owned elements' qualities at the loop's end */
+    uint8_t *kind;     /* ne: FREE_OWNED (owned, a free node), REST (owned,
+                          outside the sub-mesh)                          */
     uint8_t *flag;     /* nn: node has a complete star in the sub-mesh   */
     uint8_t *mark;     /* nn: scratch                                    */
-    uint8_t *in_rest;  /* ne: owned and outside the sub-mesh             */
+    double lo[3], hi[3]; /* the whole mesh's box at the input coordinates */
+    int keyed;         /* params->renumber: keys carry the Morton code   */
 } local;
 
 static void local_free(local *l)
 {
-    free(l->fe), free(l->fq), free(l->key), free(l->eoff), free(l->flag);
-    free(l->mark), free(l->in_rest);
+    free(l->q), free(l->kind), free(l->flag), free(l->mark);
 }
 
-/* Step 1: keys, offsets and the owned free elements' qualities. */
+static int nodes_of(const dist_ctx *c, int32_t e)
+{
+    return getme_type_num_nodes((getme_elem_type)c->etype[e]);
+}
+
+/* Step 1: the box and the owned elements' qualities. */
 static int local_init(dist_ctx *c, const getme_mesh *part,
                       const getme_mesh *whole, const getme_params *p,
-                      local *l)
+                      local *l, int64_t *num_free)
 {
     memset(l, 0, sizeof *l);
-    l->fe = xmalloc((size_t)c->ne * sizeof *l->fe);
-    l->fq = xmalloc((size_t)c->ne * sizeof *l->fq);
-    l->key = xmalloc((size_t)c->ne * sizeof *l->key);
-    l->eoff = xmalloc(((size_t)c->ne + 1) * sizeof *l->eoff);
+    l->q = xmalloc((size_t)c->ne * sizeof *l->q);
+    l->kind = xmalloc((size_t)c->ne);
     l->flag = xmalloc((size_t)c->nn);
-    l->mark = calloc((size_t)c->nn + 1, 1);
-    l->in_rest = xmalloc((size_t)c->ne);
-    int ok = l->fe && l->fq && l->key && l->eoff && l->flag && l->mark &&
-             l->in_rest;
+    l->mark = xmalloc((size_t)c->nn);
+    l->keyed = p->renumber != 0;
     /* the whole mesh's box at the input coordinates: the parts' nodes,
        and on rank 0 every node of the mesh it read (unused ones too) */
     double box[6] = {1e308, 1e308, 1e308, 1e308, 1e308, 1e308};
@@ -176,56 +184,46 @@ static int local_init(dist_ctx *c, const getme_mesh *part,
         const double *x = s ? (whole ? getme_mesh_coords(whole) : NULL)
                             : c->coords;
         int32_t n = s ? (whole ? getme_mesh_num_nodes(whole) : 0) : c->nn;
-        for (int64_t i = 0; x && i < 3 * (int64_t)n; i++) {
-            double v = x[i];
-            int d = (int)(i % 3);
-            box[d] = v < box[d] ? v : box[d];
-            box[3 + d] = -v < box[3 + d] ? -v : box[3 + d];
-        }
+        for (int32_t i = 0; x && i < n; i++)
+            for (int d = 0; d < 3; d++) {
+                double v = x[3 * (int64_t)i + d];
+                box[d] = v < box[d] ? v : box[d];
+                box[3 + d] = -v < box[3 + d] ? -v : box[3 + d];
+            }
     }
     MPI_Allreduce(MPI_IN_PLACE, box, 6, MPI_DOUBLE, MPI_MIN, c->comm);
-    double hi[3] = {-box[3], -box[4], -box[5]};
+    for (int d = 0; d < 3; d++)
+        l->lo[d] = box[d], l->hi[d] = -box[3 + d];
+    if (!l->q || !l->kind || !l->flag || !l->mark)
+        return -1;
     const double *x = getme_mesh_coords(part);
-    l->eoff[0] = 0;
-    for (int32_t e = 0; ok && e < c->ne; e++) {
-        int t = c->etype[e], nv = getme_type_num_nodes((getme_elem_type)t);
-        const int32_t *cn = c->conn + l->eoff[e];
-        l->eoff[e + 1] = l->eoff[e] + nv;
+    *num_free = 0;
+    int64_t off = 0;
+    for (int32_t e = 0; e < c->ne; off += nodes_of(c, e), e++) {
+        int nv = nodes_of(c, e);
+        const int32_t *cn = c->conn + off;
+        l->q[e] = 0.0;
+        l->kind[e] = 0;
         if (!c->owned[e])
             continue;
-        l->key[e] = getme_element_key((getme_elem_type)t, c->egid[e],
-                                      c->coords + 3 * (int64_t)cn[0],
-                                      p->renumber ? box : NULL,
-                                      p->renumber ? hi : NULL);
         double xe[24];
         int free_e = 0;
         for (int i = 0; i < nv; i++) {
             memcpy(xe + 3 * i, x + 3 * (int64_t)cn[i], 3 * sizeof *xe);
             free_e |= !c->fixed[cn[i]];
         }
-        if (free_e) {
-            l->fe[l->nf] = e;
-            l->fq[l->nf++] = getme_element_quality((getme_elem_type)t, xe);
-        }
+        l->q[e] = getme_element_quality((getme_elem_type)c->etype[e], xe);
+        l->kind[e] = free_e ? FREE_OWNED : 0;
+        *num_free += free_e;
     }
-    return ok ? 0 : -1;
+    return 0;
 }
 
-/* Steps 2-3 on every rank: the candidates up to position m, their nodes
-   agreed on, this rank's share of the sub-mesh and of the rest.  The
-   element and node arrays are returned for sending. */
-static int select_sub(dist_ctx *c, const getme_mesh *part, local *l,
-                      int64_t m, int64_t *hist, uint64_t **skey,
-                      int32_t **sconn, int *nse, int *nsc, sub_node **snode,
-                      int *nsn, getme_finish_rest *rest, int *ok)
+/* The nodes marked on any rank (l->mark, part order) become l->flag on
+   every rank holding them: their global ids gathered on rank 0, sorted,
+   deduplicated and broadcast.  -1 on every rank if out of memory. */
+static int agree_nodes(dist_ctx *c, local *l, int *ok)
 {
-    double bound = kth_value(c, l->fq, l->nf, m, hist);
-    /* candidate nodes, ascending global id (part nodes are) */
-    memset(l->mark, 0, (size_t)c->nn);
-    for (int32_t k = 0; k < l->nf; k++)
-        if (l->fq[k] <= bound)
-            for (int64_t j = l->eoff[l->fe[k]]; j < l->eoff[l->fe[k] + 1]; j++)
-                l->mark[c->conn[j]] = 1;
     int n = 0;
     for (int32_t i = 0; i < c->nn; i++)
         n += l->mark[i];
@@ -258,24 +256,65 @@ static int select_sub(dist_ctx *c, const getme_mesh *part, local *l,
     }
     MPI_Bcast(all, total, MPI_INT32_T, 0, c->comm);
     c->bytes_reduced += (int64_t)total * 4;
-    for (int32_t i = 0; i < c->nn; i++)
-        l->flag[i] = find(all, total, c->gid[i]) >= 0;
+    /* both ascending: one merge */
+    for (int32_t i = 0, j = 0; i < c->nn; i++) {
+        while (j < total && all[j] < c->gid[i])
+            j++;
+        l->flag[i] = j < total && all[j] == c->gid[i];
+    }
     free(all);
+    return 0;
+}
+
+/* Steps 2-3 on every rank: the candidates up to position m, their nodes
+   and `rings - 1` rings of nodes around them agreed on (complete stars),
+   this rank's share of the sub-mesh and of the rest.  The element and
+   node arrays are returned for sending. */
+static int select_sub(dist_ctx *c, const getme_mesh *part, local *l,
+                      int64_t m, int rings, int64_t *hist, uint64_t **skey,
+                      int32_t **sconn, int *nse, int *nsc, sub_node **snode,
+                      int *nsn, getme_finish_rest *rest, int *ok)
+{
+    double bound = kth_value(c, l->q, l->kind, c->ne, m, hist);
+    memset(l->mark, 0, (size_t)c->nn);
+    int64_t off = 0;
+    for (int32_t e = 0; e < c->ne; off += nodes_of(c, e), e++)
+        if ((l->kind[e] & FREE_OWNED) && l->q[e] <= bound)
+            for (int i = 0; i < nodes_of(c, e); i++)
+                l->mark[c->conn[off + i]] = 1;
+    for (int ring = 1;; ring++) {
+        if (agree_nodes(c, l, ok) != 0)
+            return -1;
+        if (ring == rings)
+            break;
+        /* one more ring: the nodes of owned elements touching one (each
+           element's owner holds all its nodes) */
+        off = 0;
+        for (int32_t e = 0; e < c->ne; off += nodes_of(c, e), e++) {
+            int in = 0, nv = nodes_of(c, e);
+            for (int i = 0; c->owned[e] && i < nv; i++)
+                in |= l->flag[c->conn[off + i]];
+            for (int i = 0; in && i < nv; i++)
+                l->mark[c->conn[off + i]] = 1;
+        }
+    }
 
     /* owned elements touching a candidate node: this rank sends them */
     int ne = 0, nc = 0;
     memset(l->mark, 0, (size_t)c->nn);
-    for (int32_t e = 0; e < c->ne; e++) {
-        int in = 0;
-        for (int64_t j = l->eoff[e]; j < l->eoff[e + 1]; j++)
-            in |= l->flag[c->conn[j]];
-        l->in_rest[e] = c->owned[e] && !in;
+    off = 0;
+    for (int32_t e = 0; e < c->ne; off += nodes_of(c, e), e++) {
+        int in = 0, nv = nodes_of(c, e);
+        for (int i = 0; i < nv; i++)
+            in |= l->flag[c->conn[off + i]];
+        l->kind[e] = (uint8_t)((l->kind[e] & FREE_OWNED) |
+                               (c->owned[e] && !in ? REST : 0));
         if (!c->owned[e] || !in)
             continue;
         ne++;
-        nc += (int)(l->eoff[e + 1] - l->eoff[e]);
-        for (int64_t j = l->eoff[e]; j < l->eoff[e + 1]; j++)
-            l->mark[c->conn[j]] = 1;
+        nc += nv;
+        for (int i = 0; i < nv; i++)
+            l->mark[c->conn[off + i]] = 1;
     }
     int nn = 0;
     for (int32_t i = 0; i < c->nn; i++)
@@ -283,17 +322,24 @@ static int select_sub(dist_ctx *c, const getme_mesh *part, local *l,
     *skey = xmalloc((size_t)ne * sizeof **skey);
     *sconn = xmalloc((size_t)nc * sizeof **sconn);
     *snode = xmalloc((size_t)nn * sizeof **snode);
-    if (!*skey || !*sconn || !*snode) {
+    uint8_t *in_rest = xmalloc((size_t)c->ne);
+    if (!*skey || !*sconn || !*snode || !in_rest) {
         *ok = 0;
         ne = nc = nn = 0;
     }
     const double *x = getme_mesh_coords(part);
-    for (int32_t e = 0, k = 0, q = 0; ne && e < c->ne; e++) {
-        if (!c->owned[e] || l->in_rest[e])
+    off = 0;
+    for (int32_t e = 0, k = 0, q = 0; ne && e < c->ne;
+         off += nodes_of(c, e), e++) {
+        if (!c->owned[e] || (l->kind[e] & REST))
             continue;
-        (*skey)[k++] = l->key[e];
-        for (int64_t j = l->eoff[e]; j < l->eoff[e + 1]; j++)
-            (*sconn)[q++] = c->gid[c->conn[j]];
+        const int32_t *cn = c->conn + off;
+        (*skey)[k++] = getme_element_key(
+            (getme_elem_type)c->etype[e], c->egid[e],
+            c->coords + 3 * (int64_t)cn[0], l->keyed ? l->lo : NULL,
+            l->keyed ? l->hi : NULL);
+        for (int i = 0; i < nodes_of(c, e); i++)
+            (*sconn)[q++] = c->gid[cn[i]];
     }
     for (int32_t i = 0, k = 0; nn && i < c->nn; i++)
         if (l->mark[i]) {
@@ -306,8 +352,12 @@ static int select_sub(dist_ctx *c, const getme_mesh *part, local *l,
         }
     *nse = ne, *nsc = nc, *nsn = nn;
     getme_finish_rest_init(rest);
-    if (getme_finish_rest_add(rest, part, l->in_rest) != GETME_OK)
+    for (int32_t e = 0; in_rest && e < c->ne; e++)
+        in_rest[e] = (l->kind[e] & REST) != 0;
+    if (!in_rest || getme_finish_rest_add(rest, part, in_rest, l->q) !=
+                        GETME_OK)
         *ok = 0;
+    free(in_rest);
     return 0;
 }
 
@@ -439,8 +489,9 @@ int dist_finish(dist_ctx *c, getme_mesh *part, const getme_mesh *whole,
     if (!params->finish)
         return 0; /* getme_smooth_part's result is final */
     local l;
+    int64_t n = 0;
     int64_t *hist = xmalloc(65536 * sizeof *hist);
-    int ok = local_init(c, part, whole, params, &l) == 0 && hist;
+    int ok = local_init(c, part, whole, params, &l, &n) == 0 && hist;
     MPI_Allreduce(MPI_IN_PLACE, &ok, 1, MPI_INT, MPI_LAND, c->comm);
     int32_t *moved_id = NULL;
     double *moved_x = NULL;
@@ -450,7 +501,6 @@ int dist_finish(dist_ctx *c, getme_mesh *part, const getme_mesh *whole,
         goto out;
     /* the finishing bound's position k among all free elements (finish.c,
        getme__threshold with at least 64) */
-    int64_t n = l.nf;
     MPI_Allreduce(MPI_IN_PLACE, &n, 1, MPI_INT64_T, MPI_SUM, c->comm);
     if (n == 0) {
         ret = 0;
@@ -459,17 +509,22 @@ int dist_finish(dist_ctx *c, getme_mesh *part, const getme_mesh *whole,
     double pos = params->finish_fraction * (double)n;
     pos = pos < 63.0 ? 63.0 : pos;
     int64_t k = pos >= (double)(n - 1) ? n - 1 : (int64_t)pos;
-    for (int64_t margin = MARGIN0;; margin *= GROW) {
-        int64_t m = (k + 1) * margin - 1;
-        m = m > n - 1 ? n - 1 : m;
+    /* tests: GETME_MPI_FINISH_FIRST=N starts with N candidates, so that
+       the sub-mesh has to grow */
+    const char *first = getenv("GETME_MPI_FINISH_FIRST");
+    int64_t count = first && atoll(first) > 0 ? atoll(first)
+                                               : (k + 1) * MARGIN0;
+    double threshold = c->rank == 0 ? res->threshold : 0.0;
+    for (int rings = 1;;) {
+        int64_t m = count - 1 > n - 1 ? n - 1 : count - 1;
         c->sub_tries++;
         uint64_t *skey = NULL;
         int32_t *sconn = NULL;
         sub_node *snode = NULL;
         int nse = 0, nsc = 0, nsn = 0;
         getme_finish_rest rest;
-        if (select_sub(c, part, &l, m, hist, &skey, &sconn, &nse, &nsc,
-                       &snode, &nsn, &rest, &ok) != 0)
+        if (select_sub(c, part, &l, m, rings, hist, &skey, &sconn, &nse,
+                       &nsc, &snode, &nsn, &rest, &ok) != 0)
             goto out;
         int te = 0, tc = 0, tn = 0, tr = 0;
         uint64_t *akey = gather(c, skey, nse, sizeof *skey, &te, &ok);
@@ -494,8 +549,23 @@ int dist_finish(dist_ctx *c, getme_mesh *part, const getme_mesh *whole,
         }
         free(akey), free(aconn), free(anode), free(arest);
         MPI_Bcast(&status, 1, MPI_INT, 0, c->comm);
-        if (status == GETME_ERR_INCOMPLETE && m < n - 1)
-            continue; /* grow: every rank decides alike */
+        if (status == GETME_ERR_INCOMPLETE && m < n - 1) {
+            /* grow: at least fourfold, and to twice the free elements at
+               or below the bound that did not fit (later passes' bounds
+               are higher); every rank decides alike */
+            double need = res->threshold;
+            MPI_Bcast(&need, 1, MPI_DOUBLE, 0, c->comm);
+            if (c->rank == 0)
+                res->threshold = threshold;
+            int64_t below = 0;
+            for (int32_t e = 0; e < c->ne; e++)
+                below += (l.kind[e] & FREE_OWNED) && l.q[e] <= need;
+            MPI_Allreduce(MPI_IN_PLACE, &below, 1, MPI_INT64_T, MPI_SUM,
+                          c->comm);
+            count = 2 * below > 2 * (m + 1) ? 2 * below : 2 * (m + 1);
+            rings++;
+            continue;
+        }
         if (status != GETME_OK) {
             if (status == GETME_ERR_INCOMPLETE)
                 snprintf(err, es, "the finishing step needs more than every "

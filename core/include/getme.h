@@ -821,11 +821,14 @@ typedef struct getme_finish_rest {
 GETME_API void getme_finish_rest_init(getme_finish_rest *rest);
 
 /* Add the elements e of mesh with include[e] != 0 (NULL: all) at the
-   mesh's coordinates and fixed marks (those of the whole mesh).
-   GETME_ERR_ARGUMENT for second-order meshes (not supported). */
+   mesh's coordinates and fixed marks (those of the whole mesh).  q: their
+   getme_element_quality() values if the caller has them (per element of
+   mesh; NULL: computed here).  GETME_ERR_ARGUMENT for second-order meshes
+   (not supported). */
 GETME_API getme_status getme_finish_rest_add(getme_finish_rest *rest,
                                              const getme_mesh *mesh,
-                                             const uint8_t *include);
+                                             const uint8_t *include,
+                                             const double *q);
 
 /* into += from (counts and sum added, minima taken). */
 GETME_API void getme_finish_rest_merge(getme_finish_rest *into,
@@ -848,8 +851,10 @@ GETME_API void getme_finish_rest_merge(getme_finish_rest *into,
  * finish_fraction of the whole mesh's free elements) must be below
  * rest->q_min_free, and every free node of an element at or below it must
  * be complete.  If not, GETME_ERR_INCOMPLETE: nothing is stored, no
- * progress is reported, result is unchanged; grow the sub-mesh (or use the
- * whole mesh) and call again.  The checks depend only on the data, so
+ * progress is reported, result is unchanged but for result->threshold, the
+ * pass bound that did not fit (a bigger sub-mesh holds at least every free
+ * element at or below it, with complete stars); grow the sub-mesh (or use
+ * the whole mesh) and call again.  The checks depend only on the data, so
  * every caller decides alike.  The progress callback is called once per
  * pass after the step succeeded (its return value is ignored: a stop must
  * not depend on where the mesh is held).

@@ -268,6 +268,7 @@ getme_status getme__finish(getme_run *run)
             run->sub ? sub_bound(run, prm->finish_fraction, 64, &incomplete)
                      : getme__threshold(run, prm->finish_fraction, 64);
         if (incomplete) {
+            run->sub->need = bound;
             st = GETME_ERR_INCOMPLETE;
             break;
         }
@@ -278,6 +279,7 @@ getme_status getme__finish(getme_run *run)
             break;
         }
         if (run->sub && !stars_inside(run, list, n)) {
+            run->sub->need = bound;
             free(list);
             st = GETME_ERR_INCOMPLETE;
             break;

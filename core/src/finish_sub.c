@@ -55,7 +55,8 @@ static void set_sum(getme_finish_rest *r, getme_ufx s)
 
 getme_status getme_finish_rest_add(getme_finish_rest *rest,
                                    const getme_mesh *mesh,
-                                   const uint8_t *include)
+                                   const uint8_t *include,
+                                   const double *qual)
 {
     if (!rest || !mesh)
         return GETME_ERR_ARGUMENT;
@@ -73,7 +74,7 @@ getme_status getme_finish_rest_add(getme_finish_rest *rest,
             getme__gather_local(mesh, bl, i, ysign, x);
             /* the workspace's values: getme__ws_quality, free_elem,
                getme__ws_corner_min */
-            double q = getme__quality(t, x);
+            double q = qual ? qual[bl->first + i] : getme__quality(t, x);
             int free = 0;
             for (int j = 0; j < nv; j++)
                 free |= !mesh->fixed[bl->conn[(int64_t)i * nv + j]];
@@ -179,6 +180,7 @@ getme_status getme_smooth_finish_sub(getme_mesh *sub,
     if (st == GETME_ERR_INCOMPLETE) {
         getme__fail(sub, st, "the finishing step needs elements outside the "
                              "sub-mesh: grow it");
+        result->threshold = fs.need;
         goto done;
     }
     if (st != GETME_OK) {

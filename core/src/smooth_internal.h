@@ -156,6 +156,7 @@ typedef struct getme_finish_sub {
     const uint8_t *complete;
     getme_progress *log;
     int num_log, cap_log;
+    double need;    /* GETME_ERR_INCOMPLETE: the pass bound that did not fit */
 } getme_finish_sub;
 
 /* q_mean, q*_min, q_min (may be NULL) of the whole mesh: the workspace's

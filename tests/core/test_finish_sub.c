@@ -150,8 +150,19 @@ static cut_out run_cut(getme_mesh *loop, const elem_rank *ranked,
         a[e] = !in_sub[e] && e % 3 == 0;
         b[e] = !in_sub[e] && e % 3 != 0;
     }
-    CHECK(getme_finish_rest_add(&rest, loop, a) == GETME_OK);
-    CHECK(getme_finish_rest_add(&half, loop, b) == GETME_OK);
+    double *q = malloc((size_t)ne * sizeof *q); /* given for one half */
+    for (int32_t e = 0; e < ne; e++) {
+        getme_elem_type t;
+        int32_t c[8];
+        double xe[24];
+        int nv = getme_mesh_get_element(loop, e, &t, c);
+        for (int i = 0; i < nv; i++)
+            memcpy(xe + 3 * i, x + 3 * (size_t)c[i], 3 * sizeof *xe);
+        q[e] = getme_element_quality(t, xe);
+    }
+    CHECK(getme_finish_rest_add(&rest, loop, a, q) == GETME_OK);
+    CHECK(getme_finish_rest_add(&half, loop, b, NULL) == GETME_OK);
+    free(q);
     getme_finish_rest_merge(&rest, &half);
     CHECK(rest.num_elements == ne - m);
 
@@ -163,6 +174,10 @@ static cut_out run_cut(getme_mesh *loop, const elem_rank *ranked,
     out.st = getme_smooth_finish_sub(sub, p, skey, complete, &rest, &out.res);
     if (out.st == GETME_ERR_INCOMPLETE) {
         CHECK(calls == 0);
+        /* the bound that did not fit: one of the whole run's, so at most
+           its last pass's, and at least q*_min at the start */
+        CHECK(out.res.threshold >= loop_res->q_min_star);
+        out.res.threshold = loop_res->threshold;
         CHECK(memcmp(&out.res, loop_res, sizeof out.res) == 0);
     } else if (out.st == GETME_OK) {
         CHECK_EQ_INT(calls, out.res.passes_finish);
