@@ -22,13 +22,14 @@
  *     such a node; its owner sends it (key and node ids), with its nodes
  *     (position, fixed mark) and its rank's rest constants.
  *  4. Rank 0 runs getme_smooth_finish_sub().  If it needs more
- *     (GETME_ERR_INCOMPLETE, decided from the data alone), 2-4 repeat with
- *     twice as many candidates, at least twice the free elements at or
- *     below the pass bound that did not fit (the next passes' bounds are
- *     higher still), and one more ring of complete nodes around them (a
- *     pass can lower a neighbour of a moved node below the next pass's
- *     bound; that neighbour's nodes then need complete stars); with every
- *     free element a candidate it
+ *     (GETME_ERR_INCOMPLETE, decided from the data alone), 2-4 repeat:
+ *     with twice as many candidates, at least twice the free elements at
+ *     or below the pass bound that did not fit, if that bound is above
+ *     the candidates' quality (the next passes' bounds are higher still);
+ *     else with one more ring of complete nodes around them (a pass
+ *     lowered a neighbour of a moved node below the next pass's bound, so
+ *     that neighbour's nodes need complete stars).  With every free
+ *     element a candidate and enough rings it
  *     cannot fail (GETME_MPI_FINISH_FIRST=N, for tests, starts with N
  *     candidates).  Then rank 0 broadcasts the nodes that moved and every
  *     rank updates its copies.
@@ -273,9 +274,11 @@ static int agree_nodes(dist_ctx *c, local *l, int *ok)
 static int select_sub(dist_ctx *c, const getme_mesh *part, local *l,
                       int64_t m, int rings, int64_t *hist, uint64_t **skey,
                       int32_t **sconn, int *nse, int *nsc, sub_node **snode,
-                      int *nsn, getme_finish_rest *rest, int *ok)
+                      int *nsn, getme_finish_rest *rest, double *taken,
+                      int *ok)
 {
     double bound = kth_value(c, l->q, l->kind, c->ne, m, hist);
+    *taken = bound;
     memset(l->mark, 0, (size_t)c->nn);
     int64_t off = 0;
     for (int32_t e = 0; e < c->ne; off += nodes_of(c, e), e++)
@@ -523,8 +526,9 @@ int dist_finish(dist_ctx *c, getme_mesh *part, const getme_mesh *whole,
         sub_node *snode = NULL;
         int nse = 0, nsc = 0, nsn = 0;
         getme_finish_rest rest;
+        double taken;
         if (select_sub(c, part, &l, m, rings, hist, &skey, &sconn, &nse,
-                       &nsc, &snode, &nsn, &rest, &ok) != 0)
+                       &nsc, &snode, &nsn, &rest, &taken, &ok) != 0)
             goto out;
         int te = 0, tc = 0, tn = 0, tr = 0;
         uint64_t *akey = gather(c, skey, nse, sizeof *skey, &te, &ok);
@@ -550,20 +554,26 @@ int dist_finish(dist_ctx *c, getme_mesh *part, const getme_mesh *whole,
         free(akey), free(aconn), free(anode), free(arest);
         MPI_Bcast(&status, 1, MPI_INT, 0, c->comm);
         if (status == GETME_ERR_INCOMPLETE && m < n - 1) {
-            /* grow: at least fourfold, and to twice the free elements at
-               or below the bound that did not fit (later passes' bounds
-               are higher); every rank decides alike */
+            /* grow (every rank decides alike).  A bound above the
+               candidates' quality may have met an element outside: take
+               twice the candidates, at least twice the free elements at or
+               below it (later passes' bounds are higher).  A bound within
+               it can only have met an element without complete stars (a
+               neighbour a move lowered): one more ring. */
             double need = res->threshold;
             MPI_Bcast(&need, 1, MPI_DOUBLE, 0, c->comm);
             if (c->rank == 0)
                 res->threshold = threshold;
+            if (!(need > taken)) {
+                rings++;
+                continue;
+            }
             int64_t below = 0;
             for (int32_t e = 0; e < c->ne; e++)
                 below += (l.kind[e] & FREE_OWNED) && l.q[e] <= need;
             MPI_Allreduce(MPI_IN_PLACE, &below, 1, MPI_INT64_T, MPI_SUM,
                           c->comm);
             count = 2 * below > 2 * (m + 1) ? 2 * below : 2 * (m + 1);
-            rings++;
             continue;
         }
         if (status != GETME_OK) {
