@@ -599,9 +599,10 @@ int dist_finish(dist_ctx *c, getme_mesh *part, const getme_mesh *whole,
     c->bytes_reduced += (int64_t)num_moved * 28;
     double *x = xmalloc((size_t)c->nn * 3 * sizeof *x);
     ok = x && getme_mesh_get_coords(part, x) == GETME_OK;
-    for (int32_t i = 0; ok && i < c->nn; i++) {
-        int64_t j = find(moved_id, num_moved, c->gid[i]);
-        if (j >= 0)
+    for (int32_t i = 0, j = 0; ok && i < c->nn; i++) { /* both ascending */
+        while (j < num_moved && moved_id[j] < c->gid[i])
+            j++;
+        if (j < num_moved && moved_id[j] == c->gid[i])
             memcpy(x + 3 * (size_t)i, moved_x + 3 * (size_t)j, 3 * sizeof *x);
     }
     ok = ok && getme_mesh_set_coords(part, x) == GETME_OK;

@@ -8,9 +8,9 @@
  * -v, -q.  Rank 0 reads IN through libgetme_formats (fixed nodes by the
  * same rules as `getme smooth`), untangles it if needed as `getme smooth`
  * does, splits it with METIS and sends every rank its part; all ranks run
- * getme_smooth_part(); rank 0 gathers the positions, runs the finishing
- * step (getme_smooth_finish) and writes OUT, the same bytes as
- * `getme smooth IN -o OUT` writes with the same options.  A failure on any
+ * getme_smooth_part(); the finishing step runs on the worst elements'
+ * patches (finish_sub.c); rank 0 gathers the positions and writes OUT, the
+ * same bytes as `getme smooth IN -o OUT` writes with the same options.  A failure on any
  * rank stops every rank with one error line from rank 0 and no output.
  *
  * Exit codes: those of `getme smooth` (cli.h); 1 also when a rank fails
