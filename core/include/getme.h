@@ -823,8 +823,8 @@ GETME_API void getme_finish_rest_init(getme_finish_rest *rest);
 /* Add the elements e of mesh with include[e] != 0 (NULL: all) at the
    mesh's coordinates and fixed marks (those of the whole mesh).  q: their
    getme_element_quality() values if the caller has them (per element of
-   mesh; NULL: computed here).  GETME_ERR_ARGUMENT for second-order meshes
-   (not supported). */
+   mesh; NULL: computed here).  GETME_ERR_ARGUMENT for planar and
+   second-order meshes (not supported). */
 GETME_API getme_status getme_finish_rest_add(getme_finish_rest *rest,
                                              const getme_mesh *mesh,
                                              const uint8_t *include,
@@ -836,8 +836,8 @@ GETME_API void getme_finish_rest_merge(getme_finish_rest *into,
 
 /*
  * getme_smooth_finish() on a sub-mesh.  sub: elements of the whole mesh
- * (linear, a volume mesh or a planar one with the whole mesh's
- * orientation) added in ascending key order, nodes at the positions the
+ * (linear volume elements: a planar sub-mesh would decide its orientation
+ * alone; GETME_ERR_ARGUMENT) added in ascending key order, nodes at the positions the
  * distributed loop reached, fixed marks of the whole mesh (set with
  * getme_mesh_set_fixed_mask: the sub-mesh's cut is not skin); key: per
  * element (getme_element_key()); complete: per node, 1 when every element

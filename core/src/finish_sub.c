@@ -60,9 +60,8 @@ getme_status getme_finish_rest_add(getme_finish_rest *rest,
 {
     if (!rest || !mesh)
         return GETME_ERR_ARGUMENT;
-    if (mesh->ho)
+    if (mesh->ho || mesh->dim != 3)
         return GETME_ERR_ARGUMENT;
-    double ysign = mesh->mirror == 1 ? -1.0 : 1.0;
     getme_ufx s = rest_sum(rest);
     for (int b = 0; b < mesh->num_blocks; b++) {
         const getme_block *bl = &mesh->blocks[b];
@@ -71,7 +70,7 @@ getme_status getme_finish_rest_add(getme_finish_rest *rest,
             if (include && !include[bl->first + i])
                 continue;
             double x[3 * GETME_MAX_NV];
-            getme__gather_local(mesh, bl, i, ysign, x);
+            getme__gather_local(mesh, bl, i, 1.0, x);
             /* the workspace's values: getme__ws_quality, free_elem,
                getme__ws_corner_min */
             double q = qual ? qual[bl->first + i] : getme__quality(t, x);
@@ -135,9 +134,10 @@ getme_status getme_smooth_finish_sub(getme_mesh *sub,
 {
     if (!sub || !key || !complete || !rest || !result)
         return GETME_ERR_ARGUMENT;
-    if (sub->ho)
+    /* a planar sub-mesh would decide its orientation (mirror) alone */
+    if (sub->ho || sub->dim != 3)
         return getme__fail(sub, GETME_ERR_ARGUMENT, "the finishing step on "
-                           "a sub-mesh takes linear elements only");
+                           "a sub-mesh takes linear volume elements only");
     getme_params defaults, local;
     if (!params) {
         getme_params_init(&defaults);

@@ -324,5 +324,25 @@ int main(void)
         getme_mesh_free(whole), getme_mesh_free(loop);
         free_gen(&g);
     }
+    /* planar meshes are refused (a sub-mesh would decide its orientation
+       alone), as are missing arguments */
+    gen g = make_mesh(3);
+    getme_mesh *flat = build(&g);
+    int32_t fne = getme_mesh_num_elements(flat);
+    uint64_t *fkey = calloc((size_t)fne, sizeof *fkey);
+    uint8_t *fcomplete = calloc((size_t)getme_mesh_num_nodes(flat), 1);
+    getme_finish_rest rest;
+    getme_finish_rest_init(&rest);
+    CHECK(rest.num_elements == 0 && rest.q_min == 1.0 && rest.corner_min == 1.0);
+    CHECK(getme_finish_rest_add(&rest, flat, NULL, NULL) == GETME_ERR_ARGUMENT);
+    getme_result r;
+    memset(&r, 0, sizeof r);
+    CHECK(getme_smooth_finish_sub(flat, NULL, fkey, fcomplete, &rest, &r) ==
+          GETME_ERR_ARGUMENT);
+    CHECK(getme_smooth_finish_sub(flat, NULL, NULL, fcomplete, &rest, &r) ==
+          GETME_ERR_ARGUMENT);
+    free(fkey), free(fcomplete);
+    getme_mesh_free(flat);
+    free_gen(&g);
     return check_summary("test_finish_sub");
 }
