@@ -749,7 +749,8 @@ typedef struct getme_comm {
  * GETMe adaptive on this process's part (see getme_comm).  params as for
  * getme_smooth() (method GETME_METHOD_ADAPTIVE only); the finishing step
  * (params->finish) is not run here but by getme_smooth_finish() on the
- * gathered mesh.  The input must be valid (every element of every part;
+ * gathered mesh or getme_smooth_finish_sub() on the worst elements'
+ * patches.  The input must be valid (every element of every part;
  * untangle the whole mesh first): otherwise every process returns
  * GETME_ERR_INVALID_MESH.  result holds the values of the whole mesh
  * (identical on every process).  The positions of the part's nodes are
