@@ -21,6 +21,7 @@ typedef struct dist_ctx {
     uint8_t *fixed;     /* nn                                               */
     int32_t *gid;       /* nn: global node index                            */
     uint8_t *etype;     /* ne                                               */
+    int32_t *egid;      /* ne: global element index (finish_sub.c's keys)   */
     int64_t nconn;
     int32_t *conn;      /* part node indices, element after element          */
     uint8_t *owned;     /* ne                                               */
@@ -44,7 +45,21 @@ typedef struct dist_ctx {
        ghost elements (copies, summed over ranks) */
     int64_t interface_nodes, ghost_elements;
     int exit_code;      /* rank 0's exit code when it gave up (dist_go)    */
+    /* rank 0: the finishing step's sub-mesh (finish_sub.c): elements and
+       node copies gathered in the last try, tries */
+    int64_t sub_elements, sub_nodes;
+    int sub_tries;
 } dist_ctx;
+
+/* finish_sub.c: after getme_smooth_part on every rank (collective), the
+   finishing step on rank 0 on the patches of the worst elements only
+   (getme_smooth_finish_sub); every copy of a moved node gets its final
+   position in part.  whole: rank 0's mesh at its input coordinates (NULL
+   elsewhere; its bounding box keys the elements).  res: rank 0's result,
+   updated there.  0, or -1 on every rank with the message in err. */
+int dist_finish(dist_ctx *c, getme_mesh *part, const getme_mesh *whole,
+                const getme_params *params, getme_result *res, char *err,
+                size_t err_size);
 
 /* comm.c */
 int dist_comm_init(dist_ctx *c);

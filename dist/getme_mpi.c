@@ -8,9 +8,9 @@
  * -v, -q.  Rank 0 reads IN through libgetme_formats (fixed nodes by the
  * same rules as `getme smooth`), untangles it if needed as `getme smooth`
  * does, splits it with METIS and sends every rank its part; all ranks run
- * getme_smooth_part(); rank 0 gathers the positions, runs the finishing
- * step (getme_smooth_finish) and writes OUT, the same bytes as
- * `getme smooth IN -o OUT` writes with the same options.  A failure on any
+ * getme_smooth_part(); the finishing step runs on the worst elements'
+ * patches (finish_sub.c); rank 0 gathers the positions and writes OUT, the
+ * same bytes as `getme smooth IN -o OUT` writes with the same options.  A failure on any
  * rank stops every rank with one error line from rank 0 and no output.
  *
  * Exit codes: those of `getme smooth` (cli.h); 1 also when a rank fails
@@ -408,7 +408,25 @@ int main(int argc, char **argv)
         }
         free(all);
     }
-    /* 4. gather the counted nodes' positions on rank 0 */
+    /* 4. the finishing step on the worst elements' patches (finish_sub.c):
+       then every part holds the final positions */
+    double tf = MPI_Wtime();
+    params.progress = c.rank == 0 ? cli_smooth_progress : NULL;
+    params.progress_data = so; /* rank 0 alone: getme smooth's lines */
+    if (dist_finish(&c, part, doc ? getme_doc_mesh(doc) : NULL, &params,
+                    &res, err, sizeof err) != 0) {
+        if (c.rank == 0)
+            cli_error("%s: %s; no output written", a.input, err);
+        code = 1;
+        goto out;
+    }
+    double finish_seconds = MPI_Wtime() - tf;
+    if (c.sub_tries && log->verbose)
+        cli_info(log, "Finishing step on rank 0 on a sub-mesh of %lld "
+                 "elements (%lld node copies gathered, %d tr%s)",
+                 (long long)c.sub_elements, (long long)c.sub_nodes,
+                 c.sub_tries, c.sub_tries == 1 ? "y" : "ies");
+    /* 5. gather the counted nodes' positions on rank 0 */
     {
         const double *x = getme_mesh_coords(part);
         int n = 0;
@@ -481,14 +499,10 @@ int main(int argc, char **argv)
         free(all_ids), free(all_pos);
     }
 
-    /* 5. rank 0: the finishing step on the gathered mesh, then write */
+    /* 6. rank 0: write */
     if (c.rank == 0) {
         getme_mesh *mesh = getme_doc_mesh(doc);
-        double tf = MPI_Wtime();
-        /* rank 0 alone: getme smooth's progress lines, not collective */
-        params.progress = cli_smooth_progress;
-        params.progress_data = so;
-        st = getme_smooth_finish(mesh, &params, xyz, &res);
+        st = getme_mesh_set_coords(mesh, xyz);
         res.num_invalid_initial = ur.num_invalid_before;
         res.untangle_sweeps = ur.sweeps;
         res.untangle_seconds = ur.seconds;
@@ -502,7 +516,7 @@ int main(int argc, char **argv)
                      "%d passes in %.2f s",
                      res.iterations, res.iterations_mean, res.iterations_min,
                      res.cycles_min, loop_seconds, c.size, res.passes_finish,
-                     MPI_Wtime() - tf);
+                     finish_seconds);
             code = finish_output(&a, &paths, doc, &before, &mbefore, &res);
             if (code == 0)
                 cli_info(log, "Done (%.2f s in all)", MPI_Wtime() - t0);

@@ -42,13 +42,14 @@ static int fill_part(dist_ctx *c, const part *p, const getme_mesh *mesh,
     c->gid = xmalloc((size_t)p->nn * sizeof *c->gid);
     c->counted = xmalloc((size_t)p->nn);
     c->etype = xmalloc((size_t)p->ne);
+    c->egid = xmalloc((size_t)p->ne * sizeof *c->egid);
     c->owned = xmalloc((size_t)p->ne);
     c->nconn = 0;
     for (int32_t k = 0; k < p->ne; k++)
         c->nconn += eptr[p->elems[k] + 1] - eptr[p->elems[k]];
     c->conn = xmalloc((size_t)c->nconn * sizeof *c->conn);
     if (!c->coords || !c->fixed || !c->gid || !c->counted || !c->etype ||
-        !c->owned || !c->conn)
+        !c->egid || !c->owned || !c->conn)
         return -1;
     for (int32_t k = 0; k < p->nn; k++) {
         int32_t g = p->nodes[k];
@@ -61,6 +62,7 @@ static int fill_part(dist_ctx *c, const part *p, const getme_mesh *mesh,
     for (int32_t k = 0; k < p->ne; k++) {
         int32_t e = p->elems[k];
         c->etype[k] = etype[e];
+        c->egid[k] = e;
         c->owned[k] = epart[e] == r;
         for (int32_t j = eptr[e]; j < eptr[e + 1]; j++)
             c->conn[m++] = glocal[eind[j]];
@@ -121,6 +123,7 @@ static int send_part(dist_ctx *c, int r)
     rc |= MPI_Send(c->gid, c->nn, MPI_INT32_T, r, TAG_DATA, w);
     rc |= MPI_Send(c->counted, c->nn, MPI_UINT8_T, r, TAG_DATA, w);
     rc |= MPI_Send(c->etype, c->ne, MPI_UINT8_T, r, TAG_DATA, w);
+    rc |= MPI_Send(c->egid, c->ne, MPI_INT32_T, r, TAG_DATA, w);
     rc |= MPI_Send(c->owned, c->ne, MPI_UINT8_T, r, TAG_DATA, w);
     rc |= MPI_Send(c->conn, (int)c->nconn, MPI_INT32_T, r, TAG_DATA, w);
     rc |= MPI_Send(c->nb_rank, c->num_nb, MPI_INT, r, TAG_DATA, w);
@@ -155,6 +158,7 @@ int dist_partition_recv(dist_ctx *c)
     c->gid = xmalloc((size_t)c->nn * sizeof *c->gid);
     c->counted = xmalloc((size_t)c->nn);
     c->etype = xmalloc((size_t)c->ne);
+    c->egid = xmalloc((size_t)c->ne * sizeof *c->egid);
     c->owned = xmalloc((size_t)c->ne);
     c->conn = xmalloc((size_t)c->nconn * sizeof *c->conn);
     c->nb_rank = xmalloc((size_t)c->num_nb * sizeof *c->nb_rank);
@@ -171,6 +175,8 @@ int dist_partition_recv(dist_ctx *c)
     rc |= MPI_Recv(c->counted, c->nn, MPI_UINT8_T, 0, TAG_DATA, w,
                    MPI_STATUS_IGNORE);
     rc |= MPI_Recv(c->etype, c->ne, MPI_UINT8_T, 0, TAG_DATA, w,
+                   MPI_STATUS_IGNORE);
+    rc |= MPI_Recv(c->egid, c->ne, MPI_INT32_T, 0, TAG_DATA, w,
                    MPI_STATUS_IGNORE);
     rc |= MPI_Recv(c->owned, c->ne, MPI_UINT8_T, 0, TAG_DATA, w,
                    MPI_STATUS_IGNORE);
@@ -189,7 +195,7 @@ int dist_partition_recv(dist_ctx *c)
     rc = MPI_Recv(c->nb_node, (int)c->nb_ptr[c->num_nb], MPI_INT32_T, 0,
                   TAG_DATA, w, MPI_STATUS_IGNORE);
     return rc == MPI_SUCCESS && c->coords && c->fixed && c->gid &&
-                   c->counted && c->etype && c->owned && c->conn &&
+                   c->counted && c->etype && c->egid && c->owned && c->conn &&
                    c->nb_rank && c->nb_count && c->nb_node
                ? 0
                : -1;
@@ -198,10 +204,10 @@ int dist_partition_recv(dist_ctx *c)
 void dist_part_free(dist_ctx *c)
 {
     free(c->coords), free(c->fixed), free(c->gid), free(c->counted);
-    free(c->etype), free(c->owned), free(c->conn);
+    free(c->etype), free(c->egid), free(c->owned), free(c->conn);
     free(c->nb_rank), free(c->nb_count), free(c->nb_ptr), free(c->nb_node);
     c->coords = NULL, c->fixed = NULL, c->gid = NULL, c->counted = NULL;
-    c->etype = NULL, c->owned = NULL, c->conn = NULL;
+    c->etype = NULL, c->egid = NULL, c->owned = NULL, c->conn = NULL;
     c->nb_rank = NULL, c->nb_count = NULL, c->nb_ptr = NULL, c->nb_node = NULL;
 }
 

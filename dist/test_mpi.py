@@ -9,7 +9,9 @@ the same bytes as `getme smooth` with 1 and 2 threads (tets: 1, 2, 3 and
 4 ranks, 2 ranks also with 2 threads each; hexes and mixed: 1 and 3); fixed nodes keep
 their input coordinates bit for bit; the output is valid (getme quality).
 A rank that fails to read its part (GETME_MPI_FAIL_RANK) stops every rank
-with one error line and leaves no output.
+with one error line and leaves no output.  The finishing step runs on a
+sub-mesh (-v says so); started too small (GETME_MPI_FINISH_FIRST=1) it
+grows and the bytes stay the same; so with --param renumber=0.
 
 --sanitized (the ASan+UBSan build): tets only, and LeakSanitizer off in
 the MPI ranks (Open MPI's own start-up allocations are never freed);
@@ -75,6 +77,26 @@ with tempfile.TemporaryDirectory() as tmp:
                 if np == 3 and threads == 1:
                     c.check("comm" in p.stdout and "KiB" in p.stdout,
                             f"{case}: -v logs the communication per iteration")
+                    c.check("on a sub-mesh of" in p.stdout,
+                            f"{case}: the finishing step runs on a sub-mesh: "
+                            f"{p.stdout[-600:]}")
+        # the finishing step's sub-mesh too small at first (1 candidate):
+        # it grows until exact, and the bytes stay getme smooth's
+        out = os.path.join(tmp, f"{case}-grow.msh")
+        p = mpirun(3, "smooth", inp, "-o", out, "-v",
+                   env=dict(ENV, GETME_MPI_FINISH_FIRST="1"))
+        c.check(p.returncode == 0 and "tries)" in p.stdout,
+                f"{case}: a 1-candidate sub-mesh grows: {p.stdout[-600:]}")
+        c.check(os.path.exists(out) and open(out, "rb").read() == ref_bytes,
+                f"{case}: grown sub-mesh, the same bytes as getme smooth")
+        # renumber=0: the finishing step's element keys carry no Morton code
+        ref0 = os.path.join(tmp, f"{case}-ref-r0.msh")
+        c.run("smooth", inp, "-o", ref0, "--param", "renumber=0", "-q", env=ENV)
+        out = os.path.join(tmp, f"{case}-r0.msh")
+        p = mpirun(3, "smooth", inp, "-o", out, "--param", "renumber=0")
+        c.check(p.returncode == 0 and os.path.exists(out) and
+                open(out, "rb").read() == open(ref0, "rb").read(),
+                f"{case}: renumber=0, the same bytes as getme smooth")
         # fixed nodes bit for bit, output valid
         before, after = nodes(inp), nodes(ref)
         c.run("quality", ref, "-q")  # exit 6 if an element is invalid

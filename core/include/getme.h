@@ -68,7 +68,8 @@ typedef enum getme_status {
     GETME_ERR_TOPOLOGY = 4,     /* node index out of range, repeated node ... */
     GETME_ERR_STATE = 5,        /* call out of order (e.g. no elements yet)   */
     GETME_ERR_CANCELLED = 6,    /* the progress callback asked to stop        */
-    GETME_ERR_COMM = 7          /* a getme_comm hook reported a failure       */
+    GETME_ERR_COMM = 7,         /* a getme_comm hook reported a failure       */
+    GETME_ERR_INCOMPLETE = 8    /* getme_smooth_finish_sub(): grow the sub-mesh */
 } getme_status;
 
 /* A static English description of a status code ("invalid mesh", ...). */
@@ -750,7 +751,8 @@ typedef struct getme_comm {
  * GETMe adaptive on this process's part (see getme_comm).  params as for
  * getme_smooth() (method GETME_METHOD_ADAPTIVE only); the finishing step
  * (params->finish) is not run here but by getme_smooth_finish() on the
- * gathered mesh.  The input must be valid (every element of every part;
+ * gathered mesh or getme_smooth_finish_sub() on the worst elements'
+ * patches.  The input must be valid (every element of every part;
  * untangle the whole mesh first): otherwise every process returns
  * GETME_ERR_INVALID_MESH.  result holds the values of the whole mesh
  * (identical on every process).  The positions of the part's nodes are
@@ -777,6 +779,95 @@ GETME_API getme_status getme_smooth_finish(getme_mesh *mesh,
                                            const getme_params *params,
                                            const double *xyz,
                                            getme_result *result);
+
+/*
+ * The finishing step on a sub-mesh (docs/distributed.md, "The finishing
+ * step on a sub-mesh"): the same moves as getme_smooth_finish() on the
+ * whole mesh, without holding it.  The finishing step only moves free
+ * nodes of the worst elements; the caller sends one process the elements
+ * around them (the sub-mesh) and constants of the rest of the mesh.
+ *
+ * The whole mesh's element order decides ties and the order of node stars;
+ * a sub-mesh reproduces it from one 64-bit key per element:
+ *
+ *   key = type << 61 | morton << 31 | index
+ *
+ * type the getme_elem_type (linear), index the element's index in the
+ * whole mesh (< 2^31), morton the 30-bit Morton code of the element's first
+ * node at the whole mesh's INPUT coordinates in the bounding box lo, hi of
+ * all nodes of the whole mesh (used or not): per axis d,
+ * s = (x_d - lo_d) * 1023 / (hi_d - lo_d) (0 if hi_d = lo_d), clamped to
+ * [0, 1023] and truncated to an integer, its 10 bits spread to every third
+ * bit from bit d.  With params->renumber = 0 morton is 0 (lo = hi = NULL).
+ * getme_element_key() computes it.
+ */
+GETME_API uint64_t getme_element_key(getme_elem_type type, int32_t index,
+                                     const double first_node_xyz[3],
+                                     const double lo[3], const double hi[3]);
+
+/*
+ * Constants of the elements outside a sub-mesh (they do not move): count,
+ * count with a free node, the exact fixed-point sum of their mean ratios
+ * (128-bit two's complement, q_sum[0] the low 64 bits; order-free, so
+ * per-process parts can be merged in any order), the lowest mean ratio,
+ * the lowest among elements with a free node, the worst corner scaled
+ * Jacobian (1 without corners).  Minima start at 1 (an empty rest).
+ */
+typedef struct getme_finish_rest {
+    int64_t num_elements;
+    int64_t num_free_elements;
+    uint64_t q_sum[2];
+    double q_min, q_min_free, corner_min;
+} getme_finish_rest;
+
+/* An empty rest (counts and sum 0, minima 1). */
+GETME_API void getme_finish_rest_init(getme_finish_rest *rest);
+
+/* Add the elements e of mesh with include[e] != 0 (NULL: all) at the
+   mesh's coordinates and fixed marks (those of the whole mesh).  q: their
+   getme_element_quality() values if the caller has them (per element of
+   mesh; NULL: computed here).  GETME_ERR_ARGUMENT for planar and
+   second-order meshes (not supported). */
+GETME_API getme_status getme_finish_rest_add(getme_finish_rest *rest,
+                                             const getme_mesh *mesh,
+                                             const uint8_t *include,
+                                             const double *q);
+
+/* into += from (counts and sum added, minima taken). */
+GETME_API void getme_finish_rest_merge(getme_finish_rest *into,
+                                       const getme_finish_rest *from);
+
+/*
+ * getme_smooth_finish() on a sub-mesh.  sub: elements of the whole mesh
+ * (linear volume elements: a planar sub-mesh would decide its orientation
+ * alone; GETME_ERR_ARGUMENT) added in ascending key order, nodes at the positions the
+ * distributed loop reached, fixed marks of the whole mesh (set with
+ * getme_mesh_set_fixed_mask: the sub-mesh's cut is not skin); key: per
+ * element (getme_element_key()); complete: per node, 1 when every element
+ * of the whole mesh containing it is in sub; rest: the other elements;
+ * result as filled by getme_smooth_part() (its corner_sj_initial is the
+ * whole input's).  The nodes of sub then hold, bit for bit, what
+ * getme_smooth_finish() gives on the whole mesh, and result its values
+ * for the whole mesh.
+ *
+ * Exactness is checked every pass: the pass bound (the quality at
+ * finish_fraction of the whole mesh's free elements) must be below
+ * rest->q_min_free, and every free node of an element at or below it must
+ * be complete.  If not, GETME_ERR_INCOMPLETE: nothing is stored, no
+ * progress is reported, result is unchanged but for result->threshold, the
+ * pass bound that did not fit (a bigger sub-mesh holds at least every free
+ * element at or below it, with complete stars); grow the sub-mesh (or use
+ * the whole mesh) and call again.  The checks depend only on the data, so
+ * every caller decides alike.  The progress callback is called once per
+ * pass after the step succeeded (its return value is ignored: a stop must
+ * not depend on where the mesh is held).
+ */
+GETME_API getme_status getme_smooth_finish_sub(getme_mesh *sub,
+                                               const getme_params *params,
+                                               const uint64_t *key,
+                                               const uint8_t *complete,
+                                               const getme_finish_rest *rest,
+                                               getme_result *result);
 
 /* ------------------------------------------------------------------------ */
 /* Untangling                                                               */

@@ -23,11 +23,17 @@
  * the corner guard holds).  Passes end when one raises q*_min by no more
  * than min_tol, or after finish_max_passes.  Serial and in a fixed order:
  * the output is the same for any thread count.
+ *
+ * On a sub-mesh (getme_smooth_finish_sub, run->sub) the same passes run
+ * with the whole mesh's values: the bound, q*_min and q_mean add the
+ * constant rest of the mesh, and each pass first checks that everything
+ * it can touch is inside (else GETME_ERR_INCOMPLETE).
  */
 #include "patch.h"
 #include "smooth_internal.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -113,6 +119,115 @@ static getme_status improve(getme_run *run, getme_patch *p, int32_t e)
     return GETME_OK;
 }
 
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The pass bound on a sub-mesh: getme__threshold's quantile of the whole
+   mesh's free elements.  It is the sub-mesh's own value at the whole
+   mesh's position k when that lies below every free element outside
+   (those are then all above it, so the k + 1 lowest are inside);
+   *incomplete is set when not.  -1 if out of memory. */
+static double sub_bound(const getme_run *run, double fraction,
+                        int32_t min_count, int *incomplete)
+{
+    const getme_ws *ws = run->ws;
+    const getme_finish_rest *rest = run->sub->rest;
+    int64_t n = ws->num_free_elem + rest->num_free_elements;
+    if (n == 0)
+        return 0.0;
+    double pos = fraction * (double)n;
+    if (pos < (double)min_count - 1.0)
+        pos = (double)min_count - 1.0;
+    int64_t k = pos >= (double)(n - 1) ? n - 1 : pos <= 0.0 ? 0 : (int64_t)pos;
+    if (k >= ws->num_free_elem) {
+        *incomplete = 1;
+        return 0.0;
+    }
+    double *v = malloc((size_t)ws->num_free_elem * sizeof *v);
+    if (!v)
+        return -1.0;
+    int32_t m = 0;
+    for (int32_t e = 0; e < ws->ne; e++)
+        if (ws->free_elem[e])
+            v[m++] = run->q[e];
+    qsort(v, (size_t)m, sizeof *v, cmp_double);
+    double bound = v[k];
+    free(v);
+    if (rest->num_free_elements > 0 && !(bound < rest->q_min_free))
+        *incomplete = 1;
+    return bound;
+}
+
+/* On a sub-mesh: 1 if every free node of every listed element has its
+   whole star inside (improve() moves them and fills their stars). */
+static int stars_inside(const getme_run *run, const ranked *r, int32_t n)
+{
+    const getme_ws *ws = run->ws;
+    for (int32_t i = 0; i < n; i++) {
+        int t = getme__ws_type(ws, r[i].e);
+        const int32_t *c = getme__ws_nodes(ws, t, r[i].e);
+        for (int j = 0; j < getme__nv[t]; j++)
+            if (!ws->fixed[c[j]] && !run->sub->complete[c[j]])
+                return 0;
+    }
+    return 1;
+}
+
+void getme__finish_summary(const getme_run *run, double *q_mean,
+                           double *q_min_star, double *q_min)
+{
+    const getme_ws *ws = run->ws;
+    if (!run->sub) {
+        getme__ws_summary(ws, run->q, q_mean, q_min_star, q_min);
+        return;
+    }
+    /* the exact sum of getme__ws_summary (exact.h), plus the rest's */
+    const getme_finish_rest *rest = run->sub->rest;
+    getme_ufx s = (getme_ufx)rest->q_sum[1] << 64 | rest->q_sum[0];
+    double mn = rest->q_min, mns = rest->q_min_free;
+    for (int32_t e = 0; e < ws->ne; e++) {
+        double v = run->q[e];
+        s += (getme_ufx)getme__fx_q(v);
+        mn = v < mn ? v : mn;
+        if (ws->free_elem[e])
+            mns = v < mns ? v : mns;
+    }
+    int64_t n = ws->ne + rest->num_elements;
+    *q_mean = n ? getme__fx_double((getme_fx)s, GETME_FX_QINV) / (double)n
+                : 1.0;
+    *q_min_star = mns;
+    if (q_min)
+        *q_min = mn;
+}
+
+/* A pass's progress line; on a sub-mesh it is kept for later (the step
+   may still turn out to need a bigger sub-mesh). */
+static int report(getme_run *run, int pass, double q_min, double q_mean,
+                  double bound, int32_t n, int32_t raised)
+{
+    getme_finish_sub *sub = run->sub;
+    if (!sub)
+        return getme__report(run, pass, GETME_STAGE_FINISH,
+                             run->result->cycles_min, q_min, q_mean, bound,
+                             n, raised);
+    if (sub->num_log < sub->cap_log) {
+        getme_progress *g = &sub->log[sub->num_log++];
+        g->iteration = pass;
+        g->stage = GETME_STAGE_FINISH;
+        g->cycle = run->result->cycles_min;
+        g->q_min_star = q_min;
+        g->q_mean = q_mean;
+        g->threshold = bound;
+        g->num_transformed = n;
+        g->num_relaxed = raised;
+        g->elapsed = omp_get_wtime() - run->t0;
+    }
+    return 0;
+}
+
 /* The pass's elements: free ones with q <= bound, worst first. */
 static ranked *pass_list(const getme_run *run, double bound, int32_t *count)
 {
@@ -145,14 +260,28 @@ getme_status getme__finish(getme_run *run)
     p.guard = run->guard;
     p.floor = run->corner_floor;
     double q_mean, q_min;
-    getme__ws_summary(ws, run->q, &q_mean, &q_min, NULL);
+    getme__finish_summary(run, &q_mean, &q_min, NULL);
     getme_status st = GETME_OK;
     for (int pass = 1; pass <= prm->finish_max_passes; pass++) {
-        double bound = getme__threshold(run, prm->finish_fraction, 64);
+        int incomplete = 0;
+        double bound =
+            run->sub ? sub_bound(run, prm->finish_fraction, 64, &incomplete)
+                     : getme__threshold(run, prm->finish_fraction, 64);
+        if (incomplete) {
+            run->sub->need = bound;
+            st = GETME_ERR_INCOMPLETE;
+            break;
+        }
         int32_t n, raised = 0;
         ranked *list = bound < 0.0 ? NULL : pass_list(run, bound, &n);
         if (!list) {
             st = GETME_ERR_NOMEM;
+            break;
+        }
+        if (run->sub && !stars_inside(run, list, n)) {
+            run->sub->need = bound;
+            free(list);
+            st = GETME_ERR_INCOMPLETE;
             break;
         }
         /* Two sweeps: the first takes only moves that lose no total
@@ -171,11 +300,10 @@ getme_status getme__finish(getme_run *run)
         if (st != GETME_OK)
             break;
         double prev = q_min;
-        getme__ws_summary(ws, run->q, &q_mean, &q_min, NULL);
+        getme__finish_summary(run, &q_mean, &q_min, NULL);
         res->passes_finish = pass;
         res->moved_finish += raised;
-        if (getme__report(run, pass, GETME_STAGE_FINISH, res->cycles_min,
-                          q_min, q_mean, bound, n, raised)) {
+        if (report(run, pass, q_min, q_mean, bound, n, raised)) {
             res->stop_reason = GETME_STOP_CANCELLED;
             st = GETME_ERR_CANCELLED;
             break;

@@ -24,6 +24,7 @@ const char *getme_status_string(getme_status status)
     case GETME_ERR_STATE: return "call out of order";
     case GETME_ERR_CANCELLED: return "cancelled";
     case GETME_ERR_COMM: return "communication failed";
+    case GETME_ERR_INCOMPLETE: return "the sub-mesh is too small";
     }
     return "unknown status";
 }

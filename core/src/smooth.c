@@ -212,19 +212,35 @@ getme_status getme__start(getme_mesh *mesh, const getme_params **params,
     return st;
 }
 
+getme_status getme__enter(getme_mesh *mesh, const getme_params **params,
+                          getme_params *defaults, getme_ws *ws, void *result,
+                          size_t size, double *t0, int distributed)
+{
+    memset(ws, 0, sizeof *ws);
+    if (!mesh || !result)
+        return GETME_ERR_ARGUMENT;
+    memset(result, 0, size);
+    *t0 = omp_get_wtime();
+    if (distributed && mesh->dim != 3)
+        return getme__fail(mesh, GETME_ERR_ARGUMENT,
+                           "distributed smoothing needs a volume mesh");
+    if (distributed && *params && (*params)->method != GETME_METHOD_ADAPTIVE)
+        return getme__fail(mesh, GETME_ERR_ARGUMENT,
+                           "distributed smoothing runs GETMe adaptive only");
+    return getme__start(mesh, params, defaults, ws);
+}
+
 getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
                           getme_result *result)
 {
     getme_params defaults;
     getme_result local;
-    if (!mesh)
-        return GETME_ERR_ARGUMENT;
+    double t0;
+    getme_ws ws;
     if (!result)
         result = &local;
-    memset(result, 0, sizeof *result);
-    double t0 = omp_get_wtime();
-    getme_ws ws;
-    getme_status st = getme__start(mesh, &params, &defaults, &ws);
+    getme_status st = getme__enter(mesh, &params, &defaults, &ws, result,
+                                   sizeof *result, &t0, 0);
     if (st != GETME_OK)
         return st;
     getme_run run;

@@ -61,6 +61,8 @@ typedef struct getme_run {
     uint8_t *owned;     /* ne: element owned by this process (else ghost)  */
     uint8_t *counted;   /* nn: node counted by this process                */
     int comm_failed;    /* a hook failed: the loop stops (GETME_ERR_COMM)  */
+    /* getme_smooth_finish_sub only (finish_sub.c); NULL otherwise. */
+    struct getme_finish_sub *sub;
     /* The corner guard (params.corner_guard): relaxation and the finishing
        step treat a hex/prism/pyramid/quad whose worst corner falls below
        min(its old value, corner_floor) like an invalid element. */
@@ -81,6 +83,15 @@ typedef struct getme_run {
    the mesh. */
 getme_status getme__start(getme_mesh *mesh, const getme_params **params,
                           getme_params *defaults, getme_ws *ws);
+
+/* The entry of getme_smooth(), getme_smooth_part() and
+   getme_mesh_untangle(): ws zeroed; mesh and result (size bytes) must be
+   there (else GETME_ERR_ARGUMENT); result cleared, *t0 the start time; a
+   distributed run needs a volume mesh and GETMe adaptive; then
+   getme__start().  ws needs getme__ws_free() only after GETME_OK. */
+getme_status getme__enter(getme_mesh *mesh, const getme_params **params,
+                          getme_params *defaults, getme_ws *ws, void *result,
+                          size_t size, double *t0, int distributed);
 
 getme_status getme__run_alloc(getme_run *run);
 void getme__run_free(getme_run *run);
@@ -132,8 +143,26 @@ double getme__threshold(getme_run *run, double fraction,
 double getme__ws_corner_min(const getme_ws *ws);
 
 /* The finishing step (finish.c): passes of worst-first local max-min
-   optimisation until q*_min stops rising.  Needs run->q up to date. */
+   optimisation until q*_min stops rising.  Needs run->q up to date.  On a
+   sub-mesh (run->sub) it returns GETME_ERR_INCOMPLETE when a pass would
+   need an element or a star outside it. */
 getme_status getme__finish(getme_run *run);
+
+/* The finishing step on a sub-mesh (finish_sub.c): the elements outside
+   it, which nodes have their whole star inside (ws order), and the
+   progress reports held back until the step is known to be exact. */
+typedef struct getme_finish_sub {
+    const getme_finish_rest *rest;
+    const uint8_t *complete;
+    getme_progress *log;
+    int num_log, cap_log;
+    double need;    /* GETME_ERR_INCOMPLETE: the pass bound that did not fit */
+} getme_finish_sub;
+
+/* q_mean, q*_min, q_min (may be NULL) of the whole mesh: the workspace's
+   elements plus run->sub's rest, or the workspace alone without one. */
+void getme__finish_summary(const getme_run *run, double *q_mean,
+                           double *q_min_star, double *q_min);
 
 /* Untangle ws in place (untangle.c); q holds the qualities at ws->x and is
    kept up to date.  GETME_OK (res says how many elements stay invalid) or

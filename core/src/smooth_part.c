@@ -48,25 +48,16 @@ getme_status getme_smooth_part(getme_mesh *mesh, const getme_params *params,
         return GETME_ERR_ARGUMENT;
     if (!result)
         result = &local;
-    memset(result, 0, sizeof *result);
-    double t0 = omp_get_wtime();
+    double t0;
     getme_ws ws;
-    memset(&ws, 0, sizeof ws);
+    /* a failure here is agreed on below, with every process */
+    getme_status st = getme__enter(mesh, &params, &defaults, &ws, result,
+                                   sizeof *result, &t0, 1);
+    int have_ws = st == GETME_OK;
     getme_run run;
     memset(&run, 0, sizeof run);
     getme_adj adj;
     memset(&adj, 0, sizeof adj);
-    int have_ws = 0;
-    getme_status st;
-    if (mesh->dim != 3)
-        st = getme__fail(mesh, GETME_ERR_ARGUMENT,
-                         "distributed smoothing needs a volume mesh");
-    else if (params && params->method != GETME_METHOD_ADAPTIVE)
-        st = getme__fail(mesh, GETME_ERR_ARGUMENT,
-                         "distributed smoothing runs GETMe adaptive only");
-    else
-        st = getme__start(mesh, &params, &defaults, &ws);
-    have_ws = st == GETME_OK;
     if (st == GETME_OK && (st = getme__adj_build(&adj, &ws)) != GETME_OK)
         getme__fail(mesh, st, "out of memory for the neighbour sums");
     run.ws = &ws;

@@ -778,14 +778,12 @@ getme_status getme_mesh_untangle(getme_mesh *mesh, const getme_params *params,
 {
     getme_params defaults;
     getme_untangle_result local;
-    if (!mesh)
-        return GETME_ERR_ARGUMENT;
+    double t0;
+    getme_ws ws;
     if (!result)
         result = &local;
-    memset(result, 0, sizeof *result);
-    double t0 = omp_get_wtime();
-    getme_ws ws;
-    getme_status st = getme__start(mesh, &params, &defaults, &ws);
+    getme_status st = getme__enter(mesh, &params, &defaults, &ws, result,
+                                   sizeof *result, &t0, 0);
     if (st != GETME_OK)
         return st;
     double *q = malloc((size_t)ws.ne * sizeof *q);

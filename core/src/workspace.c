@@ -67,6 +67,18 @@ static uint32_t spread3(uint32_t v)
     return v;
 }
 
+uint32_t getme__morton(const double *x, const double lo[3],
+                       const double scale[3])
+{
+    uint32_t code = 0;
+    for (int d = 0; d < 3; d++) {
+        double s = (x[d] - lo[d]) * scale[d];
+        uint32_t q = s <= 0.0 ? 0u : s >= 1023.0 ? 1023u : (uint32_t)s;
+        code |= spread3(q) << d;
+    }
+    return code;
+}
+
 /* Stable LSD radix sort of idx[0..n) by key (two 16-bit passes). */
 static int radix_sort(uint32_t *key, int32_t *idx, int32_t n)
 {
@@ -140,15 +152,8 @@ static getme_status order_elements(getme_ws *ws, const getme_mesh *mesh,
         return GETME_ERR_NOMEM;
     }
 #pragma omp parallel for schedule(static) num_threads(ws->nt)
-    for (int32_t i = 0; i < mesh->num_nodes; i++) {
-        uint32_t code = 0;
-        for (int d = 0; d < 3; d++) {
-            double s = (mesh->coords[3 * (int64_t)i + d] - lo[d]) * scale[d];
-            uint32_t q = s <= 0.0 ? 0u : s >= 1023.0 ? 1023u : (uint32_t)s;
-            code |= spread3(q) << d;
-        }
-        nkey[i] = code;
-    }
+    for (int32_t i = 0; i < mesh->num_nodes; i++)
+        nkey[i] = getme__morton(mesh->coords + 3 * (int64_t)i, lo, scale);
     for (int32_t k = 0; k < ws->ne; k++) {
         int32_t local;
         const getme_block *bl = getme__find_block(mesh, ws->elem_orig[k], &local);

@@ -77,6 +77,13 @@ void getme__ws_keep(getme_ws *ws, getme_mesh *mesh);
 void getme__ws_lend_conn(getme_ws *ws, getme_mesh *mesh);
 void getme__ws_return_conn(getme_ws *ws, getme_mesh *mesh);
 
+/* The 30-bit Morton key the element order uses (renumber = 1): each
+   coordinate's (x - lo) * scale clamped to [0, 1023] and truncated, its
+   bits spread to every third bit from bit d (scale = 1023 / extent, 0 for
+   a flat axis). */
+uint32_t getme__morton(const double *x, const double lo[3],
+                       const double scale[3]);
+
 /* Write the workspace coordinates back to the mesh (undoing mirror/order). */
 void getme__ws_store(const getme_ws *ws, getme_mesh *mesh);
 
