@@ -13,7 +13,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define IN_CHUNK (1u << 20)
+/* 4 MiB: the ASCII fast path (msh41_reader.c) parses what the buffer holds
+   on several threads, one piece per thread. */
+#define IN_CHUNK (4u << 20)
 
 int msh41_in_open(msh41_input *in, const char *path)
 {
@@ -164,4 +166,31 @@ int msh41_in_eol(msh41_input *in)
     if (c == '\n')
         msh41_in_getc(in);
     return c == '\n' || c < 0;
+}
+
+const char *msh41_in_window(msh41_input *in, size_t want, size_t *avail)
+{
+    if (want > IN_CHUNK)
+        want = IN_CHUNK;
+    /* Refill when less than want is left, or less than 1/16 of the
+       buffer: a refill moves what is left to the front, at most a 16th of
+       what it then reads. */
+    if (in->len - in->pos < (want < IN_CHUNK / 16 ? want : IN_CHUNK / 16) &&
+        in->f) {
+        echo_flush(in);
+        size_t tail = in->len - in->pos;
+        memmove(in->buf, in->buf + in->pos, tail);
+        in->base += (int64_t)in->pos;
+        in->pos = in->echo_from = 0;
+        in->len = tail + fread(in->buf + tail, 1, IN_CHUNK - tail, in->f);
+    }
+    size_t n = in->len - in->pos;
+    *avail = n < want ? n : want;
+    return (const char *)in->buf + in->pos;
+}
+
+void msh41_in_consume(msh41_input *in, size_t bytes, long lines)
+{
+    in->pos += bytes;
+    in->line += lines;
 }
