@@ -29,7 +29,7 @@ int linepar_threads(int threads, size_t len)
     return threads > MAX_PIECES ? MAX_PIECES : threads;
 }
 
-static size_t count_lines(const char *p, const char *end)
+size_t linepar_count(const char *p, const char *end)
 {
     size_t k = 0;
     while (p < end && (p = memchr(p, '\n', (size_t)(end - p))) != NULL) {
@@ -84,7 +84,7 @@ size_t linepar_run(const char *text, size_t len, size_t max, int threads,
     {
 #pragma omp for schedule(static, 1)
         for (int k = 0; k < t; k++)
-            first[k + 1] = count_lines(cut[k], cut[k + 1]);
+            first[k + 1] = linepar_count(cut[k], cut[k + 1]);
 #pragma omp single
         for (int k = 0; k < t; k++)
             first[k + 1] += first[k];

@@ -24,6 +24,9 @@ typedef const char *(*linepar_fn)(void *ctx, const char *line,
 size_t linepar_run(const char *text, size_t len, size_t max, int threads,
                    linepar_fn fn, void *ctx, size_t *bytes);
 
+/* The number of '\n' in [p, end). */
+size_t linepar_count(const char *p, const char *end);
+
 /* Threads for a run of len bytes: 1 below a size where starting threads
    costs more than it saves, else threads (at least 1). */
 int linepar_threads(int threads, size_t len);

@@ -227,3 +227,40 @@ int inp_format_real(double v, char *buf)
     }
     return snprintf(buf, 32, "%.1g", v);
 }
+
+const char *inp_lines_window(inp_lines *r, size_t want, size_t *avail)
+{
+    /* Refill when less than want is left, or less than 1/16 of the
+       buffer: a refill moves what is left to the front, at most a 16th of
+       what it then reads. */
+    size_t low = want < r->cap / 16 ? want : r->cap / 16;
+    if (r->end - r->beg < low && !r->eof) {
+        if (r->beg > 0) {
+            memmove(r->buf, r->buf + r->beg, r->end - r->beg);
+            r->end -= r->beg;
+            r->beg = 0;
+        }
+        if (want > r->cap) {
+            char *b = realloc(r->buf, want + 1);
+            if (b) {
+                r->buf = b;
+                r->cap = want;
+            }
+        }
+        size_t got = fread(r->buf + r->end, 1, r->cap - r->end, r->fp);
+        if (got == 0 && !ferror(r->fp))
+            r->eof = 1; /* a read error shows at the next inp_lines_next */
+        r->end += got;
+    }
+    size_t n = r->end - r->beg;
+    *avail = n < want ? n : want;
+    return r->buf + r->beg;
+}
+
+void inp_lines_consume(inp_lines *r, size_t bytes, size_t lines)
+{
+    r->beg += bytes;
+    r->next_offset += (int64_t)bytes;
+    r->offset = r->next_offset;
+    r->lineno += (uint32_t)lines;
+}
