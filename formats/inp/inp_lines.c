@@ -4,6 +4,7 @@
  * size is read with constant memory for its text.
  */
 #include "inp_internal.h"
+#include "numformat.h"
 #include "numparse.h"
 
 #include <errno.h>
@@ -211,21 +212,23 @@ int inp_format_real(double v, char *buf)
 {
     /* Abaqus reads at most 20 characters per real field.  Values that came
        from short decimal text come back short (%.15g); anything else gets
-       the 17 significant digits that always read back to the same double. */
-    int n = snprintf(buf, 32, "%.15g", v);
-    if (n <= 20 && strtod(buf, NULL) == v)
+       the 17 significant digits that always read back to the same double.
+       numformat_g is snprintf's "%.*g" without printf's cost. */
+    int back;
+    int n = numformat_g(v, 15, buf, &back);
+    if (n <= 20 && back)
         return n;
-    n = snprintf(buf, 32, "%.17g", v);
+    n = numformat_g(v, 17, buf, NULL);
     if (n <= 20)
         return n;
     /* Tiny or huge magnitudes with a long exponent: as many digits as fit
        (a relative change below 1e-15, on a free node only). */
     for (int prec = 16; prec > 1; prec--) {
-        n = snprintf(buf, 32, "%.*g", prec, v);
+        n = numformat_g(v, prec, buf, NULL);
         if (n <= 20)
             return n;
     }
-    return snprintf(buf, 32, "%.1g", v);
+    return numformat_g(v, 1, buf, NULL);
 }
 
 const char *inp_lines_window(inp_lines *r, size_t want, size_t *avail)
