@@ -8,8 +8,8 @@
  * |v| * 10^s = m * 5^s / 2^k with k = -(e + s): N = m * 5^s < 2^53 * 5^31 <
  * 2^126 is an exact 128-bit integer, and D is N >> k rounded by the bits
  * shifted out -- half to even on an exact tie, as glibc's printf rounds in
- * the default rounding mode.  floor(log10 |v|) is taken from log10 and
- * corrected until 10^(P-1) <= N >> k < 10^P, which is exact.  The text is
+ * the default rounding mode.  floor(log10 |v|) is estimated from the binary
+ * exponent and corrected until 10^(P-1) <= N >> k < 10^P, which is exact.  The text is
  * then laid out as %g does: %e style if the decimal exponent X is below -4
  * or at least P, else %f style, trailing zeros (and a bare '.') removed.
  *
@@ -53,12 +53,19 @@ static const uint64_t pow10_u64[20] = {1ULL,
                                        1000000000000000000ULL,
                                        10000000000000000000ULL};
 
+/* 5^s for 0 <= s <= 31 (5^27 is the largest power below 2^64). */
+static const uint64_t pow5_u64[28] = {
+    1ULL, 5ULL, 25ULL, 125ULL, 625ULL, 3125ULL, 15625ULL, 78125ULL,
+    390625ULL, 1953125ULL, 9765625ULL, 48828125ULL, 244140625ULL,
+    1220703125ULL, 6103515625ULL, 30517578125ULL, 152587890625ULL,
+    762939453125ULL, 3814697265625ULL, 19073486328125ULL, 95367431640625ULL,
+    476837158203125ULL, 2384185791015625ULL, 11920928955078125ULL,
+    59604644775390625ULL, 298023223876953125ULL, 1490116119384765625ULL,
+    7450580596923828125ULL};
+
 static u128 pow5(int s)
 {
-    u128 p = 1;
-    for (int i = 0; i < s; i++)
-        p *= 5;
-    return p;
+    return s > 27 ? (u128)pow5_u64[27] * pow5_u64[s - 27] : pow5_u64[s];
 }
 
 static int slow(double v, int prec, char *buf, int *roundtrip)
@@ -128,7 +135,9 @@ int numformat_g(double v, int prec, char *buf, int *roundtrip)
     int be = (int)(bits >> 52 & 0x7ff);
     uint64_t m = (bits & ((1ULL << 52) - 1)) | (1ULL << 52);
     int e = be - 1075; /* v = m * 2^e */
-    int x = (int)floor(log10(fabs(v)));
+    /* floor(log10 |v|) from the binary exponent: off by at most one,
+       which the loop below corrects */
+    int x = (int)floor((double)(be - 1023) * 0.30102999566398120);
     for (int tries = 0; tries < 3; tries++) {
         int s = prec - 1 - x, k = -(e + s);
         if (s < 0 || s > 31 || k < 1 || k > 64)

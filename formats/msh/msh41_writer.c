@@ -150,15 +150,14 @@ static int format_double(double v, char *buf)
 static int ascii_coord_line(writer *w, uint64_t tag)
 {
     char line[8192], *p = line, *end;
-    size_t n = 0;
-    int c;
-    while ((c = msh41_in_getc(&w->in)) >= 0) {
-        if (n + 1 >= sizeof line)
-            return -1;
-        line[n++] = (char)c;
-        if (c == '\n')
-            break;
-    }
+    size_t avail;
+    const char *buf = msh41_in_window(&w->in, sizeof line, &avail);
+    const char *nl = memchr(buf, '\n', avail);
+    size_t n = nl ? (size_t)(nl + 1 - buf) : avail;
+    if (n >= sizeof line) /* no newline in 8 KiB */
+        return -1;
+    memcpy(line, buf, n);
+    msh41_in_consume(&w->in, n, nl != NULL);
     line[n] = 0;
     if (tag == 0) {
         errno = 0;
