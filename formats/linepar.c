@@ -4,7 +4,7 @@
  * The ASCII readers know how many records a section holds (MSH block
  * headers) or can check that a line is a plain data line (INP), and each
  * record is one line, so a run of lines in the read buffer can be cut into
- * one piece per thread at line boundaries.  Each piece first counts its
+ * pieces at line boundaries (four per thread, taken as threads come free).  Each piece first counts its
  * lines (so every piece knows the index of its first line: the arrays are
  * filled at known offsets, the same bytes for any thread count), then
  * parses them.  A line the parse function refuses stops its piece; the
@@ -61,6 +61,10 @@ size_t linepar_run(const char *text, size_t len, size_t max, int threads,
                    linepar_fn fn, void *ctx, size_t *bytes)
 {
     int t = linepar_threads(threads, len);
+    /* Four pieces per thread, handed out as threads come free: on a
+       loaded machine a thread that is not running does not hold up the
+       others for its whole share. */
+    int np = t == 1 ? 1 : 4 * t > MAX_PIECES ? MAX_PIECES : 4 * t;
     if (t == 1) {
         const char *p = text;
         size_t k = parse_piece(&p, text + len, 0, max, fn, ctx);
@@ -70,10 +74,10 @@ size_t linepar_run(const char *text, size_t len, size_t max, int threads,
     const char *cut[MAX_PIECES + 1], *stop_at[MAX_PIECES], *end = text + len;
     size_t first[MAX_PIECES + 1], stop[MAX_PIECES];
     cut[0] = text;
-    cut[t] = end;
-    for (int k = 1; k < t; k++) {
-        /* the start of the first line that begins at or after k/t */
-        const char *p = text + (size_t)k * (len / (size_t)t);
+    cut[np] = end;
+    for (int k = 1; k < np; k++) {
+        /* the start of the first line that begins at or after k/np */
+        const char *p = text + (size_t)k * (len / (size_t)np);
         const char *nl = p > cut[k - 1]
                              ? memchr(p - 1, '\n', (size_t)(end - (p - 1)))
                              : NULL;
@@ -82,25 +86,25 @@ size_t linepar_run(const char *text, size_t len, size_t max, int threads,
     first[0] = 0;
 #pragma omp parallel num_threads(t)
     {
-#pragma omp for schedule(static, 1)
-        for (int k = 0; k < t; k++)
+#pragma omp for schedule(dynamic, 1)
+        for (int k = 0; k < np; k++)
             first[k + 1] = linepar_count(cut[k], cut[k + 1]);
 #pragma omp single
-        for (int k = 0; k < t; k++)
+        for (int k = 0; k < np; k++)
             first[k + 1] += first[k];
-#pragma omp for schedule(static, 1)
-        for (int k = 0; k < t; k++) {
+#pragma omp for schedule(dynamic, 1)
+        for (int k = 0; k < np; k++) {
             stop_at[k] = cut[k];
             stop[k] = parse_piece(&stop_at[k], cut[k + 1], first[k], max, fn,
                                   ctx);
         }
     }
     /* the first piece that stopped early (refused a line or reached max) */
-    for (int k = 0; k < t; k++)
+    for (int k = 0; k < np; k++)
         if (stop[k] < first[k + 1]) {
             *bytes = (size_t)(stop_at[k] - text);
             return stop[k];
         }
     *bytes = len;
-    return first[t];
+    return first[np];
 }

@@ -15,8 +15,8 @@ typedef const char *(*linepar_fn)(void *ctx, const char *line,
                                   const char *end, size_t index);
 
 /* Parse at most max lines of text[0..len) with fn (len ends a line: the
-   text's last byte is a '\n'), split at line boundaries into one piece per
-   thread.  fn must write only what belongs to its index.  Returns how
+   text's last byte is a '\n'), split at line boundaries into pieces for
+   threads threads.  fn must write only what belongs to its index.  Returns how
    many lines come before the first refused one in text order (all, up to
    max, if none), whatever the thread count: lines after a refused one may
    have been parsed too, and the caller ignores what they wrote.  *bytes

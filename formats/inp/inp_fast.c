@@ -131,7 +131,7 @@ static const char *element_line(void *vc, const char *p, const char *end,
 }
 
 #define WANT_MIN ((size_t)4096)
-#define WANT_MAX ((size_t)4 << 20)
+#define WANT_MAX ((size_t)8 << 20)
 
 size_t inp_fast_run(inp_deck *d, inp_lines *in, int nv, int threads,
                     size_t *want)

@@ -32,7 +32,7 @@
 
 #define MSH41_TOKEN_MAX 127 /* msh41_reader.c's TOK - 1 */
 #define WANT_MIN ((size_t)4096)
-#define WANT_MAX ((size_t)4 << 20)
+#define WANT_MAX ((size_t)8 << 20)
 
 /* Blanks between tokens; a line's '\n' ends every scan below (the run
    handed to linepar ends with one). */

@@ -13,9 +13,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* 4 MiB: the ASCII fast path (msh41_reader.c) parses what the buffer holds
+/* 8 MiB: the ASCII fast path (msh41_fast.c) parses what the buffer holds
    on several threads, one piece per thread. */
-#define IN_CHUNK (4u << 20)
+#define IN_CHUNK (8u << 20)
 
 int msh41_in_open(msh41_input *in, const char *path)
 {

@@ -2,7 +2,7 @@
  * test_fastpath.c -- the ASCII fast paths (formats/linepar.c, MSH
  * msh41_fast.c, INP inp_fast.c) against the readers' own line and token
  * paths, on meshes large enough for runs to be split across threads
- * (82,944 tets: megabytes of element lines, runs of up to 4 MiB):
+ * (82,944 tets: megabytes of element lines, runs of up to 8 MiB):
  *  - property: a file whose lines are randomly reshaped (blanks, tabs,
  *    CRLF, '+' signs, exponents, records split over two lines or joined,
  *    blank and comment lines; each such line is refused by the fast path
