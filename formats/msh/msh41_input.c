@@ -14,7 +14,7 @@
 #include <string.h>
 
 /* 8 MiB: the ASCII fast path (msh41_fast.c) parses what the buffer holds
-   on several threads, one piece per thread. */
+   in pieces across threads (linepar.c). */
 #define IN_CHUNK (8u << 20)
 
 int msh41_in_open(msh41_input *in, const char *path)

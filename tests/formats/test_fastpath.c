@@ -184,13 +184,28 @@ static void real_text(char *buf, double v)
     snprintf(buf, 40, rnd() % 16 == 0 ? "%.17e" : "%.17g", v);
 }
 
+/* Element e's tokens: its number and its four node numbers. */
+static void element_tokens(int e, char tbuf[5][40], const char *tok[5])
+{
+    snprintf(tbuf[0], 40, "%d", e + 1);
+    for (int k = 0; k < 4; k++)
+        snprintf(tbuf[k + 1], 40, "%d", tet[e][k] + 1);
+    for (int k = 0; k < 5; k++)
+        tok[k] = tbuf[k];
+}
+
+static void start_file(const char *path, out *o)
+{
+    o->f = fopen(path, "wb");
+    o->line = 0;
+    o->nbad = 0;
+}
+
 static void write_msh(const char *path, out *o)
 {
     char tbuf[5][40];
     const char *tok[5];
-    o->f = fopen(path, "wb");
-    o->line = 0;
-    o->nbad = 0;
+    start_file(path, o);
     put_line(o, "$MeshFormat\n4.1 0 8\n$EndMeshFormat");
     put_line(o, "$Entities\n0 0 0 1\n1 0 0 0 1 1 1 0 0\n$EndEntities");
     o->line += 5;
@@ -217,11 +232,7 @@ static void write_msh(const char *path, out *o)
     fprintf(o->f, "$Elements\n1 %d 1 %d\n3 1 4 %d\n", NE, NE, NE);
     o->line += 3;
     for (int e = 0; e < NE; e++, rec++) {
-        snprintf(tbuf[0], sizeof tbuf[0], "%d", e + 1);
-        for (int k = 0; k < 4; k++)
-            snprintf(tbuf[k + 1], sizeof tbuf[k + 1], "%d", tet[e][k] + 1);
-        for (int k = 0; k < 5; k++)
-            tok[k] = tbuf[k];
+        element_tokens(e, tbuf, tok);
         if (damaged(o, rec))
             tok[3] = "999999";
         put_record(o, tok, 5, 1, 1, e + 1 < NE);
@@ -234,9 +245,7 @@ static void write_inp(const char *path, out *o)
 {
     char tbuf[5][40];
     const char *tok[5];
-    o->f = fopen(path, "wb");
-    o->line = 0;
-    o->nbad = 0;
+    start_file(path, o);
     put_line(o, "*HEADING\nfast path test\n*NODE");
     o->line += 2;
     long rec = 0;
@@ -253,11 +262,7 @@ static void write_inp(const char *path, out *o)
     }
     put_line(o, "*ELEMENT, TYPE=C3D4, ELSET=Block");
     for (int e = 0; e < NE; e++, rec++) {
-        snprintf(tbuf[0], sizeof tbuf[0], "%d", e + 1);
-        for (int k = 0; k < 4; k++)
-            snprintf(tbuf[k + 1], sizeof tbuf[k + 1], "%d", tet[e][k] + 1);
-        for (int k = 0; k < 5; k++)
-            tok[k] = tbuf[k];
+        element_tokens(e, tbuf, tok);
         if (damaged(o, rec))
             tok[2] = "0";
         put_record(o, tok, 5, 0, 1, 0);
@@ -383,7 +388,7 @@ static void run_format(int msh)
             if (t == 0)
                 snprintf(first_error, sizeof first_error, "%s", r.error);
             CHECK(strcmp(r.error, first_error) == 0);
-            if (strstr(r.error, want) != r.error || t == 0)
+            if (strstr(r.error, want) != r.error)
                 fprintf(stderr, "%s seed %d, %d threads: %s (want '%s')\n",
                         name, seed, THREADS[t], r.error, want);
             free_result(&r);
