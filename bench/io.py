@@ -9,9 +9,8 @@ it: compile tests/formats/io_bench.c against that build with
 -Dnum_threads=verbose and give it OMP_NUM_THREADS; this script sets both).
 Per file, thread count and build, runs alternate build by build:
     io_bench FILE OUT --threads T --move --no-skin
-under `perf record -F 999` (one-thread runs only), so every node is free
-and every node line is rewritten (the worst case of a smoothing run's
-output), without the boundary search.  Columns:
+so every node is free and every node line is rewritten (the worst case of
+a smoothing run's output), without the boundary search.  Columns:
   read s / write s  the wall time of getme_doc_open / getme_doc_write;
   reader CPU s      (one thread) CPU samples of a separate read-only run
                     under `perf record -F 999`, outside libgetme.so: the
