@@ -31,7 +31,6 @@
 
 static double xyz[3 * NN];
 static int32_t tet[NE][4];
-static char dir[256];
 
 static uint64_t rng_state;
 static uint32_t rnd(void)
@@ -95,15 +94,6 @@ static void make_mesh(void)
                     }
                     e++;
                 }
-}
-
-static const char *tpath(const char *name)
-{
-    static char buf[4][512];
-    static int k;
-    k = (k + 1) % 4;
-    snprintf(buf[k], sizeof buf[k], "%s/%s", dir, name);
-    return buf[k];
 }
 
 /* ---- writing the files, with reshaped and damaged lines ----------------- */
@@ -331,8 +321,8 @@ static void run_format(int msh)
     out o;
     memset(&o, 0, sizeof o);
     o.mode = PLAIN;
-    (msh ? write_msh : write_inp)(tpath(name), &o);
-    result plain = read_file(tpath(name), 1);
+    (msh ? write_msh : write_inp)(name, &o);
+    result plain = read_file(name, 1);
     CHECK(plain.st == GETME_FORMATS_OK);
     CHECK_EQ_INT(plain.nn, NN);
     CHECK_EQ_INT(plain.ne, NE);
@@ -342,7 +332,7 @@ static void run_format(int msh)
         exact = plain.x[i] == xyz[i];
     CHECK(exact);
     for (int t = 1; t < NT; t++) {
-        result r = read_file(tpath(name), THREADS[t]);
+        result r = read_file(name, THREADS[t]);
         CHECK(same_mesh(&plain, &r));
         free_result(&r);
     }
@@ -353,9 +343,9 @@ static void run_format(int msh)
         rng_state = 1000 + (uint64_t)seed + 100 * (uint64_t)msh;
         o.mode = RESHAPE;
         o.one_in = one_in[seed - 1];
-        (msh ? write_msh : write_inp)(tpath(name), &o);
+        (msh ? write_msh : write_inp)(name, &o);
         for (int t = 0; t < NT; t++) {
-            result r = read_file(tpath(name), THREADS[t]);
+            result r = read_file(name, THREADS[t]);
             CHECK(same_mesh(&plain, &r));
             if (r.st != GETME_FORMATS_OK)
                 fprintf(stderr, "reshaped %s seed %d: %s\n", name, seed,
@@ -369,20 +359,20 @@ static void run_format(int msh)
         o.mode = DAMAGE;
         o.damage_at[0] = (long)(rnd() % (uint32_t)nrec);
         o.damage_at[1] = seed % 2 ? (long)(rnd() % (uint32_t)nrec) : -1;
-        (msh ? write_msh : write_inp)(tpath(name), &o);
+        (msh ? write_msh : write_inp)(name, &o);
         long first = o.bad_line[0];
         for (int k = 1; k < o.nbad; k++)
             if (o.bad_line[k] < first)
                 first = o.bad_line[k];
         char want[600];
         if (msh)
-            snprintf(want, sizeof want, "'%s', line %ld: ", tpath(name),
+            snprintf(want, sizeof want, "'%s', line %ld: ", name,
                      first);
         else
-            snprintf(want, sizeof want, "%s:%ld: ", tpath(name), first);
+            snprintf(want, sizeof want, "%s:%ld: ", name, first);
         char first_error[1024] = "";
         for (int t = 0; t < NT; t++) {
-            result r = read_file(tpath(name), THREADS[t]);
+            result r = read_file(name, THREADS[t]);
             CHECK(r.st != GETME_FORMATS_OK);
             CHECK(strstr(r.error, want) == r.error);
             if (t == 0)
@@ -399,15 +389,16 @@ static void run_format(int msh)
 
 int main(void)
 {
+    /* the files go to a folder of their own, named in the messages */
+    char dir[64], cmd[128];
     snprintf(dir, sizeof dir, "fastpath-%ld", (long)getpid());
-    char cmd[300];
     snprintf(cmd, sizeof cmd, "mkdir -p %s", dir);
-    if (system(cmd) != 0)
+    if (system(cmd) != 0 || chdir(dir) != 0)
         return 1;
     make_mesh();
     run_format(1);
     run_format(0);
-    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+    snprintf(cmd, sizeof cmd, "cd .. && rm -rf %s", dir);
     if (system(cmd) != 0)
         return 1;
     return check_summary("test_fastpath");
