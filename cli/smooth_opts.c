@@ -142,6 +142,18 @@ int cli_smooth_option(cli_smooth_opts *o, int argc, char **argv, int *i)
     return 1;
 }
 
+/* Gmsh's initialisation sets OpenMP's global thread count to 1, so
+   "default" must be decided here: OMP_NUM_THREADS if set, else every
+   core. */
+static int threads_or_default(int requested)
+{
+    if (requested)
+        return requested;
+    const char *env = getenv("OMP_NUM_THREADS");
+    int n = env ? atoi(env) : 0;
+    return n > 0 ? n : omp_get_num_procs();
+}
+
 void cli_smooth_doc_options(const cli_smooth_opts *o, getme_doc_options *d)
 {
     getme_doc_options_init(d);
@@ -151,6 +163,8 @@ void cli_smooth_doc_options(const cli_smooth_opts *o, getme_doc_options *d)
     d->num_free = o->num_free;
     d->fix_interfaces = !o->free_interfaces;
     d->verbose = o->log.verbose;
+    /* the ASCII readers parse with the smoothing's threads */
+    d->num_threads = threads_or_default(o->params.num_threads);
 }
 
 int cli_smooth_progress(const getme_progress *p, void *data)
@@ -192,14 +206,7 @@ int cli_smooth_progress(const getme_progress *p, void *data)
 
 void cli_smooth_threads(cli_smooth_opts *o)
 {
-    /* Gmsh's initialisation sets OpenMP's global thread count to 1, so
-       "default" must be decided here: OMP_NUM_THREADS if set, else every
-       core. */
-    if (!o->params.num_threads) {
-        const char *env = getenv("OMP_NUM_THREADS");
-        int n = env ? atoi(env) : 0;
-        o->params.num_threads = n > 0 ? n : omp_get_num_procs();
-    }
+    o->params.num_threads = threads_or_default(o->params.num_threads);
 }
 
 void cli_untangle_warning(const cli_log *log, const getme_untangle_result *ur)

@@ -84,6 +84,9 @@ typedef struct getme_doc_options {
        (the native MSH reader declines MSH 4.0, parametric nodes...).  The
        getme command passes getme_gmsh_format() of libgetme_gmsh here. */
     const getme_format *const *adapters;
+    /* Threads the ASCII readers parse with (0: OpenMP's default, 1: the
+       calling thread only).  The document is the same for any value. */
+    int num_threads;
 } getme_doc_options;
 
 /* Fill options with the defaults (fix skin and interfaces, no names, no

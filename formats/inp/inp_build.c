@@ -16,6 +16,7 @@
 
 #include <stdarg.h>
 #include <stdio.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -39,13 +40,19 @@ static const char *where(const inp_deck *d, int file, uint32_t line,
     return buf;
 }
 
-/* Block holding element e (read order). */
-static size_t block_of(const inp_deck *d, int32_t e)
+/* Index of the last of n blocks (stride bytes apart, each with its first
+   index as an int32_t at byte offset off, in increasing order) whose
+   first index is at most i: the block holding i. */
+static size_t block_holding(const void *blocks, size_t n, size_t stride,
+                            size_t off, int32_t i)
 {
-    size_t lo = 0, hi = d->neblocks;
+    const char *b = blocks;
+    size_t lo = 0, hi = n;
     while (hi - lo > 1) {
         size_t mid = (lo + hi) / 2;
-        if (d->eblocks[mid].first <= e)
+        int32_t first;
+        memcpy(&first, b + mid * stride + off, sizeof first);
+        if (first <= i)
             lo = mid;
         else
             hi = mid;
@@ -53,17 +60,17 @@ static size_t block_of(const inp_deck *d, int32_t e)
     return lo;
 }
 
+/* Block holding element e / node n (read order). */
+static size_t block_of(const inp_deck *d, int32_t e)
+{
+    return block_holding(d->eblocks, d->neblocks, sizeof *d->eblocks,
+                         offsetof(inp_elem_block, first), e);
+}
+
 static size_t nblock_of(const inp_deck *d, int32_t n)
 {
-    size_t lo = 0, hi = d->nnblocks;
-    while (hi - lo > 1) {
-        size_t mid = (lo + hi) / 2;
-        if (d->nblocks[mid].first <= n)
-            lo = mid;
-        else
-            hi = mid;
-    }
-    return lo;
+    return block_holding(d->nblocks, d->nnblocks, sizeof *d->nblocks,
+                         offsetof(inp_node_block, first), n);
 }
 
 /* ---- id maps -------------------------------------------------------------- */

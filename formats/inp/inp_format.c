@@ -5,6 +5,7 @@
  */
 #include "inp_internal.h"
 
+#include <omp.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -42,7 +43,9 @@ static getme_formats_status inp_open(getme_doc *doc, const getme_doc_options *op
     }
     inp_deck deck;
     memset(&deck, 0, sizeof deck);
-    getme_formats_status st = inp_read(&deck, doc->path, doc);
+    int threads = opts->num_threads > 0 ? opts->num_threads
+                                        : omp_get_max_threads();
+    getme_formats_status st = inp_read(&deck, doc->path, doc, threads);
     if (st == GETME_FORMATS_OK)
         st = inp_build(&deck, doc, opts);
     inp_deck_free(&deck);

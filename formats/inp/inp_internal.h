@@ -65,6 +65,12 @@ int inp_lines_open(inp_lines *r, const char *path);
 int inp_lines_next(inp_lines *r);
 void inp_lines_close(inp_lines *r);
 
+/* The unread bytes of the buffer, want of them if the file has them (the
+   buffer grows to want): *avail gets how many there are.  For the fast
+   path (inp_fast.c), which consumes whole lines with inp_lines_consume. */
+const char *inp_lines_window(inp_lines *r, size_t want, size_t *avail);
+void inp_lines_consume(inp_lines *r, size_t bytes, size_t lines);
+
 enum { INP_LINE_BLANK, INP_LINE_COMMENT, INP_LINE_KEYWORD, INP_LINE_DATA };
 int inp_line_kind(const char *text, size_t len);
 
@@ -267,9 +273,22 @@ enum { INP_LOOKUP_NSET = 0, INP_LOOKUP_ELSET = 1, INP_LOOKUP_PART = 2,
        INP_LOOKUP_INSTANCE = 3 };
 int64_t inp_lookup_key(int what, int scope, int32_t name);
 
-/* Read path and its includes into deck.  On failure the message (one line,
+/* Read path and its includes into deck, plain data lines on threads
+   threads (inp_fast.c).  On failure the message (one line,
    "file:line: ...") is in doc->error. */
-getme_formats_status inp_read(inp_deck *deck, const char *path, getme_doc *doc);
+getme_formats_status inp_read(inp_deck *deck, const char *path, getme_doc *doc,
+                              int threads);
+/* Room for n nodes / elements in the deck's per-node / per-element arrays
+   (they grow together): 0 or -1. */
+int inp_reserve_nodes(inp_deck *deck, size_t n);
+int inp_reserve_elems(inp_deck *deck, size_t n);
+/* Parse the plain *NODE (nv 0) or *ELEMENT (nv nodes each) data lines at
+   the reader's position into the deck, on threads threads; stops before
+   the first other line.  Returns how many lines were taken (the caller
+   counts them into its open block).  *want is the window size, kept by
+   the caller between calls. */
+size_t inp_fast_run(inp_deck *deck, inp_lines *in, int nv, int threads,
+                    size_t *want);
 void inp_deck_free(inp_deck *deck);
 
 /* Where an element / node was read, for messages: "file:line". */

@@ -4,6 +4,7 @@
  * size is read with constant memory for its text.
  */
 #include "inp_internal.h"
+#include "numformat.h"
 #include "numparse.h"
 
 #include <errno.h>
@@ -211,19 +212,58 @@ int inp_format_real(double v, char *buf)
 {
     /* Abaqus reads at most 20 characters per real field.  Values that came
        from short decimal text come back short (%.15g); anything else gets
-       the 17 significant digits that always read back to the same double. */
-    int n = snprintf(buf, 32, "%.15g", v);
-    if (n <= 20 && strtod(buf, NULL) == v)
+       the 17 significant digits that always read back to the same double.
+       numformat_g is snprintf's "%.*g" without printf's cost. */
+    int back;
+    int n = numformat_g(v, 15, buf, &back);
+    if (n <= 20 && back)
         return n;
-    n = snprintf(buf, 32, "%.17g", v);
+    n = numformat_g(v, 17, buf, NULL);
     if (n <= 20)
         return n;
     /* Tiny or huge magnitudes with a long exponent: as many digits as fit
        (a relative change below 1e-15, on a free node only). */
     for (int prec = 16; prec > 1; prec--) {
-        n = snprintf(buf, 32, "%.*g", prec, v);
+        n = numformat_g(v, prec, buf, NULL);
         if (n <= 20)
             return n;
     }
-    return snprintf(buf, 32, "%.1g", v);
+    return numformat_g(v, 1, buf, NULL);
+}
+
+const char *inp_lines_window(inp_lines *r, size_t want, size_t *avail)
+{
+    /* Refill when less than want is left, or less than 1/16 of the
+       buffer: a refill moves what is left to the front, at most a 16th of
+       what it then reads. */
+    size_t low = want < r->cap / 16 ? want : r->cap / 16;
+    if (r->end - r->beg < low && !r->eof) {
+        if (r->beg > 0) {
+            memmove(r->buf, r->buf + r->beg, r->end - r->beg);
+            r->end -= r->beg;
+            r->beg = 0;
+        }
+        if (want > r->cap) {
+            char *b = realloc(r->buf, want + 1);
+            if (b) {
+                r->buf = b;
+                r->cap = want;
+            }
+        }
+        size_t got = fread(r->buf + r->end, 1, r->cap - r->end, r->fp);
+        if (got == 0 && !ferror(r->fp))
+            r->eof = 1; /* a read error shows at the next inp_lines_next */
+        r->end += got;
+    }
+    size_t n = r->end - r->beg;
+    *avail = n < want ? n : want;
+    return r->buf + r->beg;
+}
+
+void inp_lines_consume(inp_lines *r, size_t bytes, size_t lines)
+{
+    r->beg += bytes;
+    r->next_offset += (int64_t)bytes;
+    r->offset = r->next_offset;
+    r->lineno += (uint32_t)lines;
 }

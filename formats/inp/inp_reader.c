@@ -49,6 +49,8 @@ typedef struct reader {
     int extra_file;
     uint32_t extra_line;
     int32_t extra_elem;
+    int threads;           /* for the fast path (inp_fast.c)             */
+    size_t fast_want;      /* its window                                  */
     int depth;
     dev_t dev[INP_MAX_DEPTH + 1];
     ino_t ino[INP_MAX_DEPTH + 1];
@@ -180,6 +182,33 @@ static getme_formats_status open_node_block(reader *rd, int64_t offset)
     return GETME_FORMATS_OK;
 }
 
+int inp_reserve_nodes(inp_deck *d, size_t n)
+{
+    size_t cap = d->cap_nodes;
+    if (n <= cap)
+        return 0;
+    /* The per-node arrays grow together. */
+    size_t c1 = cap, c2 = cap, c3 = cap;
+    if (inp_reserve((void **)&d->node_id, &c1, n, sizeof *d->node_id) ||
+        inp_reserve((void **)&d->node_line, &c2, n, sizeof *d->node_line) ||
+        inp_reserve((void **)&d->xyz, &c3, n, 3 * sizeof *d->xyz))
+        return -1;
+    d->cap_nodes = c1;
+    return c2 != c1 || c3 != c1 ? -1 : 0; /* cannot differ: same doubling */
+}
+
+int inp_reserve_elems(inp_deck *d, size_t n)
+{
+    if (n <= d->cap_elems)
+        return 0;
+    size_t c1 = d->cap_elems, c2 = d->cap_elems;
+    if (inp_reserve((void **)&d->elem_id, &c1, n, sizeof *d->elem_id) ||
+        inp_reserve((void **)&d->elem_line, &c2, n, sizeof *d->elem_line))
+        return -1;
+    d->cap_elems = c1;
+    return c2 != c1 ? -1 : 0;
+}
+
 static getme_formats_status node_line(reader *rd, const char *text, size_t len,
                                  int64_t offset)
 {
@@ -207,19 +236,8 @@ static getme_formats_status node_line(reader *rd, const char *text, size_t len,
         return fail(rd, GETME_FORMATS_ERR_UNSUPPORTED, "more than %d nodes",
                     INT32_MAX / 3 - 1);
     size_t n = (size_t)d->nnodes;
-    size_t cap = d->cap_nodes;
-    if (n + 1 > cap) {
-        /* The four per-node arrays grow together. */
-        size_t c1 = cap, c2 = cap, c3 = cap;
-        if (inp_reserve((void **)&d->node_id, &c1, n + 1, sizeof *d->node_id) ||
-            inp_reserve((void **)&d->node_line, &c2, n + 1,
-                        sizeof *d->node_line) ||
-            inp_reserve((void **)&d->xyz, &c3, n + 1, 3 * sizeof *d->xyz))
-            return nomem(rd);
-        d->cap_nodes = c1;
-        if (c2 != c1 || c3 != c1)
-            return nomem(rd); /* cannot happen: same doubling */
-    }
+    if (inp_reserve_nodes(d, n + 1))
+        return nomem(rd);
     d->node_id[n] = (int32_t)id;
     d->node_line[n] = rd->line;
     memcpy(&d->xyz[3 * n], x, sizeof x);
@@ -280,14 +298,8 @@ static getme_formats_status start_element(reader *rd, const inp_field *f)
     if (d->nelems >= INT32_MAX - 1)
         return fail(rd, GETME_FORMATS_ERR_UNSUPPORTED, "too many elements");
     size_t n = (size_t)d->nelems;
-    if (n + 1 > d->cap_elems) {
-        size_t c1 = d->cap_elems, c2 = d->cap_elems;
-        if (inp_reserve((void **)&d->elem_id, &c1, n + 1, sizeof *d->elem_id) ||
-            inp_reserve((void **)&d->elem_line, &c2, n + 1,
-                        sizeof *d->elem_line))
-            return nomem(rd);
-        d->cap_elems = c1;
-    }
+    if (inp_reserve_elems(d, n + 1))
+        return nomem(rd);
     d->elem_id[n] = (int32_t)id;
     d->elem_line[n] = rd->line;
     d->nelems++;
@@ -843,6 +855,30 @@ static getme_formats_status line(reader *rd, inp_lines *in)
     return data_line(rd, in->text, in->len, in->offset);
 }
 
+/* Inside a *NODE block, or an *ELEMENT block of a fixed-size type between
+   elements, once its first line opened the block in this file: the plain
+   data lines that follow go through the fast path, which stops at the
+   first other line (read by line() as always). */
+static void fast_lines(reader *rd, inp_lines *in)
+{
+    inp_deck *d = rd->d;
+    if (rd->kw_open)
+        return;
+    if (rd->mode == M_NODE && rd->nblock >= 0 &&
+        d->nblocks[rd->nblock].file == rd->file) {
+        size_t got = inp_fast_run(d, in, 0, rd->threads, &rd->fast_want);
+        d->nblocks[rd->nblock].count += (int32_t)got;
+    } else if (rd->mode == M_ELEMENT && rd->eblock >= 0 &&
+               d->eblocks[rd->eblock].file == rd->file && rd->pending < 0 &&
+               rd->nv > 0) {
+        size_t got = inp_fast_run(d, in, rd->nv, rd->threads, &rd->fast_want);
+        d->eblocks[rd->eblock].count += (int32_t)got;
+        d->eblocks[rd->eblock].conn_end = d->nconn;
+        d->count_kind[rd->kind] += (int32_t)got;
+    }
+    rd->line = in->lineno;
+}
+
 static getme_formats_status add_file(reader *rd, const char *path, int parent,
                                 inp_lines *in)
 {
@@ -892,7 +928,10 @@ static getme_formats_status read_file(reader *rd, const char *path, int parent)
     }
     rd->depth++;
     int rc;
-    while ((rc = inp_lines_next(&in)) == 1) {
+    for (;;) {
+        fast_lines(rd, &in);
+        if ((rc = inp_lines_next(&in)) != 1)
+            break;
         rd->line = in.lineno;
         if ((st = line(rd, &in)))
             break;
@@ -915,7 +954,8 @@ static getme_formats_status read_file(reader *rd, const char *path, int parent)
     return st;
 }
 
-getme_formats_status inp_read(inp_deck *d, const char *path, getme_doc *doc)
+getme_formats_status inp_read(inp_deck *d, const char *path, getme_doc *doc,
+                              int threads)
 {
     reader *rd = calloc(1, sizeof *rd);
     if (!rd)
@@ -927,6 +967,7 @@ getme_formats_status inp_read(inp_deck *d, const char *path, getme_doc *doc)
     rd->nblock = rd->eblock = -1;
     rd->set = rd->chunk = -1;
     rd->pending = -1;
+    rd->threads = threads;
     getme_formats_status st = GETME_FORMATS_OK;
     if (new_scope(rd, INP_SCOPE_MODEL, -1) != 0)
         st = nomem(rd);

@@ -13,7 +13,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define IN_CHUNK (1u << 20)
+/* 8 MiB: the ASCII fast path (msh41_fast.c) parses what the buffer holds
+   in pieces across threads (linepar.c). */
+#define IN_CHUNK (8u << 20)
+/* What a refill reads unless the fast path asks for more: copying the
+   file through (the writer's echo) is faster through a buffer that stays
+   in the cache. */
+#define IN_READ (1u << 20)
 
 int msh41_in_open(msh41_input *in, const char *path)
 {
@@ -66,7 +72,7 @@ static int refill(msh41_input *in)
     echo_flush(in);
     in->base += (int64_t)in->len;
     in->pos = in->echo_from = 0;
-    in->len = in->f ? fread(in->buf, 1, IN_CHUNK, in->f) : 0;
+    in->len = in->f ? fread(in->buf, 1, IN_READ, in->f) : 0;
     return in->len ? 0 : -1;
 }
 
@@ -164,4 +170,32 @@ int msh41_in_eol(msh41_input *in)
     if (c == '\n')
         msh41_in_getc(in);
     return c == '\n' || c < 0;
+}
+
+const char *msh41_in_window(msh41_input *in, size_t want, size_t *avail)
+{
+    if (want > IN_CHUNK)
+        want = IN_CHUNK;
+    /* Refill when less than want is left, or less than 1/16 of the
+       buffer: a refill moves what is left to the front, at most a 16th of
+       what it then reads. */
+    if (in->len - in->pos < (want < IN_CHUNK / 16 ? want : IN_CHUNK / 16) &&
+        in->f) {
+        echo_flush(in);
+        size_t tail = in->len - in->pos;
+        memmove(in->buf, in->buf + in->pos, tail);
+        in->base += (int64_t)in->pos;
+        in->pos = in->echo_from = 0;
+        size_t fill = want > IN_READ ? want : IN_READ;
+        in->len = tail + fread(in->buf + tail, 1, fill - tail, in->f);
+    }
+    size_t n = in->len - in->pos;
+    *avail = n < want ? n : want;
+    return (const char *)in->buf + in->pos;
+}
+
+void msh41_in_consume(msh41_input *in, size_t bytes, long lines)
+{
+    in->pos += bytes;
+    in->line += lines;
 }

@@ -60,6 +60,11 @@ int msh41_in_eol(msh41_input *in);
 void msh41_in_skip_space(msh41_input *in);
 /* Start / stop copying consumed bytes to out (NULL stops). */
 void msh41_in_echo(msh41_input *in, FILE *out);
+/* The unread bytes, want of them (at most the buffer) if the file still
+   has them: *avail gets how many are there.  The text is not NUL-ended. */
+const char *msh41_in_window(msh41_input *in, size_t want, size_t *avail);
+/* Consume bytes of the window, holding lines newlines. */
+void msh41_in_consume(msh41_input *in, size_t bytes, long lines);
 
 /* ---- element types and node tags: the shared model code (formats/model) */
 
@@ -159,6 +164,7 @@ typedef struct msh41_reader {
     msh41_nblock *nb;
     size_t nnb;
     msh41_nodemap map;        /* tag -> file index (later mesh index) */
+    int tags_run;             /* tags[i] == tags[0] + i (4.1 elements)   */
     msh41_eblock *eb;
     size_t neb, cap_eb;
     int top_dim;
@@ -171,6 +177,8 @@ typedef struct msh41_reader {
     int (*ent22)[3];          /* (dim, elementary, physical) seen         */
     size_t nent22, cap_ent22;
     size_t cap_cur;           /* room in the last element block            */
+    int threads;              /* for the ASCII fast path                   */
+    size_t fast_want;         /* its window (msh41_fast.c)                 */
 } msh41_reader;
 
 /* Error at the current position: "'file', line N: ..." (ASCII) or
@@ -187,6 +195,32 @@ msh41_entity *msh41_find_entity(const msh41_reader *r, int dim, int tag);
 const char *msh41_group_name(const msh41_reader *r, int dim, int tag);
 /* Everything after parsing: mesh, fixed nodes, regions, ids, info. */
 getme_formats_status msh41_build(msh41_reader *r, msh41_doc *m);
+/* Store element i of block b (NULL: a dropped block) from rec = tag + nv
+   node tags, flagging its nodes if fix: 0, or 1 + k if node k repeats an
+   earlier one of a kept element, or -(1 + k) if node k is not in $Nodes. */
+int msh41_store_element(msh41_reader *r, msh41_eblock *b, size_t i,
+                        const uint64_t *rec, int nv, int fix);
+
+/* ---- ASCII fast path (msh41_fast.c) -------------------------------------- */
+
+enum { MSH41_FAST_TAGS, MSH41_FAST_COORDS, MSH41_FAST_ELEMENTS };
+#define MSH41_MAX_REC 128 /* element tag + node tags of one ASCII record */
+
+typedef struct msh41_fast_job {
+    int kind;                 /* MSH41_FAST_*                               */
+    uint64_t *tags;           /* TAGS: node tags of the block               */
+    double *xyz;              /* COORDS: 3 per node of the block            */
+    msh41_eblock *b;          /* ELEMENTS: the block (NULL: dropped)        */
+    int nv, fix;              /* ELEMENTS: nodes per element, --fix group    */
+} msh41_fast_job;
+
+/* Read records first, first + 1, ... (at most n) of an ASCII run, one per
+   line, from the current position, on r->threads threads; stops before
+   the first line that is not one plain record (the token reader takes
+   it).  Returns how many were read. */
+size_t msh41_fast(msh41_reader *r, const msh41_fast_job *job, size_t first,
+                  size_t n);
+
 /* Node tag -> index of tags[0..n) (tag 0 and repeated tags refused). */
 getme_formats_status msh41_map_build(msh41_reader *r, msh41_nodemap *map,
                                 const uint64_t *tags, size_t n);

@@ -18,6 +18,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <omp.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -490,9 +491,19 @@ static getme_formats_status read_node_tags(msh41_reader *r, uint64_t *tags,
                                       size_t n)
 {
     if (!r->binary) {
+        msh41_fast_job job = {MSH41_FAST_TAGS, tags, NULL, NULL, 0, 0};
         getme_formats_status st = GETME_FORMATS_OK;
-        for (size_t i = 0; i < n && st == GETME_FORMATS_OK; i++)
-            st = read_u64(r, &tags[i], "node tag");
+        /* the header's newline: every message after it names a later
+           token's line anyway */
+        int line_start = n ? msh41_in_eol(&r->in) : 1;
+        for (size_t i = 0; i < n && st == GETME_FORMATS_OK;) {
+            if (line_start)
+                i += msh41_fast(r, &job, i, n - i);
+            if (i == n)
+                break;
+            st = read_u64(r, &tags[i++], "node tag");
+            line_start = msh41_in_eol(&r->in);
+        }
         return st;
     }
     if (msh41_in_read(&r->in, tags, n * 8))
@@ -533,8 +544,12 @@ static getme_formats_status read_node_coords(msh41_reader *r, double *xyz,
                 return not_finite(r, tags[i], xyz + 3 * i);
         return GETME_FORMATS_OK;
     }
+    msh41_fast_job job = {MSH41_FAST_COORDS, NULL, xyz, NULL, 0, 0};
     getme_formats_status st = GETME_FORMATS_OK;
     for (size_t i = 0; i < n && st == GETME_FORMATS_OK; i++) {
+        i += msh41_fast(r, &job, i, n - i); /* every record ends a line */
+        if (i == n)
+            break;
         for (int k = 0; k < 3 && st == GETME_FORMATS_OK; k++)
             st = read_double(r, &xyz[3 * i + k]);
         if (st == GETME_FORMATS_OK && !finite3(xyz + 3 * i))
@@ -543,6 +558,17 @@ static getme_formats_status read_node_coords(msh41_reader *r, double *xyz,
             st = msh41_decline(r, "node coordinates not one node per line");
     }
     return st;
+}
+
+/* Are the tags n consecutive numbers in order (Gmsh numbers its nodes
+   so)?  Then a tag's index is tag - tags[0], without the map's table,
+   whose random reads cost more than parsing an element line. */
+static int tags_run(const uint64_t *tags, size_t n)
+{
+    for (size_t i = 1; i < n; i++)
+        if (tags[i] != tags[0] + i)
+            return 0;
+    return n > 0;
 }
 
 static getme_formats_status read_node_block(msh41_reader *r, size_t *filled)
@@ -616,6 +642,8 @@ static getme_formats_status read_nodes(msh41_reader *r)
         st = expect_end(r);
     if (st == GETME_FORMATS_OK)
         st = msh41_map_build(r, &r->map, r->tags, r->nnodes);
+    if (st == GETME_FORMATS_OK)
+        r->tags_run = tags_run(r->tags, r->nnodes);
     return st;
 }
 
@@ -670,27 +698,26 @@ static getme_formats_status new_eblock(msh41_reader *r, int dim, int tag,
 }
 
 /* One element: rec = tag + nv node tags.  Nodes must exist (as for Gmsh's
-   reader); kept blocks store file indices, --fix groups flag nodes. */
-static getme_formats_status take_element(msh41_reader *r, msh41_eblock *b,
-                                    size_t i, const uint64_t *rec, int nv,
-                                    int fix)
+   reader); kept blocks store file indices, --fix groups flag nodes.  0, or
+   1 + k if node k repeats an earlier node of a kept element, or -(1 + k)
+   if node k is not in $Nodes (nothing is reported: the fast path refuses
+   such a line and take_element says what is wrong). */
+int msh41_store_element(msh41_reader *r, msh41_eblock *b, size_t i,
+                        const uint64_t *rec, int nv, int fix)
 {
     for (int k = 0; k < nv; k++) {
         for (int j = 0; b && b->conn && j < k; j++)
             if (rec[1 + j] == rec[1 + k])
-                return msh41_fail(r, GETME_FORMATS_ERR_INVALID,
-                                  "element %llu is degenerate: node %llu "
-                                  "appears twice; getme smooths valid meshes "
-                                  "only",
-                                  (unsigned long long)rec[0],
-                                  (unsigned long long)rec[1 + k]);
-        int32_t idx = msh41_map_find(&r->map, rec[1 + k]);
+                return 1 + k;
+        int32_t idx;
+        if (r->tags_run) { /* tags first, first + 1, ...: no table */
+            uint64_t d = rec[1 + k] - r->tags[0];
+            idx = d < r->nnodes ? (int32_t)d : -1;
+        } else {
+            idx = msh41_map_find(&r->map, rec[1 + k]);
+        }
         if (idx < 0)
-            return msh41_fail(r, GETME_FORMATS_ERR_PARSE,
-                              "element %llu uses node %llu, which is not in "
-                              "$Nodes",
-                              (unsigned long long)rec[0],
-                              (unsigned long long)rec[1 + k]);
+            return -(1 + k);
         if (fix)
             r->flag[idx] |= MSH41_FIXGRP;
         if (b && b->conn)
@@ -698,6 +725,27 @@ static getme_formats_status take_element(msh41_reader *r, msh41_eblock *b,
     }
     if (b && b->ids)
         b->ids[i] = (int64_t)rec[0];
+    return 0;
+}
+
+static getme_formats_status take_element(msh41_reader *r, msh41_eblock *b,
+                                    size_t i, const uint64_t *rec, int nv,
+                                    int fix)
+{
+    int rc = msh41_store_element(r, b, i, rec, nv, fix);
+    if (rc > 0)
+        return msh41_fail(r, GETME_FORMATS_ERR_INVALID,
+                          "element %llu is degenerate: node %llu "
+                          "appears twice; getme smooths valid meshes "
+                          "only",
+                          (unsigned long long)rec[0],
+                          (unsigned long long)rec[rc]);
+    if (rc < 0)
+        return msh41_fail(r, GETME_FORMATS_ERR_PARSE,
+                          "element %llu uses node %llu, which is not in "
+                          "$Nodes",
+                          (unsigned long long)rec[0],
+                          (unsigned long long)rec[-rc]);
     return GETME_FORMATS_OK;
 }
 
@@ -727,17 +775,26 @@ static getme_formats_status read_binary_elements(msh41_reader *r, msh41_eblock *
     return st;
 }
 
+/* Records the fast path (msh41_fast.c) refuses are read here, one at a
+   time; after one, the fast path goes on if a new line starts. */
 static getme_formats_status read_ascii_elements(msh41_reader *r, msh41_eblock *b,
                                            uint64_t count, int nv, int fix)
 {
-    uint64_t rec[128];
+    uint64_t rec[MSH41_MAX_REC];
+    msh41_fast_job job = {MSH41_FAST_ELEMENTS, NULL, NULL, b, nv, fix};
     getme_formats_status st = GETME_FORMATS_OK;
-    for (uint64_t i = 0; i < count && st == GETME_FORMATS_OK; i++) {
+    int line_start = count ? msh41_in_eol(&r->in) : 1; /* header's end */
+    for (size_t i = 0; i < count && st == GETME_FORMATS_OK;) {
+        if (line_start)
+            i += msh41_fast(r, &job, i, (size_t)count - i);
+        if (i == count)
+            break;
         st = read_u64(r, &rec[0], "element tag");
         for (int k = 0; k < nv && st == GETME_FORMATS_OK; k++)
             st = read_u64(r, &rec[1 + k], "node tag");
         if (st == GETME_FORMATS_OK)
-            st = take_element(r, b, (size_t)i, rec, nv, fix);
+            st = take_element(r, b, i++, rec, nv, fix);
+        line_start = msh41_in_eol(&r->in);
     }
     return st;
 }
@@ -1294,6 +1351,8 @@ getme_formats_status msh41_open(getme_doc *doc, const getme_doc_options *opts,
         return getme_doc_fail(doc, GETME_FORMATS_ERR_OPEN, "Cannot open '%s': %s",
                               doc->path, strerror(errno));
     }
+    r.threads = opts && opts->num_threads > 0 ? opts->num_threads
+                                                : omp_get_max_threads();
     remember_identity(m, r.in.f);
     r.file_size = m->size > 0 ? m->size : 1;
     getme_formats_status st = read_file(&r);

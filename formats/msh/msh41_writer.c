@@ -18,6 +18,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "msh41_internal.h"
+#include "numformat.h"
 #include "numparse.h"
 
 #include <errno.h>
@@ -134,15 +135,12 @@ static int ascii_u64(writer *w, uint64_t *v)
     return *end || errno ? -1 : 0;
 }
 
-/* Shortest of %.15g/%.16g/%.17g that reads back to v. */
-static int format_double(double v, char *buf, size_t size)
+/* Shortest of %.15g/%.16g/%.17g that reads back to v (buf: 32 bytes). */
+static int format_double(double v, char *buf)
 {
-    int n = 0;
-    for (int prec = 15; prec <= 17; prec++) {
-        n = snprintf(buf, size, "%.*g", prec, v);
-        if (numparse_strtod(buf, NULL) == v)
-            break;
-    }
+    int n = 0, back = 0;
+    for (int prec = 15; prec <= 17 && !back; prec++)
+        n = numformat_g(v, prec, buf, &back);
     return n;
 }
 
@@ -152,15 +150,14 @@ static int format_double(double v, char *buf, size_t size)
 static int ascii_coord_line(writer *w, uint64_t tag)
 {
     char line[8192], *p = line, *end;
-    size_t n = 0;
-    int c;
-    while ((c = msh41_in_getc(&w->in)) >= 0) {
-        if (n + 1 >= sizeof line)
-            return -1;
-        line[n++] = (char)c;
-        if (c == '\n')
-            break;
-    }
+    size_t avail;
+    const char *buf = msh41_in_window(&w->in, sizeof line, &avail);
+    const char *nl = memchr(buf, '\n', avail);
+    size_t n = nl ? (size_t)(nl + 1 - buf) : avail;
+    if (n >= sizeof line) /* no newline in 8 KiB */
+        return -1;
+    memcpy(line, buf, n);
+    msh41_in_consume(&w->in, n, nl != NULL);
     line[n] = 0;
     if (tag == 0) {
         errno = 0;
@@ -181,14 +178,17 @@ static int ascii_coord_line(writer *w, uint64_t tag)
     const char *eol = n >= 2 && line[n - 2] == '\r' ? "\r\n"
                       : n >= 1 && line[n - 1] == '\n' ? "\n"
                                                        : "";
-    char num[3][40];
-    for (int k = 0; k < 3; k++)
-        format_double(x[k], num[k], sizeof num[k]);
-    return fwrite(line, 1, prefix, w->out) != prefix ||
-                   fprintf(w->out, "%s%s %s %s%s", prefix ? " " : "", num[0],
-                           num[1], num[2], eol) < 0
-               ? -1
-               : 0;
+    char text[8192 + 3 * 33 + 3];
+    size_t len = prefix;
+    memcpy(text, line, prefix);
+    for (int k = 0; k < 3; k++) {
+        if (k > 0 || prefix)
+            text[len++] = ' ';
+        len += (size_t)format_double(x[k], text + len);
+    }
+    for (const char *e = eol; *e; e++)
+        text[len++] = *e;
+    return fwrite(text, 1, len, w->out) == len ? 0 : -1;
 }
 
 static int ascii_block(writer *w)

@@ -1,0 +1,405 @@
+/*
+ * test_fastpath.c -- the ASCII fast paths (formats/linepar.c, MSH
+ * msh41_fast.c, INP inp_fast.c) against the readers' own line and token
+ * paths, on meshes large enough for runs to be split across threads
+ * (82,944 tets: megabytes of element lines, runs of up to 8 MiB):
+ *  - property: a file whose lines are randomly reshaped (blanks, tabs,
+ *    CRLF, '+' signs, exponents, records split over two lines or joined,
+ *    blank and comment lines; each such line is refused by the fast path
+ *    and read by the token / line reader) gives exactly the mesh of the
+ *    plain file, for 1, 2, 3 and 7 threads, with one line in 8, 500 or
+ *    20000 reshaped (so the places where the fast path stops and resumes,
+ *    and so the pieces the threads get, move around);
+ *  - damage: one or two bad records at random lines give one error, the
+ *    same text for every thread count, naming the file and the first bad
+ *    line in file order.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "check.h"
+
+#include "getme_formats.h"
+
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#define N 24 /* cubes per side: 25^3 nodes, 6 N^3 tets */
+#define NN ((N + 1) * (N + 1) * (N + 1))
+#define NE (6 * N * N * N)
+
+static double xyz[3 * NN];
+static int32_t tet[NE][4];
+
+static uint64_t rng_state;
+static uint32_t rnd(void)
+{
+    rng_state = rng_state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return (uint32_t)(rng_state >> 33);
+}
+
+static int node_at(int i, int j, int k)
+{
+    return i + (N + 1) * (j + (N + 1) * k);
+}
+
+static double volume6(const int32_t *t)
+{
+    const double *a = xyz + 3 * t[0], *b = xyz + 3 * t[1], *c = xyz + 3 * t[2],
+                 *d = xyz + 3 * t[3];
+    double u[3], v[3], w[3];
+    for (int k = 0; k < 3; k++) {
+        u[k] = b[k] - a[k];
+        v[k] = c[k] - a[k];
+        w[k] = d[k] - a[k];
+    }
+    return u[0] * (v[1] * w[2] - v[2] * w[1]) -
+           u[1] * (v[0] * w[2] - v[2] * w[0]) +
+           u[2] * (v[0] * w[1] - v[1] * w[0]);
+}
+
+/* A cube of Kuhn tets, nodes jittered (long decimals), all positive. */
+static void make_mesh(void)
+{
+    rng_state = 7;
+    for (int k = 0; k <= N; k++)
+        for (int j = 0; j <= N; j++)
+            for (int i = 0; i <= N; i++) {
+                double *x = xyz + 3 * node_at(i, j, k);
+                int c[3] = {i, j, k};
+                for (int a = 0; a < 3; a++) {
+                    int inner = c[a] > 0 && c[a] < N;
+                    x[a] = (c[a] + (inner ? 0.1 * (rnd() / 4294967296.0 - 0.5)
+                                          : 0.0)) / N;
+                }
+            }
+    static const int perm[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
+                                   {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+    int e = 0;
+    for (int k = 0; k < N; k++)
+        for (int j = 0; j < N; j++)
+            for (int i = 0; i < N; i++)
+                for (int p = 0; p < 6; p++) {
+                    int c[3] = {i, j, k};
+                    tet[e][0] = node_at(c[0], c[1], c[2]);
+                    for (int s = 0; s < 3; s++) {
+                        c[perm[p][s]]++;
+                        tet[e][s + 1] = node_at(c[0], c[1], c[2]);
+                    }
+                    if (volume6(tet[e]) < 0) {
+                        int32_t t = tet[e][2];
+                        tet[e][2] = tet[e][3];
+                        tet[e][3] = t;
+                    }
+                    e++;
+                }
+}
+
+/* ---- writing the files, with reshaped and damaged lines ----------------- */
+
+enum { PLAIN, RESHAPE, DAMAGE };
+
+typedef struct out {
+    FILE *f;
+    int mode;
+    long line;         /* lines written so far                          */
+    long bad_line[2];  /* lines damaged (mode DAMAGE), in file order      */
+    int nbad;
+    long damage_at[2]; /* record numbers to damage                       */
+    uint32_t one_in;   /* RESHAPE: one line in this many                  */
+} out;
+
+static void put_line(out *o, const char *s)
+{
+    fputs(s, o->f);
+    fputc('\n', o->f);
+    o->line++;
+}
+
+/* A record's line: reshaped now and then (every shape is one that the
+   fast path refuses or that still holds one record per line).  split:
+   the record may go over two lines; join: the next record may follow on
+   the same line (MSH tags and elements: the token reader reads them). */
+static void put_record(out *o, const char *tok[], int ntok, int msh,
+                       int split, int join)
+{
+    char line[1024];
+    size_t n = 0;
+    int shape = o->mode == RESHAPE && rnd() % o->one_in == 0
+                    ? 1 + (int)(rnd() % 7)
+                    : 0;
+    if ((shape == 3 && !split) || (shape == 7 && !join))
+        shape = 0;
+    if (shape == 7) {
+        for (int t = 0; t < ntok; t++)
+            fprintf(o->f, "%s ", tok[t]);
+        return;
+    }
+    if (shape == 5) { /* a blank line (INP: a comment) before it */
+        put_line(o, msh ? "" : "** a comment");
+        shape = 0;
+    }
+    for (int t = 0; t < ntok; t++) {
+        const char *sep = t == 0 ? "" : msh ? " " : ", ";
+        if (shape == 1)
+            sep = t == 0 ? "  " : msh ? " \t " : " ,\t";
+        if (shape == 3 && t == ntok / 2 && ntok > 1) /* split over 2 lines */
+            sep = msh ? "\n" : ",\n";
+        n += (size_t)snprintf(line + n, sizeof line - n, "%s%s%s", sep,
+                              shape == 4 && t == 0 ? "+" : "", tok[t]);
+    }
+    if (shape == 2)
+        n += (size_t)snprintf(line + n, sizeof line - n, "\r");
+    if (shape == 6)
+        n += (size_t)snprintf(line + n, sizeof line - n, msh ? "  " : " ");
+    o->line += shape == 3 && ntok > 1;
+    put_line(o, line);
+}
+
+/* Record r of the file: damage it if asked to. */
+static int damaged(out *o, long r)
+{
+    for (int k = 0; k < 2; k++)
+        if (o->mode == DAMAGE && o->damage_at[k] == r) {
+            o->bad_line[o->nbad++] = o->line + 1;
+            return 1;
+        }
+    return 0;
+}
+
+static void real_text(char *buf, double v)
+{
+    /* %.17g, or an exponent form of the same value */
+    snprintf(buf, 40, rnd() % 16 == 0 ? "%.17e" : "%.17g", v);
+}
+
+/* Element e's tokens: its number and its four node numbers. */
+static void element_tokens(int e, char tbuf[5][40], const char *tok[5])
+{
+    snprintf(tbuf[0], 40, "%d", e + 1);
+    for (int k = 0; k < 4; k++)
+        snprintf(tbuf[k + 1], 40, "%d", tet[e][k] + 1);
+    for (int k = 0; k < 5; k++)
+        tok[k] = tbuf[k];
+}
+
+static void start_file(const char *path, out *o)
+{
+    o->f = fopen(path, "wb");
+    o->line = 0;
+    o->nbad = 0;
+}
+
+static void write_msh(const char *path, out *o)
+{
+    char tbuf[5][40];
+    const char *tok[5];
+    start_file(path, o);
+    put_line(o, "$MeshFormat\n4.1 0 8\n$EndMeshFormat");
+    put_line(o, "$Entities\n0 0 0 1\n1 0 0 0 1 1 1 0 0\n$EndEntities");
+    o->line += 5;
+    fprintf(o->f, "$Nodes\n1 %d 1 %d\n3 1 0 %d\n", NN, NN, NN);
+    o->line += 3;
+    long rec = 0;
+    for (int i = 0; i < NN; i++, rec++) {
+        snprintf(tbuf[0], sizeof tbuf[0], "%d", i + 1);
+        tok[0] = tbuf[0];
+        if (damaged(o, rec))
+            tok[0] = "7x";
+        put_record(o, tok, 1, 1, 0, i + 1 < NN);
+    }
+    for (int i = 0; i < NN; i++, rec++) {
+        for (int k = 0; k < 3; k++) {
+            real_text(tbuf[k], xyz[3 * i + k]);
+            tok[k] = tbuf[k];
+        }
+        if (damaged(o, rec))
+            tok[1] = "0.5q";
+        put_record(o, tok, 3, 1, 1, 0);
+    }
+    put_line(o, "$EndNodes");
+    fprintf(o->f, "$Elements\n1 %d 1 %d\n3 1 4 %d\n", NE, NE, NE);
+    o->line += 3;
+    for (int e = 0; e < NE; e++, rec++) {
+        element_tokens(e, tbuf, tok);
+        if (damaged(o, rec))
+            tok[3] = "999999";
+        put_record(o, tok, 5, 1, 1, e + 1 < NE);
+    }
+    put_line(o, "$EndElements");
+    fclose(o->f);
+}
+
+static void write_inp(const char *path, out *o)
+{
+    char tbuf[5][40];
+    const char *tok[5];
+    start_file(path, o);
+    put_line(o, "*HEADING\nfast path test\n*NODE");
+    o->line += 2;
+    long rec = 0;
+    for (int i = 0; i < NN; i++, rec++) {
+        snprintf(tbuf[0], sizeof tbuf[0], "%d", i + 1);
+        for (int k = 0; k < 3; k++) {
+            real_text(tbuf[k + 1], xyz[3 * i + k]);
+            tok[k + 1] = tbuf[k + 1];
+        }
+        tok[0] = tbuf[0];
+        if (damaged(o, rec))
+            tok[2] = "abc";
+        put_record(o, tok, 4, 0, 0, 0);
+    }
+    put_line(o, "*ELEMENT, TYPE=C3D4, ELSET=Block");
+    for (int e = 0; e < NE; e++, rec++) {
+        element_tokens(e, tbuf, tok);
+        if (damaged(o, rec))
+            tok[2] = "0";
+        put_record(o, tok, 5, 0, 1, 0);
+    }
+    put_line(o, "*SOLID SECTION, ELSET=Block, MATERIAL=Steel\n,");
+    fclose(o->f);
+}
+
+/* ---- reading -------------------------------------------------------------- */
+
+typedef struct result {
+    getme_formats_status st;
+    char error[1024];
+    double *x;
+    int32_t *conn;
+    int32_t nn, ne;
+} result;
+
+static result read_file(const char *path, int threads)
+{
+    result r;
+    memset(&r, 0, sizeof r);
+    getme_doc_options o;
+    getme_doc_options_init(&o);
+    o.num_threads = threads;
+    getme_doc *doc = NULL;
+    r.st = getme_doc_open(&doc, path, &o);
+    snprintf(r.error, sizeof r.error, "%s",
+             r.st == GETME_FORMATS_OK ? "" : getme_doc_error(doc));
+    getme_mesh *m = r.st == GETME_FORMATS_OK ? getme_doc_mesh(doc) : NULL;
+    if (m) {
+        r.nn = getme_mesh_num_nodes(m);
+        r.ne = getme_mesh_num_elements(m);
+        r.x = malloc((size_t)r.nn * 3 * sizeof *r.x);
+        r.conn = calloc((size_t)r.ne * 8, sizeof *r.conn);
+        getme_mesh_get_coords(m, r.x);
+        for (int32_t e = 0; e < r.ne; e++) {
+            getme_elem_type t;
+            getme_mesh_get_element(m, e, &t, r.conn + 8 * e);
+        }
+    }
+    getme_doc_close(doc);
+    return r;
+}
+
+static int same_mesh(const result *a, const result *b)
+{
+    return a->st == GETME_FORMATS_OK && b->st == GETME_FORMATS_OK &&
+           a->nn == b->nn && a->ne == b->ne &&
+           memcmp(a->x, b->x, (size_t)a->nn * 3 * sizeof *a->x) == 0 &&
+           memcmp(a->conn, b->conn, (size_t)a->ne * 8 * sizeof *a->conn) == 0;
+}
+
+static void free_result(result *r)
+{
+    free(r->x);
+    free(r->conn);
+}
+
+static const int THREADS[] = {1, 2, 3, 7};
+#define NT ((int)(sizeof THREADS / sizeof *THREADS))
+
+static void run_format(int msh)
+{
+    const char *name = msh ? "fast.msh" : "fast.inp";
+    out o;
+    memset(&o, 0, sizeof o);
+    o.mode = PLAIN;
+    (msh ? write_msh : write_inp)(name, &o);
+    result plain = read_file(name, 1);
+    CHECK(plain.st == GETME_FORMATS_OK);
+    CHECK_EQ_INT(plain.nn, NN);
+    CHECK_EQ_INT(plain.ne, NE);
+    /* the plain file is the mesh that was written */
+    int exact = plain.st == GETME_FORMATS_OK && plain.nn == NN;
+    for (int i = 0; exact && i < 3 * NN; i++)
+        exact = plain.x[i] == xyz[i];
+    CHECK(exact);
+    for (int t = 1; t < NT; t++) {
+        result r = read_file(name, THREADS[t]);
+        CHECK(same_mesh(&plain, &r));
+        free_result(&r);
+    }
+    /* few reshaped lines: long runs, split across threads; many: the
+       fast path stops and resumes every few lines */
+    static const uint32_t one_in[] = {8, 500, 20000};
+    for (int seed = 1; seed <= 3; seed++) {
+        rng_state = 1000 + (uint64_t)seed + 100 * (uint64_t)msh;
+        o.mode = RESHAPE;
+        o.one_in = one_in[seed - 1];
+        (msh ? write_msh : write_inp)(name, &o);
+        for (int t = 0; t < NT; t++) {
+            result r = read_file(name, THREADS[t]);
+            CHECK(same_mesh(&plain, &r));
+            if (r.st != GETME_FORMATS_OK)
+                fprintf(stderr, "reshaped %s seed %d: %s\n", name, seed,
+                        r.error);
+            free_result(&r);
+        }
+    }
+    long nrec = msh ? 2L * NN + NE : (long)NN + NE;
+    for (int seed = 1; seed <= 6; seed++) {
+        rng_state = 2000 + (uint64_t)seed + 100 * (uint64_t)msh;
+        o.mode = DAMAGE;
+        o.damage_at[0] = (long)(rnd() % (uint32_t)nrec);
+        o.damage_at[1] = seed % 2 ? (long)(rnd() % (uint32_t)nrec) : -1;
+        (msh ? write_msh : write_inp)(name, &o);
+        long first = o.bad_line[0];
+        for (int k = 1; k < o.nbad; k++)
+            if (o.bad_line[k] < first)
+                first = o.bad_line[k];
+        char want[600];
+        if (msh)
+            snprintf(want, sizeof want, "'%s', line %ld: ", name,
+                     first);
+        else
+            snprintf(want, sizeof want, "%s:%ld: ", name, first);
+        char first_error[1024] = "";
+        for (int t = 0; t < NT; t++) {
+            result r = read_file(name, THREADS[t]);
+            CHECK(r.st != GETME_FORMATS_OK);
+            CHECK(strstr(r.error, want) == r.error);
+            if (t == 0)
+                snprintf(first_error, sizeof first_error, "%s", r.error);
+            CHECK(strcmp(r.error, first_error) == 0);
+            if (strstr(r.error, want) != r.error)
+                fprintf(stderr, "%s seed %d, %d threads: %s (want '%s')\n",
+                        name, seed, THREADS[t], r.error, want);
+            free_result(&r);
+        }
+    }
+    free_result(&plain);
+}
+
+int main(void)
+{
+    /* the files go to a folder of their own, named in the messages */
+    char dir[64], cmd[128];
+    snprintf(dir, sizeof dir, "fastpath-%ld", (long)getpid());
+    snprintf(cmd, sizeof cmd, "mkdir -p %s", dir);
+    if (system(cmd) != 0 || chdir(dir) != 0)
+        return 1;
+    make_mesh();
+    run_format(1);
+    run_format(0);
+    snprintf(cmd, sizeof cmd, "cd .. && rm -rf %s", dir);
+    if (system(cmd) != 0)
+        return 1;
+    return check_summary("test_fastpath");
+}
