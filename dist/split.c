@@ -196,16 +196,11 @@ int dist_split_detect(dist_split *s, const char *input)
         n - 6 < sizeof s->stem) {
         memcpy(s->stem, input, n - 6);
         s->stem[n - 6] = 0;
-        if (count_partitions(input) > 0) {
-            char path[DIST_PATH];
-            int k = 1;
+        int np = count_partitions(input);
+        if (np > 0) { /* the files are NAME_1 .. NAME_np: a missing one
+                         is an error of the rank that reads it */
             s->mode = DIST_SPLIT_FILES;
-            for (; k < 1 << 20; k++) {
-                dist_split_path(s, k + 1, path, sizeof path);
-                if (!exists(path))
-                    break;
-            }
-            s->nparts = k;
+            s->nparts = np;
             return s->mode;
         }
     }
