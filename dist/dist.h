@@ -99,6 +99,13 @@ typedef struct dist_split {
     dist_elem *elem;       /* own elements, then the ghost layer            */
     int64_t *optr;         /* nn + 1: other ranks holding each node ...     */
     int *orank;            /* ... ascending                                 */
+    /* element order keys of the whole mesh (dist_split_setup): its box
+       (min xyz, max xyz, allreduced) for Morton keys, and whether element
+       tags are one dense run, so that an element's index in the
+       single-process order is tag - tag_min without a global sort */
+    double box[6];
+    int64_t tag_min;
+    int dense_tags;
     /* rank 0: the whole mesh for the finishing step (until that step runs
        on gathered patches): nodes in ascending tag */
     getme_mesh *whole;

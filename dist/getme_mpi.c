@@ -311,6 +311,28 @@ out:
     return code;
 }
 
+/* With -v, at the end (collective): every rank's peak RSS over the whole
+   run, reading and writing included (bench/mpi.py). */
+static void log_peak_rss(dist_ctx *c, const cli_log *log)
+{
+    if (!log->verbose)
+        return;
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    double mine = (double)ru.ru_maxrss / 1024.0;
+    double *all = c->rank == 0 ? malloc((size_t)c->size * sizeof *all) : NULL;
+    MPI_Gather(&mine, 1, MPI_DOUBLE, all, 1, MPI_DOUBLE, 0, c->comm);
+    if (all) {
+        char line[4096];
+        size_t used = 0;
+        for (int r = 0; r < c->size && used < sizeof line; r++)
+            used += (size_t)snprintf(line + used, sizeof line - used, "%s%.1f",
+                                     r ? "/" : "", all[r]);
+        cli_info(log, "Peak RSS per rank (whole run): %s MiB", line);
+    }
+    free(all);
+}
+
 /* Gmsh-partitioned input read per rank (split.c, docs/distributed.md §3):
    every rank reads its own parts, the ranks build the parts among
    themselves, rank 0 runs the finishing step on the whole mesh it
@@ -482,6 +504,7 @@ static int run_split(dist_ctx *c, args *a, dist_split *s)
         }
         cli_write_guard(&guard, 0);
     }
+    log_peak_rss(c, log);
     free(xyz);
     return code;
 }
@@ -707,6 +730,7 @@ int main(int argc, char **argv)
         }
     }
     MPI_Bcast(&code, 1, MPI_INT, 0, c.comm);
+    log_peak_rss(&c, log);
 out:
     free(xyz);
     getme_mesh_free(part);

@@ -281,6 +281,8 @@ int dist_split_read(dist_split *s, const getme_doc_options *base, char *msg,
 {
     getme_doc_options o = *base;
     o.one_part = 1;
+    o.adapters = NULL; /* a part the native reader declines is an error,
+                          not a whole-model read through Gmsh */
     s->docs = calloc((size_t)(s->count ? s->count : 1), sizeof *s->docs);
     if (!s->docs) {
         snprintf(msg, size, "out of memory");
@@ -769,6 +771,38 @@ static void fill_ctx(const dist_split *s, dist_ctx *c)
     free(pos), free(cnt), free(slot);
 }
 
+/* What an element order of the whole mesh needs on every rank (the
+   finishing step on gathered patches breaks ties by the Morton key of an
+   element's first node in the whole mesh's box, then by its index in the
+   single-process order): the box, and whether the element tags are one
+   dense run (Gmsh numbers a file's volume elements consecutively in its
+   order), in which case that index is tag - tag_min. */
+static void order_keys(dist_split *s, dist_ctx *c)
+{
+    double lo[3] = {1e308, 1e308, 1e308}, hi[3] = {-1e308, -1e308, -1e308};
+    for (int32_t i = 0; i < s->nn; i++)
+        for (int k = 0; k < 3; k++) {
+            lo[k] = s->node[i].x[k] < lo[k] ? s->node[i].x[k] : lo[k];
+            hi[k] = s->node[i].x[k] > hi[k] ? s->node[i].x[k] : hi[k];
+        }
+    MPI_Allreduce(MPI_IN_PLACE, lo, 3, MPI_DOUBLE, MPI_MIN, c->comm);
+    MPI_Allreduce(MPI_IN_PLACE, hi, 3, MPI_DOUBLE, MPI_MAX, c->comm);
+    int64_t tmin = INT64_MAX, tmax = INT64_MIN, n = s->own_ne;
+    for (int32_t e = 0; e < s->own_ne; e++) {
+        tmin = s->elem[e].tag < tmin ? s->elem[e].tag : tmin;
+        tmax = s->elem[e].tag > tmax ? s->elem[e].tag : tmax;
+    }
+    MPI_Allreduce(MPI_IN_PLACE, &tmin, 1, MPI_INT64_T, MPI_MIN, c->comm);
+    MPI_Allreduce(MPI_IN_PLACE, &tmax, 1, MPI_INT64_T, MPI_MAX, c->comm);
+    MPI_Allreduce(MPI_IN_PLACE, &n, 1, MPI_INT64_T, MPI_SUM, c->comm);
+    for (int k = 0; k < 3; k++) {
+        s->box[k] = lo[k];
+        s->box[3 + k] = hi[k];
+    }
+    s->tag_min = tmin;
+    s->dense_tags = tmax - tmin + 1 == n; /* tags are distinct */
+}
+
 int dist_split_setup(dist_split *s, dist_ctx *c, unsigned fix_flags)
 {
     if (mark_faces(s, c, fix_flags) != 0 || directory(s, c) != 0 ||
@@ -781,6 +815,7 @@ int dist_split_setup(dist_split *s, dist_ctx *c, unsigned fix_flags)
     MPI_Allreduce(mine, all, 2, MPI_INT64_T, MPI_SUM, c->comm);
     c->interface_nodes = all[0];
     c->ghost_elements = all[1];
+    order_keys(s, c);
     return 0;
 }
 
@@ -849,6 +884,8 @@ int dist_split_whole(dist_split *s, dist_ctx *c, char *msg, size_t size)
     }
     gather(c, mine, w, &elems, &ew);
     free(mine);
+    free(s->elem), free(s->optr), free(s->orank); /* the set-up's tables */
+    s->elem = NULL, s->optr = NULL, s->orank = NULL;
     if (c->rank != 0)
         return 0;
     int rc = -1;
