@@ -93,7 +93,9 @@ typedef struct dist_split {
     char input[DIST_PATH]; /* as named (NAME_1.msh, or the one file)        */
     char stem[DIST_PATH];  /* NAME                                          */
     int first, count;      /* this rank's parts: first .. first+count-1     */
-    getme_doc **docs;      /* count, open until written                     */
+    getme_doc **docs;      /* count, open while read (then closed: opened
+                              again to be written)                         */
+    getme_doc_options opts; /* how they were read                          */
     int32_t nn, ne, own_ne;
     dist_node *node;       /* the part's nodes, ascending tag               */
     dist_elem *elem;       /* own elements, then the ghost layer            */
@@ -138,7 +140,7 @@ int32_t whole_index(const dist_split *s, uint64_t tag);
 /* Collective: the part's positions of counted nodes into rank 0's xyz. */
 void dist_split_gather(dist_split *s, dist_ctx *c, const double *part_xyz,
                        double *xyz);
-/* Collective: rank 0's final xyz to the ranks' documents. */
+/* Collective: rank 0's final xyz to the ranks' node tables. */
 void dist_split_scatter(dist_split *s, dist_ctx *c, const double *xyz);
 /* Collective: write the output parts (temporary files, agreement,
    renames).  0, or -1 with rank 0's message. */

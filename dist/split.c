@@ -283,6 +283,7 @@ int dist_split_read(dist_split *s, const getme_doc_options *base, char *msg,
     o.one_part = 1;
     o.adapters = NULL; /* a part the native reader declines is an error,
                           not a whole-model read through Gmsh */
+    s->opts = o;
     s->docs = calloc((size_t)(s->count ? s->count : 1), sizeof *s->docs);
     if (!s->docs) {
         snprintf(msg, size, "out of memory");
@@ -317,7 +318,14 @@ int dist_split_read(dist_split *s, const getme_doc_options *base, char *msg,
         }
     }
     *code = 1;
-    return take_docs(s, msg, size);
+    int rc = take_docs(s, msg, size);
+    /* the documents are opened again to be written: not kept through the
+       smoothing (a second copy of the part) */
+    for (int d = 0; d < s->count; d++) {
+        getme_doc_close(s->docs[d]);
+        s->docs[d] = NULL;
+    }
+    return rc;
 }
 
 /* ---- records to their ranks ---------------------------------------------- */
@@ -978,17 +986,14 @@ void dist_split_gather(dist_split *s, dist_ctx *c, const double *part_xyz,
 
 /* ---- writing ------------------------------------------------------------ */
 
-/* Rank 0's final coordinates to every rank's documents (by node tag). */
+/* Rank 0's final coordinates into every rank's node table (by tag), from
+   which its output parts are written. */
 void dist_split_scatter(dist_split *s, dist_ctx *c, const double *xyz)
 {
-    int64_t n = 0;
-    for (int d = 0; d < s->count; d++)
-        n += getme_mesh_num_nodes(getme_doc_mesh(s->docs[d]));
-    int64_t *tags = xalloc((size_t)n * sizeof *tags), k = 0, *all, total;
-    for (int d = 0; d < s->count; d++)
-        for (int32_t i = 0; i < getme_mesh_num_nodes(getme_doc_mesh(s->docs[d]));
-             i++)
-            tags[k++] = (int64_t)getme_doc_node_id(s->docs[d], i);
+    int64_t n = s->nn;
+    int64_t *tags = xalloc((size_t)n * sizeof *tags), *all, total;
+    for (int32_t i = 0; i < s->nn; i++)
+        tags[i] = (int64_t)s->node[i].tag;
     gather(c, tags, n, &all, &total);
     /* rank 0 answers in the same layout: 3 doubles per tag */
     int cnt = (int)(3 * n), *counts = NULL, *displs = NULL;
@@ -998,7 +1003,8 @@ void dist_split_scatter(dist_split *s, dist_ctx *c, const double *xyz)
         displs = xalloc((size_t)c->size * sizeof *displs);
         ans = xalloc((size_t)total * 3 * sizeof *ans);
         for (int64_t i = 0; i < total; i++)
-            memcpy(ans + 3 * i, xyz + 3 * (size_t)whole_index(s, (uint64_t)all[i]),
+            memcpy(ans + 3 * i,
+                   xyz + 3 * (size_t)whole_index(s, (uint64_t)all[i]),
                    3 * sizeof *ans);
     }
     MPI_Gather(&cnt, 1, MPI_INT, counts, 1, MPI_INT, 0, c->comm);
@@ -1008,12 +1014,8 @@ void dist_split_scatter(dist_split *s, dist_ctx *c, const double *xyz)
     }
     MPI_Scatterv(ans, counts, displs, MPI_DOUBLE, mine, cnt, MPI_DOUBLE, 0,
                  c->comm);
-    k = 0;
-    for (int d = 0; d < s->count; d++) {
-        getme_mesh *m = getme_doc_mesh(s->docs[d]);
-        getme_mesh_set_coords(m, mine + 3 * k);
-        k += getme_mesh_num_nodes(m);
-    }
+    for (int32_t i = 0; i < s->nn; i++)
+        memcpy(s->node[i].x, mine + 3 * (size_t)i, sizeof s->node[i].x);
     free(tags), free(all), free(counts), free(displs), free(ans), free(mine);
 }
 
@@ -1108,9 +1110,17 @@ int dist_agree(dist_ctx *c, int failed, const char *msg, char *out,
     return first;
 }
 
+/* Tests: the environment variable names this rank (a failure to
+   inject). */
+static int injected(const char *var, int rank)
+{
+    const char *v = getenv(var);
+    return v && *v && atoi(v) == rank;
+}
+
 /* Every rank writes its output parts to temporary files; when all are
    written (agreed), every rank renames its own.  One partitioned file:
-   rank 0 reads it whole again and writes it.  0, or -1 with rank 0's
+   rank 0 reads it again again and writes it.  0, or -1 with rank 0's
    message in msg (the failing rank named; after a failed rename, which
    parts are new). */
 int dist_split_write(dist_split *s, dist_ctx *c, const char *output,
@@ -1119,34 +1129,36 @@ int dist_split_write(dist_split *s, dist_ctx *c, const char *output,
     char err[900] = "", first_err[1000] = "";
     int nd = s->mode == DIST_SPLIT_FILES ? s->count : c->rank == 0;
     char (*tmp)[DIST_PATH] = xalloc((size_t)(nd ? nd : 1) * sizeof *tmp);
-    getme_doc *whole = NULL;
+    getme_doc *again = NULL;
     int failed = 0, made = 0;
     for (int d = 0; d < nd && !failed; d++) {
         char out[DIST_PATH];
         out_path(s, output, s->first + d, out, sizeof out);
-        getme_doc *doc = s->mode == DIST_SPLIT_FILES ? s->docs[d] : NULL;
-        if (!doc) { /* one file: read it again whole, set the positions */
-            getme_doc_options o;
-            getme_doc_options_init(&o);
-            o.one_part = 1;
-            if (getme_doc_open(&whole, s->input, &o) != GETME_FORMATS_OK) {
-                snprintf(err, sizeof err, "reading %.300s again to write it: %.500s",
-                         s->input, whole ? getme_doc_error(whole) : "");
-                failed = 1;
-                break;
-            }
-            doc = whole;
-            getme_mesh *m = getme_doc_mesh(doc);
-            double *x = xalloc((size_t)getme_mesh_num_nodes(m) * 3 *
-                               sizeof *x);
-            for (int32_t i = 0; i < getme_mesh_num_nodes(m); i++)
-                memcpy(x + 3 * (size_t)i,
-                       xyz + 3 * (size_t)whole_index(
-                                     s, getme_doc_node_id(doc, i)),
-                       3 * sizeof *x);
-            getme_mesh_set_coords(m, x);
-            free(x);
+        /* the input part read again (one file: whole, on rank 0), its
+           nodes given the final positions by tag */
+        char in[DIST_PATH];
+        getme_doc_options o = s->opts;
+        o.partition = 0;
+        dist_split_path(s, s->first + d, in, sizeof in);
+        if (getme_doc_open(&again, in, &o) != GETME_FORMATS_OK) {
+            snprintf(err, sizeof err, "reading %.300s again to write it: "
+                     "%.500s", in, again ? getme_doc_error(again) : "");
+            failed = 1;
+            break;
         }
+        getme_doc *doc = again;
+        getme_mesh *m = getme_doc_mesh(doc);
+        double *x = xalloc((size_t)getme_mesh_num_nodes(m) * 3 * sizeof *x);
+        for (int32_t i = 0; i < getme_mesh_num_nodes(m); i++) {
+            uint64_t tag = getme_doc_node_id(doc, i);
+            memcpy(x + 3 * (size_t)i,
+                   s->mode == DIST_SPLIT_FILES
+                       ? s->node[find_node(s, tag)].x
+                       : xyz + 3 * (size_t)whole_index(s, tag),
+                   3 * sizeof *x);
+        }
+        getme_mesh_set_coords(m, x);
+        free(x);
         if (getme_io_tmp_path(out, tmp[d], sizeof tmp[d]) != 0) {
             snprintf(err, sizeof err, "cannot write '%.700s': %s", out,
                      strerror(errno));
@@ -1154,10 +1166,16 @@ int dist_split_write(dist_split *s, dist_ctx *c, const char *output,
         } else if (made++, getme_doc_write(doc, tmp[d]) != GETME_FORMATS_OK) {
             snprintf(err, sizeof err, "%s", getme_doc_error(doc));
             failed = 1;
+        } else if (injected("GETME_MPI_FAIL_WRITE", c->rank)) {
+            snprintf(err, sizeof err, "cannot write '%.700s' (failure "
+                     "injected by GETME_MPI_FAIL_WRITE)", out);
+            failed = 1;
         }
+        getme_doc_close(again);
+        again = NULL;
     }
-    if (whole)
-        getme_doc_close(whole);
+    if (again)
+        getme_doc_close(again);
     int who = dist_agree(c, failed, err, first_err, sizeof first_err);
     if (who >= 0) {
         for (int d = 0; d < made; d++)
@@ -1171,9 +1189,14 @@ int dist_split_write(dist_split *s, dist_ctx *c, const char *output,
     for (int d = 0; d < nd; d++) {
         char out[DIST_PATH];
         out_path(s, output, s->first + d, out, sizeof out);
-        if (bad)
+        if (bad) {
             remove(tmp[d]);
-        else if (getme_io_commit(tmp[d], out) != 0) {
+        } else if (injected("GETME_MPI_FAIL_RENAME", c->rank)) {
+            remove(tmp[d]);
+            snprintf(err, sizeof err, "cannot rename to '%.700s' (failure "
+                     "injected by GETME_MPI_FAIL_RENAME)", out);
+            bad = 1 + d;
+        } else if (getme_io_commit(tmp[d], out) != 0) {
             snprintf(err, sizeof err, "cannot rename to '%.700s': %s", out,
                      strerror(errno));
             bad = 1 + d;

@@ -22,7 +22,11 @@ every rank reading its own parts with the native reader, must give:
    the rank and the file, getme smooth's exit code (4 parse, 3 open), no
    output part and no temporary file;
  - an output part that is an input part refused (exit 2), the inputs
-   untouched; a stale OUT_4.msh of an earlier run reported.
+   untouched; a stale OUT_4.msh of an earlier run reported;
+ - a rank failing to write its part (GETME_MPI_FAIL_WRITE): exit 7, one
+   error line, no file left; a rank failing to rename
+   (GETME_MPI_FAIL_RENAME): the error lists exactly the parts that are
+   new.
 """
 import json
 import os
@@ -38,9 +42,10 @@ from mpi_checks import GETME_MPI, MPIEXEC, SANITIZED, ENV, c
 N = 3
 
 
-def mpirun(np, *args):
+def mpirun(np, *args, env=None):
     return subprocess.run([MPIEXEC, "--oversubscribe", "-np", str(np), GETME_MPI,
-                           *args], capture_output=True, text=True, env=ENV)
+                           *args], capture_output=True, text=True,
+                          env=dict(ENV, **(env or {})))
 
 
 def nodes(paths):
@@ -192,5 +197,26 @@ with tempfile.TemporaryDirectory() as tmp:
             open(stale + "_4.msh").read() == "old",
             f"a stale part of an earlier run is reported and left as it is "
             f"(exit {p.returncode})")
+
+    # A rank failing to write its part: nobody's part is written.  A rank
+    # failing to rename: the parts already renamed are named as new.
+    wdir = os.path.join(tmp, "w")
+    os.mkdir(wdir)
+    p = mpirun(3, "smooth", stem + "_1.msh", "-o", os.path.join(wdir, "o.msh"),
+               env={"GETME_MPI_FAIL_WRITE": "1"})
+    errors = [l for l in p.stderr.splitlines() if l.startswith("Error")]
+    c.check(p.returncode == 7 and len(errors) == 1 and "rank 1 of 3" in errors[0]
+            and "o_2.msh" in errors[0] and not os.listdir(wdir),
+            f"a rank failing to write: exit {p.returncode}, {errors}, nothing "
+            f"left ({os.listdir(wdir)})")
+    p = mpirun(3, "smooth", stem + "_1.msh", "-o", os.path.join(wdir, "o.msh"),
+               env={"GETME_MPI_FAIL_RENAME": "1"})
+    errors = [l for l in p.stderr.splitlines() if l.startswith("Error")]
+    left = sorted(os.listdir(wdir))
+    c.check(p.returncode == 7 and len(errors) == 1 and
+            errors[0].endswith("new parts: " + " ".join(
+                os.path.join(wdir, f"o_{k}.msh") for k in (1, 3)) +
+                "; the others are as before") and left == ["o_1.msh", "o_3.msh"],
+            f"a rank failing to rename: exit {p.returncode}, {errors}, left {left}")
 
 sys.exit(c.summary())

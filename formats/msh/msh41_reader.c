@@ -566,18 +566,21 @@ static getme_formats_status prepare_groups(msh41_reader *r)
         int dim, tag, used = 0;
         int by_tag = sscanf(word, "%d:%d%n", &dim, &tag, &used) == 2 &&
                      word[used] == 0;
-        for (size_t i = 0; i < r->nents; i++) {
-            msh41_entity *e = &r->ents[i];
+        /* one part of a partitioned file: its entities are marked, the
+           model's (every part has them all) only tell a name exists */
+        size_t n = r->nents + r->nmodel_ents;
+        for (size_t i = 0; i < n; i++) {
+            msh41_entity *e = i < r->nents ? &r->ents[i]
+                                           : &r->model_ents[i - r->nents];
             for (size_t k = 0; k < e->phys_count; k++) {
                 int p = r->phys[e->phys_first + k];
                 const char *name = by_tag ? NULL
                                           : msh41_group_name(r, e->dim, p);
                 int match = by_tag ? (e->dim == dim && p == tag)
                                    : (name && strcmp(name, word) == 0);
-                if (match) {
+                if (match && i < r->nents)
                     e->fix |= w < nfix;
-                    r->fix_found[w]++;
-                }
+                r->fix_found[w] += match;
             }
         }
     }
