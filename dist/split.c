@@ -137,7 +137,7 @@ static int count_partitions(const char *path)
     if (!f)
         return 0;
     char line[256];
-    int binary = 0, n = 0;
+    int binary = -1, n = 0; /* -1: not MSH 4.1, not scanned */
     if (fgets(line, sizeof line, f) && !strncmp(line, "$MeshFormat", 11) &&
         fgets(line, sizeof line, f)) {
         double v = 0;
@@ -159,10 +159,11 @@ static int count_partitions(const char *path)
             continue;
         }
         line[len] = 0;
+        line[strcspn(line, "\r\n")] = 0; /* "\n" or "\r\n" */
         len = 0;
-        if (!strcmp(line, "$Nodes\n"))
+        if (!strcmp(line, "$Nodes"))
             break;
-        if (strcmp(line, "$PartitionedEntities\n"))
+        if (strcmp(line, "$PartitionedEntities"))
             continue;
         if (binary) {
             unsigned char b[8];
