@@ -1,11 +1,14 @@
 /*
- * a2a.c -- one personalised all-to-all exchange of int64 records
- * (MPI_Alltoallv with the counts exchanged first), the step every
- * distributed set-up round of split.c is made of.
+ * a2a.c -- the collective steps the driver's set-up is made of: one
+ * personalised all-to-all exchange of int64 records (MPI_Alltoallv with
+ * the counts exchanged first), every round of split_setup.c; and the
+ * agreement on a failure (which rank, its message on rank 0).
  */
 #include "dist.h"
 
+#include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 int dist_a2a(dist_ctx *c, const int64_t *send, const int *scount,
              int64_t **recv, int **rcount)
@@ -52,3 +55,25 @@ int dist_a2a(dist_ctx *c, const int64_t *send, const int *scount,
     c->bytes_sent += 8 * stotal;
     return 0;
 }
+
+/* The lowest failing rank's message on rank 0; every rank learns whether
+   any failed (the failing rank, or -1). */
+int dist_agree(dist_ctx *c, int failed, const char *msg, char *out,
+               size_t size)
+{
+    int mine = failed ? c->rank : c->size, first = c->size;
+    MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, c->comm);
+    if (first == c->size)
+        return -1;
+    if (first != 0) {
+        if (c->rank == first)
+            MPI_Send(msg, (int)strlen(msg) + 1, MPI_CHAR, 0, 99, c->comm);
+        if (c->rank == 0)
+            MPI_Recv(out, (int)size, MPI_CHAR, first, 99, c->comm,
+                     MPI_STATUS_IGNORE);
+    } else if (c->rank == 0) {
+        snprintf(out, size, "%s", msg);
+    }
+    return first;
+}
+

@@ -50,6 +50,12 @@ typedef struct dist_ctx {
 int dist_comm_init(dist_ctx *c);
 void dist_comm_free(dist_ctx *c);
 void dist_comm_hooks(dist_ctx *c, getme_comm *hooks);
+/* The neighbour lists from each part node's other holders (optr: nn + 1
+   offsets into orank, ranks ascending): per rank the shared nodes in the
+   part's node order, which both sides must agree on (ascending global
+   index or tag).  0 or -1 (out of memory). */
+int dist_neighbours(dist_ctx *c, int32_t nn, const int64_t *optr,
+                    const int *orank);
 
 /* partition.c: on rank 0, split mesh into size parts (METIS, fixed seed)
    and send each rank its part; every rank receives its own into c.
@@ -151,5 +157,12 @@ int dist_split_write(dist_split *s, dist_ctx *c, const char *output,
 int dist_agree(dist_ctx *c, int failed, const char *msg, char *out,
                size_t size);
 void dist_split_free(dist_split *s);
+
+/* split_common.c: shared by the split*.c files */
+void dist_stop(const char *why);      /* MPI_Abort with one error line */
+void *dist_xalloc(size_t n);          /* malloc or dist_stop           */
+int32_t dist_find_node(const dist_split *s, uint64_t tag); /* -1: none */
+int dist_merge_nodes(dist_split *s, char *msg, size_t size);
+int dist_cmp_node(const void *a, const void *b); /* qsort by tag */
 
 #endif /* GETME_DIST_H */
