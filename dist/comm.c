@@ -170,3 +170,43 @@ void dist_comm_hooks(dist_ctx *c, getme_comm *h)
     h->sum_i128 = sum_i128;
     h->min = min_f64;
 }
+
+int dist_neighbours(dist_ctx *c, int32_t nn, const int64_t *optr,
+                    const int *orank)
+{
+    int *cnt = calloc((size_t)c->size, sizeof *cnt);
+    int *slot = malloc((size_t)c->size * sizeof *slot);
+    if (!cnt || !slot) {
+        free(cnt), free(slot);
+        return -1;
+    }
+    for (int64_t h = 0; h < optr[nn]; h++)
+        cnt[orank[h]]++;
+    c->num_nb = 0;
+    for (int q = 0; q < c->size; q++)
+        c->num_nb += cnt[q] > 0;
+    size_t nb = (size_t)c->num_nb;
+    c->nb_rank = malloc((nb ? nb : 1) * sizeof *c->nb_rank);
+    c->nb_count = malloc((nb ? nb : 1) * sizeof *c->nb_count);
+    c->nb_ptr = malloc((nb + 1) * sizeof *c->nb_ptr);
+    c->nb_node = malloc(((size_t)optr[nn] ? (size_t)optr[nn] : 1) *
+                        sizeof *c->nb_node);
+    int64_t *pos = malloc((nb + 1) * sizeof *pos);
+    int ok = c->nb_rank && c->nb_count && c->nb_ptr && c->nb_node && pos;
+    if (ok) {
+        c->nb_ptr[0] = 0;
+        for (int q = 0, k = 0; q < c->size; q++)
+            if (cnt[q] > 0) {
+                c->nb_rank[k] = q;
+                c->nb_count[k] = cnt[q];
+                c->nb_ptr[k + 1] = c->nb_ptr[k] + cnt[q];
+                pos[k] = c->nb_ptr[k];
+                slot[q] = k++;
+            }
+        for (int32_t i = 0; i < nn; i++) /* in the caller's node order */
+            for (int64_t h = optr[i]; h < optr[i + 1]; h++)
+                c->nb_node[pos[slot[orank[h]]]++] = i;
+    }
+    free(pos), free(cnt), free(slot);
+    return ok ? 0 : -1;
+}

@@ -65,6 +65,12 @@ int dist_finish(dist_ctx *c, getme_mesh *part, const getme_mesh *whole,
 int dist_comm_init(dist_ctx *c);
 void dist_comm_free(dist_ctx *c);
 void dist_comm_hooks(dist_ctx *c, getme_comm *hooks);
+/* The neighbour lists from each part node's other holders (optr: nn + 1
+   offsets into orank, ranks ascending): per rank the shared nodes in the
+   part's node order, which both sides must agree on (ascending global
+   index or tag).  0 or -1 (out of memory). */
+int dist_neighbours(dist_ctx *c, int32_t nn, const int64_t *optr,
+                    const int *orank);
 
 /* partition.c: on rank 0, split mesh into size parts (METIS, fixed seed)
    and send each rank its part; every rank receives its own into c.
@@ -78,5 +84,100 @@ int dist_partition_send(getme_mesh *mesh, dist_ctx *c, char *err,
                         size_t err_size);
 int dist_partition_recv(dist_ctx *c);
 void dist_part_free(dist_ctx *c);
+
+/* a2a.c: one MPI_Alltoallv of int64 records (counts exchanged first);
+   *recv and *rcount (per source rank) are malloc'd.  0, or -1 on every
+   rank if any could not allocate. */
+int dist_a2a(dist_ctx *c, const int64_t *send, const int *scount,
+             int64_t **recv, int **rcount);
+
+/* split.c: Gmsh-partitioned input read per rank (docs/distributed.md §3). */
+enum { DIST_SPLIT_NONE, DIST_SPLIT_FILES, DIST_SPLIT_ONE };
+enum { DIST_PATH = 4096 };
+
+typedef struct dist_node { /* a node of a part: tag, position, fixed */
+    uint64_t tag;
+    double x[3];
+    int64_t fixed;
+} dist_node;
+
+typedef struct dist_elem { /* an element of a part, nodes by tag */
+    int64_t tag;
+    int type, nv;
+    int32_t region;
+    uint64_t node[8];
+} dist_elem;
+
+typedef struct dist_split {
+    int mode;              /* DIST_SPLIT_*                                  */
+    int nparts;            /* N: files NAME_1..N.msh, or partitions          */
+    char input[DIST_PATH]; /* as named (NAME_1.msh, or the one file)        */
+    char stem[DIST_PATH];  /* NAME                                          */
+    int first, count;      /* this rank's parts: first .. first+count-1     */
+    getme_doc **docs;      /* count, open while read (then closed: opened
+                              again to be written)                         */
+    getme_doc_options opts; /* how they were read                          */
+    int32_t nn, ne, own_ne;
+    dist_node *node;       /* the part's nodes, ascending tag               */
+    dist_elem *elem;       /* own elements, then the ghost layer            */
+    int64_t *optr;         /* nn + 1: other ranks holding each node ...     */
+    int *orank;            /* ... ascending                                 */
+    /* element order keys of the whole mesh (dist_split_setup): its box
+       (min xyz, max xyz, allreduced) for Morton keys, and whether element
+       tags are one dense run, so that an element's index in the
+       single-process order is tag - tag_min without a global sort */
+    double box[6];
+    int64_t tag_min;
+    int dense_tags;
+    /* rank 0: the whole mesh for the finishing step (until that step runs
+       on gathered patches): nodes in ascending tag */
+    getme_mesh *whole;
+    int32_t whole_nn;
+    uint64_t *whole_tag;
+} dist_split;
+
+/* Rank 0: NAME_1.msh with $PartitionedEntities and NAME_2.msh .. beside
+   it (split files), or a file with $PartitionedEntities; the mode. */
+int dist_split_detect(dist_split *s, const char *input);
+/* Input part k's path (1-based). */
+void dist_split_path(const dist_split *s, int k, char *buf, size_t size);
+/* Rank's contiguous range of the N parts (P <= N). */
+void dist_split_range(dist_split *s, int rank, int size);
+/* Rank 0 before reading: the output parts may be written and none is an
+   input part; note gets a line about stale parts of an earlier run. */
+int dist_split_check_output(const dist_split *s, const char *output,
+                            char *msg, size_t size, char *note,
+                            size_t note_size);
+/* Read this rank's parts (not collective): 0, or -1 with msg and the exit
+   code getme smooth gives for that error. */
+int dist_split_read(dist_split *s, const getme_doc_options *opts, char *msg,
+                    size_t size, int *code);
+/* Collective: skin, interfaces, fixed marks, ghost layer, neighbours:
+   the part into c. */
+int dist_split_setup(dist_split *s, dist_ctx *c, unsigned fix_flags);
+/* Collective: rank 0 builds s->whole (the finishing step's mesh). */
+int dist_split_whole(dist_split *s, dist_ctx *c, char *msg, size_t size);
+int32_t whole_index(const dist_split *s, uint64_t tag);
+/* Collective: the part's positions of counted nodes into rank 0's xyz. */
+void dist_split_gather(dist_split *s, dist_ctx *c, const double *part_xyz,
+                       double *xyz);
+/* Collective: rank 0's final xyz to the ranks' node tables. */
+void dist_split_scatter(dist_split *s, dist_ctx *c, const double *xyz);
+/* Collective: write the output parts (temporary files, agreement,
+   renames).  0, or -1 with rank 0's message. */
+int dist_split_write(dist_split *s, dist_ctx *c, const char *output,
+                     const double *xyz, char *msg, size_t size);
+/* The lowest failing rank's message on rank 0; every rank learns whether
+   any failed (the failing rank, or -1). */
+int dist_agree(dist_ctx *c, int failed, const char *msg, char *out,
+               size_t size);
+void dist_split_free(dist_split *s);
+
+/* split_common.c: shared by the split*.c files */
+void dist_stop(const char *why);      /* MPI_Abort with one error line */
+void *dist_xalloc(size_t n);          /* malloc or dist_stop           */
+int32_t dist_find_node(const dist_split *s, uint64_t tag); /* -1: none */
+int dist_merge_nodes(dist_split *s, char *msg, size_t size);
+int dist_cmp_node(const void *a, const void *b); /* qsort by tag */
 
 #endif /* GETME_DIST_H */

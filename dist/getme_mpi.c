@@ -134,25 +134,63 @@ static getme_status build_part(const dist_ctx *c, getme_mesh **out)
     return st;
 }
 
-/* The lowest failing rank's message to rank 0; every rank learns whether
-   any failed (returns the failing rank, or -1). */
-static int agree(dist_ctx *c, int failed, const char *msg, char *out,
-                 size_t size)
+/* Every rank runs GETMe adaptive on its part (collective); with -v the
+   per-rank numbers bench/mpi.py reads.  0, or 1 after one error line
+   from rank 0. */
+static int smooth_parts(dist_ctx *c, args *a, getme_mesh *part,
+                        const getme_params *base, getme_result *res,
+                        double *loop_seconds)
 {
-    int mine = failed ? c->rank : c->size, first = c->size;
-    MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, c->comm);
-    if (first == c->size)
-        return -1;
-    if (first != 0) {
-        if (c->rank == first)
-            MPI_Send(msg, (int)strlen(msg) + 1, MPI_CHAR, 0, 99, c->comm);
+    const cli_log *log = &a->o.log;
+    getme_params params = *base;
+    run_state rs = {c, a, 0, 0.0};
+    params.progress = on_progress;
+    params.progress_data = &rs;
+    getme_comm hooks;
+    dist_comm_hooks(c, &hooks);
+    c->bytes_sent = c->bytes_reduced = 0; /* the loop's, not the set-up's */
+    c->comm_seconds = 0.0;
+    int threads = params.num_threads;
+    char msg[1200] = "", err[1200] = "";
+    cli_info(log, "Optimizing mesh (GETMe adaptive, %d ranks, %d thread%s "
+             "each)...", c->size, threads, threads == 1 ? "" : "s");
+    double ts = MPI_Wtime();
+    getme_status st = getme_smooth_part(part, &params, &hooks, res);
+    if (st != GETME_OK)
+        snprintf(msg, sizeof msg, "smoothing: %s", getme_mesh_error(part));
+    int first = dist_agree(c, st != GETME_OK, msg, err, sizeof err);
+    if (first >= 0) {
         if (c->rank == 0)
-            MPI_Recv(out, (int)size, MPI_CHAR, first, 99, c->comm,
-                     MPI_STATUS_IGNORE);
-    } else if (c->rank == 0) {
-        snprintf(out, size, "%s", msg);
+            cli_error("rank %d of %d: %s; no output written", first, c->size,
+                      err);
+        return 1;
     }
-    return first;
+    *loop_seconds = MPI_Wtime() - ts;
+    if (log->verbose) { /* per rank: the benchmark's numbers (bench/mpi.py) */
+        struct rusage ru;
+        getrusage(RUSAGE_SELF, &ru);
+        int64_t owned = 0;
+        for (int32_t e = 0; e < c->ne; e++)
+            owned += c->owned[e];
+        double mine[9] = {(double)c->ne, (double)owned, (double)c->nn,
+                          c->nb_ptr ? (double)c->nb_ptr[c->num_nb] : 0.0,
+                          *loop_seconds, c->comm_seconds,
+                          (double)c->bytes_sent, (double)c->bytes_reduced,
+                          (double)ru.ru_maxrss / 1024.0};
+        double *all = c->rank == 0 ? malloc((size_t)c->size * sizeof mine)
+                                   : NULL;
+        MPI_Gather(mine, 9, MPI_DOUBLE, all, 9, MPI_DOUBLE, 0, c->comm);
+        for (int r = 0; all && r < c->size; r++) {
+            const double *v = all + 9 * r;
+            cli_info(log, "Rank %d: %.0f elements (%.0f owned), %.0f nodes "
+                     "(%.0f shared copies), loop %.3f s, comm %.3f s, sent "
+                     "%.3f MiB, reduced %.3f MiB, max RSS %.1f MiB",
+                     r, v[0], v[1], v[2], v[3], v[4], v[5], v[6] / 1048576.0,
+                     v[7] / 1048576.0, v[8]);
+        }
+        free(all);
+    }
+    return 0;
 }
 
 /* Rank 0 before the split: check the paths, read, untangle.  0 to go on,
@@ -273,6 +311,204 @@ out:
     return code;
 }
 
+/* With -v, at the end (collective): every rank's peak RSS over the whole
+   run, reading and writing included (bench/mpi.py). */
+static void log_peak_rss(dist_ctx *c, const cli_log *log)
+{
+    if (!log->verbose)
+        return;
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    double mine = (double)ru.ru_maxrss / 1024.0;
+    double *all = c->rank == 0 ? malloc((size_t)c->size * sizeof *all) : NULL;
+    MPI_Gather(&mine, 1, MPI_DOUBLE, all, 1, MPI_DOUBLE, 0, c->comm);
+    if (all) {
+        char line[4096];
+        size_t used = 0;
+        for (int r = 0; r < c->size && used < sizeof line; r++)
+            used += (size_t)snprintf(line + used, sizeof line - used, "%s%.1f",
+                                     r ? "/" : "", all[r]);
+        cli_info(log, "Peak RSS per rank (whole run): %s MiB", line);
+    }
+    free(all);
+}
+
+/* Gmsh-partitioned input read per rank (split.c, docs/distributed.md §3):
+   every rank reads its own parts, the ranks build the parts among
+   themselves, rank 0 runs the finishing step on the whole mesh it
+   gathered, every rank writes its own output parts.  The exit code. */
+static int run_split(dist_ctx *c, args *a, dist_split *s)
+{
+    cli_smooth_opts *so = &a->o;
+    const cli_log *log = &so->log;
+    char msg[1200] = "", err[1200] = "", note[DIST_PATH + 200] = "";
+    int code = 0;
+    getme_mesh *part = NULL;
+    double *xyz = NULL;
+    getme_result res;
+    memset(&res, 0, sizeof res);
+    double t0 = MPI_Wtime();
+    if (c->rank == 0) {
+        if (so->report) {
+            cli_error("--report: not written for Gmsh-partitioned input "
+                      "read per rank (getme smooth writes it)");
+            code = EXIT_USAGE;
+        } else if (dist_split_check_output(s, a->output, msg, sizeof msg,
+                                           note, sizeof note) != 0) {
+            cli_error("%s", msg);
+            code = EXIT_USAGE;
+        } else if (note[0]) {
+            cli_warning(log, "%s", note);
+        }
+    }
+    MPI_Bcast(&code, 1, MPI_INT, 0, c->comm);
+    if (code)
+        return code;
+
+    /* 1. every rank reads its own parts; any failure stops all */
+    dist_split_range(s, c->rank, c->size);
+    getme_doc_options opts;
+    cli_smooth_doc_options(so, &opts);
+    unsigned flags = (opts.fix_skin ? (unsigned)GETME_FIX_SKIN : 0u) |
+                     (opts.fix_interfaces ? (unsigned)GETME_FIX_INTERFACES : 0u);
+    char first[DIST_PATH], last[DIST_PATH];
+    dist_split_path(s, 1, first, sizeof first);
+    dist_split_path(s, s->nparts, last, sizeof last);
+    if (s->mode == DIST_SPLIT_FILES)
+        cli_info(log, "Reading %d split files '%s' .. '%s' on %d ranks, each "
+                 "rank its own...", s->nparts, first, last, c->size);
+    else
+        cli_info(log, "Reading '%s' (%d partitions) on %d ranks, each rank "
+                 "its own partitions...", s->input, s->nparts, c->size);
+    int rcode = 0;
+    int bad = dist_split_read(s, &opts, msg, sizeof msg, &rcode) != 0;
+    const char *fail = getenv("GETME_MPI_FAIL_RANK");
+    if (!bad && fail && atoi(fail) == c->rank) {
+        snprintf(msg, sizeof msg, "cannot read its part (failure injected by "
+                 "GETME_MPI_FAIL_RANK)");
+        bad = 1, rcode = 1;
+    }
+    int who = dist_agree(c, bad, msg, err, sizeof err);
+    if (who >= 0) {
+        MPI_Bcast(&rcode, 1, MPI_INT, who, c->comm);
+        if (c->rank == 0)
+            cli_error("rank %d of %d: %s; no output written", who, c->size,
+                      err);
+        return rcode;
+    }
+
+    /* 2. the parts: skin, interfaces, ghost layer, neighbours; rank 0's
+       whole mesh for the finishing step */
+    double tp = MPI_Wtime();
+    if (dist_split_setup(s, c, flags) != 0) {
+        if (c->rank == 0)
+            cli_error("setting up the parts: an exchange failed; no output "
+                      "written");
+        return 1;
+    }
+    code = dist_split_whole(s, c, msg, sizeof msg) != 0;
+    MPI_Bcast(&code, 1, MPI_INT, 0, c->comm);
+    if (code) {
+        if (c->rank == 0)
+            cli_error("%s; no output written", msg);
+        return 1;
+    }
+    getme_quality_stats before;
+    cli_measures mbefore;
+    if (c->rank == 0) {
+        getme_mesh *w = s->whole;
+        cli_info(log, "Parts set up in %.2f s: %ld elements, %ld nodes (%ld "
+                 "fixed), %lld interface nodes, %lld ghost elements",
+                 MPI_Wtime() - tp, (long)getme_mesh_num_elements(w),
+                 (long)getme_mesh_num_nodes(w), (long)getme_mesh_num_fixed(w),
+                 (long long)c->interface_nodes, (long long)c->ghost_elements);
+        getme_mesh_quality_stats(w, -1, &before);
+        cli_print_stats(log, "Quality before", &before);
+        cli_measures_log(log, w, "Measures before", &mbefore);
+    }
+    getme_status st = build_part(c, &part);
+    msg[0] = 0;
+    if (st != GETME_OK)
+        snprintf(msg, sizeof msg, "building its part: %s",
+                 part ? getme_mesh_error(part) : getme_status_string(st));
+    if (!msg[0] && dist_comm_init(c) != 0)
+        snprintf(msg, sizeof msg, "out of memory for communication");
+    who = dist_agree(c, msg[0] != 0, msg, err, sizeof err);
+    if (who >= 0) {
+        if (c->rank == 0)
+            cli_error("rank %d of %d: %s; no output written", who, c->size,
+                      err);
+        getme_mesh_free(part);
+        return 1;
+    }
+
+    /* 3. smooth; the finishing step on rank 0 */
+    getme_params params = so->params;
+    double loop_seconds = 0.0;
+    if (smooth_parts(c, a, part, &params, &res, &loop_seconds) != 0) {
+        getme_mesh_free(part);
+        return 1;
+    }
+    if (c->rank == 0) {
+        xyz = malloc((size_t)s->whole_nn * 3 * sizeof *xyz);
+        if (!xyz) {
+            cli_error("out of memory; no output written");
+            MPI_Abort(c->comm, 1);
+        }
+        getme_mesh_get_coords(s->whole, xyz);
+    }
+    dist_split_gather(s, c, getme_mesh_coords(part), xyz);
+    getme_mesh_free(part);
+    if (c->rank == 0) {
+        double tf = MPI_Wtime();
+        params.progress = cli_smooth_progress; /* rank 0 alone */
+        params.progress_data = so;
+        st = getme_smooth_finish(s->whole, &params, xyz, &res);
+        if (st != GETME_OK) {
+            cli_error("%s: %s; no output written", a->input,
+                      getme_mesh_error(s->whole));
+            code = 1;
+        } else {
+            cli_info(log, "GETMe adaptive: %d iterations (%d q_mean, %d "
+                     "q*_min in %d cycles) in %.2f s on %d ranks, finishing "
+                     "%d passes in %.2f s",
+                     res.iterations, res.iterations_mean, res.iterations_min,
+                     res.cycles_min, loop_seconds, c->size,
+                     res.passes_finish, MPI_Wtime() - tf);
+            cli_smooth_done(so, &res);
+            getme_quality_stats after;
+            cli_measures mafter;
+            getme_mesh_quality_stats(s->whole, -1, &after);
+            cli_print_stats(log, "Quality after ", &after);
+            cli_measures_log(log, s->whole, "Measures after ", &mafter);
+            getme_mesh_get_coords(s->whole, xyz);
+        }
+    }
+    MPI_Bcast(&code, 1, MPI_INT, 0, c->comm);
+
+    /* 4. every rank writes its own output parts */
+    if (code == 0) {
+        if (s->mode == DIST_SPLIT_FILES)
+            dist_split_scatter(s, c, xyz);
+        cli_guard guard = {0};
+        cli_write_guard(&guard, 1);
+        cli_info(log, "Writing '%s'%s...", a->output,
+                 s->mode == DIST_SPLIT_FILES ? " as parts _1 .. _N, each by "
+                                               "its rank" : " on rank 0");
+        if (dist_split_write(s, c, a->output, xyz, msg, sizeof msg) != 0) {
+            if (c->rank == 0)
+                cli_error("%s", msg);
+            code = CLI_EXIT_WRITE;
+        } else {
+            cli_info(log, "Done (%.2f s in all)", MPI_Wtime() - t0);
+        }
+        cli_write_guard(&guard, 0);
+    }
+    log_peak_rss(c, log);
+    free(xyz);
+    return code;
+}
+
 int main(int argc, char **argv)
 {
     MPI_Init(&argc, &argv);
@@ -298,6 +534,30 @@ int main(int argc, char **argv)
     }
     if (c.rank != 0)
         a.o.log.quiet = 1; /* rank 0 logs; errors reach it (agree) */
+    /* Gmsh-partitioned input: every rank reads its own parts when there
+       are at least as many parts as ranks; else rank 0 reads and splits */
+    dist_split *split = calloc(1, sizeof *split);
+    if (!split) {
+        cli_error("out of memory");
+        MPI_Abort(c.comm, 1);
+    }
+    if (c.rank == 0)
+        dist_split_detect(split, a.input);
+    MPI_Bcast(split, (int)sizeof *split, MPI_BYTE, 0, c.comm);
+    if (split->mode != DIST_SPLIT_NONE && split->nparts >= c.size) {
+        code = run_split(&c, &a, split);
+        dist_split_free(split);
+        free(split);
+        dist_comm_free(&c);
+        dist_part_free(&c);
+        cli_smooth_opts_free(&a.o);
+        MPI_Finalize();
+        return code;
+    }
+    if (split->mode != DIST_SPLIT_NONE)
+        cli_info(&a.o.log, "%d partitions for %d ranks: rank 0 reads them "
+                 "all and splits the mesh with METIS", split->nparts, c.size);
+    free(split);
     cli_smooth_opts *so = &a.o;
     const cli_log *log = &so->log;
     double t0 = MPI_Wtime();
@@ -352,7 +612,7 @@ int main(int argc, char **argv)
                      part ? getme_mesh_error(part) : getme_status_string(st));
         if (!msg[0] && dist_comm_init(&c) != 0)
             snprintf(msg, sizeof msg, "out of memory for communication");
-        int first = agree(&c, msg[0] != 0, msg, err, sizeof err);
+        int first = dist_agree(&c, msg[0] != 0, msg, err, sizeof err);
         if (first >= 0) {
             if (c.rank == 0)
                 cli_error("rank %d of %d: %s; no output written", first,
@@ -364,49 +624,10 @@ int main(int argc, char **argv)
 
     /* 3. smooth */
     getme_params params = so->params;
-    run_state rs = {&c, &a, 0, 0.0};
-    params.progress = on_progress;
-    params.progress_data = &rs;
-    getme_comm hooks;
-    dist_comm_hooks(&c, &hooks);
-    int threads = params.num_threads;
-    cli_info(log, "Optimizing mesh (GETMe adaptive, %d ranks, %d thread%s "
-             "each)...", c.size, threads, threads == 1 ? "" : "s");
-    double ts = MPI_Wtime();
-    getme_status st = getme_smooth_part(part, &params, &hooks, &res);
-    if (st != GETME_OK)
-        snprintf(msg, sizeof msg, "smoothing: %s", getme_mesh_error(part));
-    int first = agree(&c, st != GETME_OK, msg, err, sizeof err);
-    if (first >= 0) {
-        if (c.rank == 0)
-            cli_error("rank %d of %d: %s; no output written", first, c.size,
-                      err);
+    double loop_seconds = 0.0;
+    if (smooth_parts(&c, &a, part, &params, &res, &loop_seconds) != 0) {
         code = 1;
         goto out;
-    }
-    double loop_seconds = MPI_Wtime() - ts;
-    if (log->verbose) { /* per rank: the benchmark's numbers (bench/mpi.py) */
-        struct rusage ru;
-        getrusage(RUSAGE_SELF, &ru);
-        int64_t owned = 0;
-        for (int32_t e = 0; e < c.ne; e++)
-            owned += c.owned[e];
-        double mine[9] = {(double)c.ne, (double)owned, (double)c.nn,
-                          c.nb_ptr ? (double)c.nb_ptr[c.num_nb] : 0.0,
-                          loop_seconds, c.comm_seconds,
-                          (double)c.bytes_sent, (double)c.bytes_reduced,
-                          (double)ru.ru_maxrss / 1024.0};
-        double *all = c.rank == 0 ? malloc((size_t)c.size * sizeof mine) : NULL;
-        MPI_Gather(mine, 9, MPI_DOUBLE, all, 9, MPI_DOUBLE, 0, c.comm);
-        for (int r = 0; all && r < c.size; r++) {
-            const double *v = all + 9 * r;
-            cli_info(log, "Rank %d: %.0f elements (%.0f owned), %.0f nodes "
-                     "(%.0f shared copies), loop %.3f s, comm %.3f s, sent "
-                     "%.3f MiB, reduced %.3f MiB, max RSS %.1f MiB",
-                     r, v[0], v[1], v[2], v[3], v[4], v[5], v[6] / 1048576.0,
-                     v[7] / 1048576.0, v[8]);
-        }
-        free(all);
     }
     /* 4. the finishing step on the worst elements' patches (finish_sub.c):
        then every part holds the final positions */
@@ -502,7 +723,7 @@ int main(int argc, char **argv)
     /* 6. rank 0: write */
     if (c.rank == 0) {
         getme_mesh *mesh = getme_doc_mesh(doc);
-        st = getme_mesh_set_coords(mesh, xyz);
+        getme_status st = getme_mesh_set_coords(mesh, xyz);
         res.num_invalid_initial = ur.num_invalid_before;
         res.untangle_sweeps = ur.sweeps;
         res.untangle_seconds = ur.seconds;
@@ -523,6 +744,7 @@ int main(int argc, char **argv)
         }
     }
     MPI_Bcast(&code, 1, MPI_INT, 0, c.comm);
+    log_peak_rss(&c, log);
 out:
     free(xyz);
     getme_mesh_free(part);

@@ -68,48 +68,24 @@ static int fill_part(dist_ctx *c, const part *p, const getme_mesh *mesh,
             c->conn[m++] = glocal[eind[j]];
     }
     /* neighbours: for each node, the other ranks holding it */
-    int *cnt = calloc((size_t)c->size, sizeof *cnt);
-    if (!cnt)
+    int64_t *optr = xmalloc(((size_t)p->nn + 1) * sizeof *optr);
+    int *orank = NULL;
+    if (!optr)
         return -1;
+    optr[0] = 0;
     for (int32_t k = 0; k < p->nn; k++)
-        for (int32_t h = hptr[p->nodes[k]]; h < hptr[p->nodes[k] + 1]; h++)
-            if (hrank[h] != r)
-                cnt[hrank[h]]++;
-    c->num_nb = 0;
-    for (int q = 0; q < c->size; q++)
-        c->num_nb += cnt[q] > 0;
-    c->nb_rank = xmalloc((size_t)c->num_nb * sizeof *c->nb_rank);
-    c->nb_count = xmalloc((size_t)c->num_nb * sizeof *c->nb_count);
-    c->nb_ptr = xmalloc(((size_t)c->num_nb + 1) * sizeof *c->nb_ptr);
-    int *slot = xmalloc((size_t)c->size * sizeof *slot);
-    if (!c->nb_rank || !c->nb_count || !c->nb_ptr || !slot) {
-        free(cnt), free(slot);
+        optr[k + 1] = optr[k] + hptr[p->nodes[k] + 1] - hptr[p->nodes[k]] - 1;
+    if (!(orank = xmalloc((size_t)optr[p->nn] * sizeof *orank))) {
+        free(optr);
         return -1;
     }
-    int k2 = 0;
-    c->nb_ptr[0] = 0;
-    for (int q = 0; q < c->size; q++)
-        if (cnt[q] > 0) {
-            c->nb_rank[k2] = q;
-            c->nb_count[k2] = cnt[q];
-            c->nb_ptr[k2 + 1] = c->nb_ptr[k2] + cnt[q];
-            slot[q] = k2++;
-        }
-    c->nb_node = xmalloc((size_t)c->nb_ptr[c->num_nb] * sizeof *c->nb_node);
-    if (!c->nb_node) {
-        free(cnt), free(slot);
-        return -1;
-    }
-    int64_t *pos = xmalloc((size_t)(c->num_nb + 1) * sizeof *pos);
-    for (int k = 0; pos && k < c->num_nb; k++)
-        pos[k] = c->nb_ptr[k];
-    for (int32_t k = 0; pos && k < p->nn; k++)
+    for (int32_t k = 0, m = 0; k < p->nn; k++)
         for (int32_t h = hptr[p->nodes[k]]; h < hptr[p->nodes[k] + 1]; h++)
             if (hrank[h] != r)
-                c->nb_node[pos[slot[hrank[h]]]++] = k;
-    int ok = pos != NULL;
-    free(pos), free(cnt), free(slot);
-    return ok ? 0 : -1;
+                orank[m++] = hrank[h];
+    int rc = dist_neighbours(c, p->nn, optr, orank);
+    free(optr), free(orank);
+    return rc;
 }
 
 /* Send c's part to rank r (then free it). */

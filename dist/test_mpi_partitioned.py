@@ -11,9 +11,11 @@ are not fixed: the same number of fixed nodes as the unpartitioned mesh
 (--report); `getme smooth` on both gives the same coordinates up to the
 16 significant digits Gmsh's writer prints (every node's coordinates of the
 partitioned output are the unpartitioned output's rounded to %.16g);
-`mpirun -np 2 getme-mpi smooth` on the partitioned file writes the same
-bytes as `getme smooth` on it, and Gmsh reopens that output with its 3
-partitions.
+`mpirun -np 2 getme-mpi smooth` on the partitioned file (each rank
+reading its own partitions natively, docs/distributed.md §3) writes the
+unpartitioned output's coordinates bit for bit (no rounding to Gmsh's 16
+digits: the native writer copies the file with only the coordinates
+changed), and Gmsh reopens both outputs with their 3 partitions.
 """
 import json
 import os
@@ -73,10 +75,11 @@ with tempfile.TemporaryDirectory() as tmp:
                         parts, "-o", mpi_out, "-q"], capture_output=True, text=True,
                        env=ENV)
     c.check(p.returncode == 0, f"getme-mpi -np 2: exit {p.returncode}: {p.stderr[-400:]}")
-    c.check(os.path.exists(mpi_out) and
-            open(mpi_out, "rb").read() == open(out["parts"], "rb").read(),
-            "getme-mpi -np 2 on the partitioned file: getme smooth's bytes")
-    _, np_mpi = nodes(mpi_out) if os.path.exists(mpi_out) else (None, 0)
+    m, np_mpi = nodes(mpi_out) if os.path.exists(mpi_out) else ({}, 0)
+    same = sum(m.get(t) == a[t] for t in a)
+    c.check(a and same == len(a) and len(m) == len(a),
+            f"getme-mpi -np 2 on the partitioned file: {same} of {len(a)} "
+            "nodes the unpartitioned result bit for bit")
     c.check(np_out == 3 and np_mpi == 3,
             f"Gmsh reopens the outputs with 3 partitions ({np_out}, {np_mpi})")
 

@@ -21,6 +21,11 @@ struct getme_doc {
     /* when elem_ids was one run (id = e + 1 + elem_id_shift for every e) it
        is freed after the read: 8 bytes per element less through smoothing */
     int64_t elem_id_shift;
+    /* one part of a partitioned MSH file (getme_doc_options.one_part):
+       node tags per mesh node, region keys per element, partitions     */
+    uint64_t *node_ids;
+    int32_t *elem_region;
+    int num_partitions;
     getme_quality_stats stats; /* all elements as read (getme_doc_open)     */
     int have_stats;
     char info[1024];     /* one line the CLI may log: zones, sets, fixed...  */

@@ -133,6 +133,21 @@ const getme_quality_stats *getme_doc_stats(const getme_doc *doc)
     return doc && doc->have_stats ? &doc->stats : NULL;
 }
 
+uint64_t getme_doc_node_id(const getme_doc *doc, int32_t i)
+{
+    return doc->node_ids ? doc->node_ids[i] : 0;
+}
+
+int32_t getme_doc_element_region(const getme_doc *doc, int32_t e)
+{
+    return doc->elem_region ? doc->elem_region[e] : -1;
+}
+
+int getme_doc_num_partitions(const getme_doc *doc)
+{
+    return doc->num_partitions;
+}
+
 int64_t getme_doc_element_id(const getme_doc *doc, int32_t e)
 {
     return doc->elem_ids ? doc->elem_ids[e]
@@ -170,6 +185,11 @@ static void reset(getme_doc *doc)
     if (doc->format && doc->format->close)
         doc->format->close(doc);
     getme_doc_set_mesh(doc, NULL, NULL);
+    free(doc->node_ids);
+    free(doc->elem_region);
+    doc->node_ids = NULL;
+    doc->elem_region = NULL;
+    doc->num_partitions = 0;
     doc->impl = NULL;
     doc->format = NULL;
     doc->info[0] = doc->warning[0] = 0;
@@ -335,6 +355,8 @@ void getme_doc_close(getme_doc *doc)
         doc->format->close(doc);
     getme_mesh_free(doc->mesh);
     free(doc->elem_ids);
+    free(doc->node_ids);
+    free(doc->elem_region);
     free(doc->path);
     free(doc);
 }

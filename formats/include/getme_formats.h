@@ -87,6 +87,20 @@ typedef struct getme_doc_options {
     /* Threads the ASCII readers parse with (0: OpenMP's default, 1: the
        calling thread only).  The document is the same for any value. */
     int num_threads;
+    /* 1: read one part of a Gmsh-partitioned MSH 4.1 file (a split file
+       NAME_k.msh, or the part numbered partition of one partitioned file)
+       natively, for a distributed caller (getme-mpi): only that part's
+       elements; nodes on the partition boundaries (entities whose parent
+       is a smoothed volume) are free; the skin and interface rules are
+       the caller's to apply across all parts (fix_skin / fix_interfaces
+       are ignored); node tags and region keys are kept
+       (getme_doc_node_id, getme_doc_element_region).  0 (default):
+       partitioned files are declined by the native reader (the Gmsh
+       plugin reads them whole). */
+    int one_part;
+    int partition;       /* with one_part, for a file holding several
+                            partitions: the one to read (1-based); 0 = all
+                            of the file's elements (a split file)         */
 } getme_doc_options;
 
 /* Fill options with the defaults (fix skin and interfaces, no names, no
@@ -148,6 +162,15 @@ GETME_FORMATS_API const char *getme_doc_file(const getme_doc *doc, size_t i);
 /* The id of mesh element e as written in the file (1-based position if
    the format has no ids). */
 GETME_FORMATS_API int64_t getme_doc_element_id(const getme_doc *doc, int32_t e);
+/* With getme_doc_options.one_part: the file's tag of mesh node i, and a
+   region key of mesh element e that is the same in every part of the
+   partitioned model (elements of the same non-empty set of physical
+   groups, or of the same model volume when in none, share it); the number
+   of partitions of the model.  Else 0, -1 and 0. */
+GETME_FORMATS_API uint64_t getme_doc_node_id(const getme_doc *doc, int32_t i);
+GETME_FORMATS_API int32_t getme_doc_element_region(const getme_doc *doc,
+                                                   int32_t e);
+GETME_FORMATS_API int getme_doc_num_partitions(const getme_doc *doc);
 
 /* ---- safe writing (used by the adapters and by programs) --------------- */
 

@@ -98,6 +98,11 @@ static int cmp_nblock(const void *a, const void *b)
 
 static int smoothed_entity(const msh41_reader *r, int dim, int tag)
 {
+    if (r->partitioned) { /* a piece of a volume: a cut moves with it */
+        const msh41_entity *e = msh41_find_entity(r, dim, tag);
+        if (e && e->parent_dim == r->top_dim)
+            return 1;
+    }
     if (dim != r->top_dim)
         return 0;
     size_t lo = 0, hi = r->neb; /* blocks are sorted by tag */
@@ -242,8 +247,39 @@ static getme_formats_status make_input(msh41_reader *r, getme__model_in *in,
         .phys = *phys,
         .num_phys = *nphys,
         .z_plane_only = 1,
-        .fix_flags = (o && !o->fix_skin ? 0u : GETME_FIX_SKIN) |
-                     (o && !o->fix_interfaces ? 0u : GETME_FIX_INTERFACES)};
+        .fix_flags = r->partitioned ? 0u /* the caller's, across parts */
+                     : (o && !o->fix_skin ? 0u : GETME_FIX_SKIN) |
+                       (o && !o->fix_interfaces ? 0u : GETME_FIX_INTERFACES)};
+    return GETME_FORMATS_OK;
+}
+
+/* One part of a partitioned file: the node tags per mesh node and the
+   region key per mesh element (blocks in mesh order), for the caller that
+   stitches the parts (getme_doc_node_id, getme_doc_element_region). */
+static getme_formats_status part_ids(msh41_reader *r,
+                                     const getme__model_out *out)
+{
+    getme_doc *doc = r->doc;
+    size_t ne = 0;
+    for (size_t b = 0; b < r->neb; b++)
+        ne += (size_t)r->eb[b].count;
+    doc->node_ids = malloc((out->num_nodes ? (size_t)out->num_nodes : 1) *
+                           sizeof *doc->node_ids);
+    doc->elem_region = malloc((ne ? ne : 1) * sizeof *doc->elem_region);
+    if (!doc->node_ids || !doc->elem_region)
+        return oom(r);
+    for (size_t i = 0; i < r->nnodes; i++)
+        if (out->loc[i] >= 0)
+            doc->node_ids[out->loc[i]] = r->tags[i];
+    size_t k = 0;
+    for (size_t b = 0; b < r->neb; b++) {
+        const msh41_entity *e =
+            msh41_find_entity(r, r->top_dim, r->eb[b].tag);
+        int32_t key = e ? e->region : -1;
+        for (int32_t j = 0; j < r->eb[b].count; j++)
+            doc->elem_region[k++] = key;
+    }
+    doc->num_partitions = r->num_partitions;
     return GETME_FORMATS_OK;
 }
 
@@ -270,6 +306,8 @@ getme_formats_status msh41_build(msh41_reader *r, msh41_doc *m)
         if (gs != GETME_OK)
             st = model_fail(r, gs, out.msg);
     }
+    if (st == GETME_FORMATS_OK && r->partitioned)
+        st = part_ids(r, &out);
     if (st == GETME_FORMATS_OK) {
         getme__nodemap_relabel(&r->map, out.loc);
         /* The file-order arrays are no longer needed: free them before the

@@ -126,6 +126,10 @@ typedef struct msh41_entity { /* $Entities entry */
     int dim, tag;
     size_t phys_first, phys_count; /* into msh41_reader.phys */
     int fix;                       /* in a group named by --fix */
+    /* partitioned files ($PartitionedEntities, one_part only): */
+    int parent_dim, parent_tag;    /* the model entity it is a piece of */
+    int skip;                      /* not in the partition being read   */
+    int32_t region;                /* getme_doc_element_region's key    */
 } msh41_entity;
 
 typedef struct msh41_nblock { /* one $Nodes entity block (file order) */
@@ -152,6 +156,11 @@ typedef struct msh41_reader {
     size_t nnames;
     msh41_entity *ents;       /* sorted by (dim, tag) */
     size_t nents;
+    /* a partitioned file read as one part (opts->one_part): ents are then
+       the $PartitionedEntities, model_ents the model's $Entities */
+    int partitioned, num_partitions;
+    msh41_entity *model_ents;
+    size_t nmodel_ents;
     int *phys;
     size_t nphys;
     int *fix_found;           /* groups matched per --fix word */

@@ -334,15 +334,15 @@ static getme_formats_status add_phys(msh41_reader *r, int tag, size_t *cap)
     return GETME_FORMATS_OK;
 }
 
-/* One entity: tag, box (a point for dim 0), physical tags, bounding
-   entities (skipped). */
-static getme_formats_status read_entity(msh41_reader *r, int dim, msh41_entity *e,
-                                   size_t *cap)
+/* One entity after its tag (and for a partitioned entity its parent and
+   partitions): box (a point for dim 0), physical tags, bounding entities
+   (skipped). */
+static getme_formats_status read_entity_rest(msh41_reader *r, int dim,
+                                             msh41_entity *e, size_t *cap)
 {
     uint64_t n = 0;
     double skip;
-    e->dim = dim;
-    getme_formats_status st = read_int(r, &e->tag, "entity tag");
+    getme_formats_status st = GETME_FORMATS_OK;
     for (int k = 0; k < (dim ? 6 : 3) && st == GETME_FORMATS_OK; k++)
         st = read_double(r, &skip);
     if (st == GETME_FORMATS_OK)
@@ -362,6 +362,15 @@ static getme_formats_status read_entity(msh41_reader *r, int dim, msh41_entity *
         st = read_int(r, &tag, "bounding entity tag");
     }
     return st;
+}
+
+/* One $Entities entry. */
+static getme_formats_status read_entity(msh41_reader *r, int dim,
+                                        msh41_entity *e, size_t *cap)
+{
+    e->dim = dim;
+    getme_formats_status st = read_int(r, &e->tag, "entity tag");
+    return st == GETME_FORMATS_OK ? read_entity_rest(r, dim, e, cap) : st;
 }
 
 static int cmp_entity(const void *a, const void *b)
@@ -416,6 +425,115 @@ static getme_formats_status read_entities(msh41_reader *r)
     return st;
 }
 
+/* ---- $PartitionedEntities (one part of a partitioned file) --------------
+ * numPartitions, the ghost entities (tag, partition; refused: their
+ * elements are copies), then per dimension the partitioned entities: tag,
+ * parentDim, parentTag, numPartitions and their tags, then as in
+ * $Entities.  Element and node blocks name these entities; the model's
+ * own $Entities (read before) stay as model_ents, for region keys. */
+
+/* The region key of a partitioned volume: the index among the model's
+   entities of the first entity of its dimension with the same non-empty
+   set of physical tags, else of its parent (the same in every part, as
+   every part carries the whole model's $Entities). */
+static int32_t region_key(const msh41_reader *r, const msh41_entity *e)
+{
+    const int *p = r->phys + e->phys_first;
+    for (size_t i = 0; e->phys_count && i < r->nmodel_ents; i++) {
+        const msh41_entity *m = &r->model_ents[i];
+        if (m->dim != e->dim || m->phys_count != e->phys_count)
+            continue;
+        size_t k = 0; /* same set: every tag of e in m (tags distinct) */
+        for (; k < e->phys_count; k++) {
+            size_t j = 0;
+            while (j < m->phys_count && r->phys[m->phys_first + j] != p[k])
+                j++;
+            if (j == m->phys_count)
+                break;
+        }
+        if (k == e->phys_count)
+            return (int32_t)i;
+    }
+    for (size_t i = 0; i < r->nmodel_ents; i++)
+        if (r->model_ents[i].dim == e->parent_dim &&
+            r->model_ents[i].tag == e->parent_tag)
+            return (int32_t)i;
+    return (int32_t)(r->nmodel_ents + (size_t)e->tag); /* no parent listed */
+}
+
+static getme_formats_status read_pentity(msh41_reader *r, int dim,
+                                         msh41_entity *e, size_t *cap)
+{
+    uint64_t np = 0;
+    int want = r->opts->partition, in = want == 0;
+    e->dim = dim;
+    getme_formats_status st = read_int(r, &e->tag, "entity tag");
+    if (st == GETME_FORMATS_OK)
+        st = read_int(r, &e->parent_dim, "parent dimension");
+    if (st == GETME_FORMATS_OK)
+        st = read_int(r, &e->parent_tag, "parent tag");
+    if (st == GETME_FORMATS_OK)
+        st = read_count(r, &np, "number of partitions", 4);
+    for (uint64_t i = 0; i < np && st == GETME_FORMATS_OK; i++) {
+        int p = 0;
+        st = read_int(r, &p, "partition tag");
+        in |= p == want;
+    }
+    e->skip = !in;
+    return st == GETME_FORMATS_OK ? read_entity_rest(r, dim, e, cap) : st;
+}
+
+static getme_formats_status read_partitioned_entities(msh41_reader *r)
+{
+    r->section = "PartitionedEntities";
+    if (!r->opts || !r->opts->one_part)
+        return msh41_decline(r, "partitioned mesh");
+    if (r->partitioned || r->have_nodes)
+        return msh41_decline(r, "$PartitionedEntities repeated or after "
+                                "$Nodes");
+    uint64_t parts = 0, ghosts = 0, count[4], total = 0;
+    size_t cap = r->nphys;
+    getme_formats_status st = read_count(r, &parts, "number of partitions", 1);
+    if (st == GETME_FORMATS_OK)
+        st = read_count(r, &ghosts, "number of ghost entities", 8);
+    if (st == GETME_FORMATS_OK && ghosts > 0)
+        return msh41_fail(r, GETME_FORMATS_ERR_UNSUPPORTED,
+                          "ghost cells (Mesh.PartitionCreateGhostCells) are "
+                          "not read: partition without them");
+    r->partitioned = 1;
+    r->num_partitions = (int)parts;
+    r->model_ents = r->ents; /* the model's; element blocks name these: */
+    r->nmodel_ents = r->nents;
+    r->ents = NULL;
+    r->nents = 0;
+    for (int d = 0; d < 4 && st == GETME_FORMATS_OK; d++) {
+        st = read_count(r, &count[d], "number of entities", 8);
+        total += st == GETME_FORMATS_OK ? count[d] : 0;
+    }
+    if (st == GETME_FORMATS_OK && total > 0 &&
+        !(r->ents = calloc((size_t)total, sizeof *r->ents)))
+        st = oom(r);
+    for (int d = 0; d < 4 && st == GETME_FORMATS_OK; d++)
+        for (uint64_t i = 0; i < count[d] && st == GETME_FORMATS_OK; i++) {
+            st = read_pentity(r, d, &r->ents[r->nents], &cap);
+            r->nents += st == GETME_FORMATS_OK;
+        }
+    if (st == GETME_FORMATS_OK)
+        st = expect_end(r);
+    for (size_t i = 0; st == GETME_FORMATS_OK && i < r->nents; i++)
+        r->ents[i].region = region_key(r, &r->ents[i]);
+    if (st == GETME_FORMATS_OK && r->nents) {
+        qsort(r->ents, r->nents, sizeof *r->ents, cmp_entity);
+        for (size_t i = 1; i < r->nents; i++)
+            if (cmp_entity(&r->ents[i - 1], &r->ents[i]) == 0)
+                return msh41_fail(r, GETME_FORMATS_ERR_PARSE,
+                                  "partitioned entity (%d, %d) is defined "
+                                  "twice",
+                                  r->ents[i].dim, r->ents[i].tag);
+    }
+    return st;
+}
+
 /* ---- --fix groups ------------------------------------------------------- */
 
 const char *msh41_group_name(const msh41_reader *r, int dim, int tag)
@@ -449,18 +567,21 @@ static getme_formats_status prepare_groups(msh41_reader *r)
         int dim, tag, used = 0;
         int by_tag = sscanf(word, "%d:%d%n", &dim, &tag, &used) == 2 &&
                      word[used] == 0;
-        for (size_t i = 0; i < r->nents; i++) {
-            msh41_entity *e = &r->ents[i];
+        /* one part of a partitioned file: its entities are marked, the
+           model's (every part has them all) only tell a name exists */
+        size_t n = r->nents + r->nmodel_ents;
+        for (size_t i = 0; i < n; i++) {
+            msh41_entity *e = i < r->nents ? &r->ents[i]
+                                           : &r->model_ents[i - r->nents];
             for (size_t k = 0; k < e->phys_count; k++) {
                 int p = r->phys[e->phys_first + k];
                 const char *name = by_tag ? NULL
                                           : msh41_group_name(r, e->dim, p);
                 int match = by_tag ? (e->dim == dim && p == tag)
                                    : (name && strcmp(name, word) == 0);
-                if (match) {
+                if (match && i < r->nents)
                     e->fix |= w < nfix;
-                    r->fix_found[w]++;
-                }
+                r->fix_found[w] += match;
             }
         }
     }
@@ -836,8 +957,8 @@ static getme_formats_status read_element_block(msh41_reader *r)
                           "element block of entity %d (dimension %d): no "
                           "such entity in $Entities or $Nodes",
                           tag, dim);
-    msh41_eblock *b = NULL;
-    if (dim >= 2 && dim >= r->top_dim && count > 0)
+    msh41_eblock *b = NULL; /* partitioned: not the part being read */
+    if (dim >= 2 && dim >= r->top_dim && count > 0 && !(e && e->skip))
         st = new_eblock(r, dim, tag, type, count, nv, &b);
     if (st != GETME_FORMATS_OK)
         return st;
@@ -1271,8 +1392,8 @@ static getme_formats_status read_section(msh41_reader *r, const char *name)
         return r->v22 ? read_nodes22(r) : read_nodes(r);
     if (strcmp(name, "Elements") == 0)
         return r->v22 ? read_elements22(r) : read_elements(r);
-    if (strcmp(name, "PartitionedEntities") == 0)
-        return msh41_decline(r, "partitioned mesh");
+    if (strcmp(name, "PartitionedEntities") == 0 && !r->v22)
+        return read_partitioned_entities(r);
     if (strcmp(name, "MeshFormat") == 0) {
         r->section = "MeshFormat";
         return msh41_fail(r, GETME_FORMATS_ERR_PARSE, "second $MeshFormat");
@@ -1297,6 +1418,7 @@ static void reader_free(msh41_reader *r)
         free(r->names[i].name);
     free(r->names);
     free(r->ents);
+    free(r->model_ents);
     free(r->phys);
     free(r->fix_found);
     free(r->tags);
@@ -1329,6 +1451,10 @@ static void reset_doc(getme_doc *doc)
     doc->mesh = NULL;
     free(doc->elem_ids);
     doc->elem_ids = NULL;
+    free(doc->node_ids);
+    doc->node_ids = NULL;
+    free(doc->elem_region);
+    doc->elem_region = NULL;
     doc->info[0] = 0;
     doc->error[0] = 0;
 }
