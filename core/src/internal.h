@@ -98,6 +98,9 @@ void getme__transform_tet(const double *x, double sigma, double *out);
    coordinate d of node i of tet l; out likewise.  Bit-identical per lane. */
 void getme__transform_tet_lanes(const double (*x)[GETME_LANES], double sigma,
                                 double (*out)[GETME_LANES]);
+/* The same for hexahedra (transform_dual.c). */
+void getme__transform_hex_lanes(const double (*x)[GETME_LANES], double sigma,
+                                double (*out)[GETME_LANES]);
 void getme__transform_hex(const double *x, double sigma, double *out);
 void getme__transform_prism(const double *x, double sigma, double *out);
 void getme__transform_pyramid(const double *x, double sigma, double *out);
