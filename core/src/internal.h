@@ -101,6 +101,10 @@ void getme__transform_tet_lanes(const double (*x)[GETME_LANES], double sigma,
 /* The same for hexahedra (transform_dual.c). */
 void getme__transform_hex_lanes(const double (*x)[GETME_LANES], double sigma,
                                 double (*out)[GETME_LANES]);
+/* getme__quality of GETME_LANES elements of type type at once (x in
+   lanes as above) into q; bit-identical per lane.  Returns 0 (nothing
+   done) for a type without a lane kernel (only tets and hexes have one). */
+int getme__quality_lanes(int type, const double (*x)[GETME_LANES], double *q);
 void getme__transform_hex(const double *x, double sigma, double *out);
 void getme__transform_prism(const double *x, double sigma, double *out);
 void getme__transform_pyramid(const double *x, double sigma, double *out);
