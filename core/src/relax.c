@@ -63,7 +63,10 @@ static void trial_qualities_lanes(getme_run *run, const int32_t *elems,
     const getme_ws *ws = run->ws;
     int t = getme__ws_type(ws, elems[k0]);
     double x[3 * GETME_MAX_NV][GETME_LANES], q[GETME_LANES];
-    if (t == getme__ws_type(ws, elems[k0 + GETME_LANES - 1])) {
+    int same = 1; /* the list need not be sorted (q*_min stage) */
+    for (int l = 1; l < GETME_LANES; l++)
+        same &= elems[k0 + l] >= ws->tstart[t] && elems[k0 + l] < ws->tstart[t + 1];
+    if (same) {
         for (int l = 0; l < GETME_LANES; l++) {
             const int32_t *c = getme__ws_nodes(ws, t, elems[k0 + l]);
             for (int i = 0; i < getme__nv[t]; i++)
