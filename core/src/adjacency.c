@@ -24,6 +24,7 @@ void getme__adj_free(getme_adj *adj)
     free(adj->irregular);
     free(adj->nsum);
     free(adj->esum);
+    getme__blocks_free(&adj->blk);
     memset(adj, 0, sizeof *adj);
 }
 
@@ -327,6 +328,8 @@ getme_status getme__adj_build(getme_adj *adj, getme_ws *ws)
         (st = getme__ws_faces(ws, adj->foff, adj->fnb)) != GETME_OK)
         goto fail;
     counts_and_flags(adj, ws, edeg);
+    if ((st = getme__blocks_build(&adj->blk, ws)) != GETME_OK)
+        goto fail;
     if (check && (st = check_all(adj, ws, rn, re)) != GETME_OK)
         goto fail;
     for (int32_t e = 0; e < ws->ne; e++)

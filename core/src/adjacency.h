@@ -31,6 +31,7 @@
 #ifndef GETME_ADJACENCY_H
 #define GETME_ADJACENCY_H
 
+#include "block_local.h"
 #include "exact.h"
 #include "workspace.h"
 
@@ -63,6 +64,7 @@ typedef struct getme_adj {
     int64_t *nsum;      /* nn: S_v at the current qualities                */
     int64_t *esum;      /* num_edges: S_e at the current qualities         */
     double qscale, qinv; /* 2^(61 - b) and its inverse                    */
+    getme_blocks blk;   /* the blocks' own node lists (block_local.h)      */
 } getme_adj;
 
 /* Build everything above for ws (parallel, deterministic); takes over
@@ -103,10 +105,11 @@ static inline int32_t getme__adj_edge(const getme_adj *adj, const int32_t *c,
 /* Sum of q over N(e) for a regular element e of type t (see above), as
    the nearest double to the exact sum of the fixed-point qualities: the
    inclusion-exclusion is exact in integers, so it equals the union walk's
-   exact sum (weights.c) bit for bit. */
-static inline double getme__adj_nsum(const getme_adj *adj,
-                                     const getme_ws *ws, const double *q,
-                                     int t, int32_t e)
+   exact sum (weights.c) bit for bit.  sv: the wrapped sum of the S_v of
+   e's nodes (the caller may read them from a block-local copy). */
+static inline double getme__adj_nsum_sv(const getme_adj *adj,
+                                        const getme_ws *ws, const double *q,
+                                        int t, int32_t e, uint64_t sv)
 {
     const int32_t *c = getme__ws_nodes(ws, t, e);
     const getme_face_table *ft = &getme__faces[t];
@@ -118,9 +121,7 @@ static inline double getme__adj_nsum(const getme_adj *adj,
        the union of nv stars), so below nv 2^61 <= 2^64: the true value is
        what the wrapped uint64 holds, whatever the partial sums did. */
     const double qs = adj->qscale;
-    uint64_t sv = 0, sf = 0, se = 0;
-    for (int i = 0; i < nv; i++)
-        sv += (uint64_t)adj->nsum[c[i]];
+    uint64_t sf = 0, se = 0;
     for (int k = 0; k < ft->num_faces; k++)
         sf += f[k] >= 0 ? (uint64_t)getme__fx64(q[f[k]], qs) : 0;
     uint64_t qe = (uint64_t)getme__fx64(q[e], qs);
@@ -131,6 +132,18 @@ static inline double getme__adj_nsum(const getme_adj *adj,
         se += (uint64_t)adj->esum[getme__adj_edge(adj, c, t, k, slot[k])];
     return (double)(sv - se + (uint64_t)(ft->num_faces - 1) * qe + sf) *
            adj->qinv;
+}
+
+/* The same, with S_v read from the global sums. */
+static inline double getme__adj_nsum(const getme_adj *adj,
+                                     const getme_ws *ws, const double *q,
+                                     int t, int32_t e)
+{
+    const int32_t *c = getme__ws_nodes(ws, t, e);
+    uint64_t sv = 0;
+    for (int i = 0; i < getme__nv[t]; i++)
+        sv += (uint64_t)adj->nsum[c[i]];
+    return getme__adj_nsum_sv(adj, ws, q, t, e, sv);
 }
 
 #endif /* GETME_ADJACENCY_H */

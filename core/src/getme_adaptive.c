@@ -34,7 +34,7 @@
 enum { MEAN_RUNNING, MIN_START, MIN_RUNNING };
 
 /* How many elements ahead transform_block prefetches (see there). */
-#define PREFETCH_AHEAD 4
+#define PREFETCH_AHEAD 8
 
 /* Eq. 9 weight of element e (type t) at the qualities run->q: from the
    inclusion-exclusion sums (adjacency.h), inlined here because it runs
@@ -51,25 +51,31 @@ static inline double weight(const getme_run *run, int t, int32_t e)
 }
 
 /* A node's contribution w x (3 coordinates) and w, added to its exact
-   fixed-point sums (set_scales): wf = trunc(w wscale) is the element's
+   fixed-point sums a (set_scales): wf = trunc(w wscale) is the element's
    weight as an integer, each coordinate becomes trunc(x pscale), and their
    product is exact in 128 bits, so sum w x and sum w are exact sums of the
    same integer weights.  Returns 1 if a coordinate is beyond run->xbound,
    where the bound would not hold (nothing is added; the caller redoes the
    scatter with a larger bound). */
-static inline int add_node(const getme_run *run, int32_t n, int64_t wf,
-                           const double *x)
+static inline int add_sum(const getme_run *run, getme_fx *a, int64_t wf,
+                          const double *x)
 {
     double b = run->xbound;
     if (!(fabs(x[0]) < b && fabs(x[1]) < b && fabs(x[2]) < b))
         return 1;
-    getme_fx *a = run->facc + 4 * (int64_t)n;
     double ps = run->pscale;
     a[0] += (getme_fx)wf * getme__fx64(x[0], ps);
     a[1] += (getme_fx)wf * getme__fx64(x[1], ps);
     a[2] += (getme_fx)wf * getme__fx64(x[2], ps);
     a[3] += wf;
     return 0;
+}
+
+/* add_sum into node n's global sums. */
+static inline int add_node(const getme_run *run, int32_t n, int64_t wf,
+                           const double *x)
+{
+    return add_sum(run, run->facc + 4 * (int64_t)n, wf, x);
 }
 
 /* AddTransformedElementNodesAndWeights for element e (type t); returns 1
@@ -109,33 +115,64 @@ static inline int add_untransformed(getme_run *run, int t, int32_t e)
     return ovf;
 }
 
-/* The free elements of [e0, e1), all of type t, transformed; t is a
-   constant in each copy (GETME_FOR_TYPE). */
-static inline void transform_block(int t, getme_run *run, int32_t e0,
-                                   int32_t e1, double sigma, int32_t *count,
-                                   int *ovf)
+/* The free elements of block b (all of type t, a constant in each copy,
+   GETME_FOR_TYPE) transformed, in three steps on the block's own node
+   list (block_local.h): copy its nodes' coordinates, S_v and fixed flags
+   into the thread's scratch; weight, transform and sum every element's
+   contributions there; add each node's block sum to its global sums once
+   and mark it in I_T.  The integer sums are exact, so this gives the same
+   bits as adding element by element into the global sums. */
+__attribute__((always_inline)) /* one copy per type: t is a constant */
+static inline void transform_block(int t, getme_run *run, int32_t b,
+                                   double sigma, int32_t *count, int *ovf)
 {
     const getme_ws *ws = run->ws;
+    const getme_adj *adj = run->adj;
+    const getme_blocks *blk = &adj->blk;
+    struct getme_block_scratch *scr = &blk->scratch[omp_get_thread_num()];
+    const int32_t *gn = blk->nodes + blk->nptr[b];
+    int32_t m = (int32_t)(blk->nptr[b + 1] - blk->nptr[b]);
+    double *xl = scr->x;
+    getme_fx *acc = scr->acc;
+    int64_t *ls = scr->nsum;
+    uint8_t *flag = scr->flag;
+    /* The node list is known: prefetch the scattered node data a few
+       nodes ahead, here and in the final addition (perf annotate: those
+       loads missed). */
+    for (int32_t k = 0; k < m; k++) {
+        int32_t g = gn[k];
+        if (k + PREFETCH_AHEAD < m) {
+            int64_t gp = gn[k + PREFETCH_AHEAD];
+            __builtin_prefetch(ws->x + 3 * gp, 0, 3);
+            __builtin_prefetch(adj->nsum + gp, 0, 3);
+        }
+        const double *p = ws->x + 3 * (int64_t)g;
+        xl[3 * k] = p[0], xl[3 * k + 1] = p[1], xl[3 * k + 2] = p[2];
+        ls[k] = adj->nsum[g];
+        flag[k] = ws->fixed[g] != 0;
+        acc[4 * k] = acc[4 * k + 1] = acc[4 * k + 2] = acc[4 * k + 3] = 0;
+    }
     int nv = getme__nv[t];
+    int32_t e0 = ws->block_start[b], e1 = ws->block_start[b + 1];
+    /* The weights first, in a loop of loads with little arithmetic, so the
+       out-of-order core keeps the scattered ones (face neighbours' q, S_e)
+       of several elements in flight; -1 marks an element not transformed
+       (a weight is >= 0). */
+    int64_t *wfs = scr->wf;
     for (int32_t e = e0; e < e1; e++) {
-        /* Prefetch what the element PREFETCH_AHEAD on will touch at
-           scattered places: its node sums' cache lines (for writing) and
-           its weight's inputs (S_v, S_e, the face neighbours' q).  Their
-           misses were most of add_transformed's samples (perf annotate);
-           an element's ~100 ns of arithmetic hides the next ones. */
+        /* Prefetch the scattered inputs of the weight PREFETCH_AHEAD
+           elements on: the face neighbours' q and S_e (their misses were
+           most of this loop's samples, perf annotate).  Written inline:
+           gcc deems a function of prefetches only free of side effects
+           and deletes its calls. */
         if (e + PREFETCH_AHEAD < e1) {
-            const getme_adj *adj = run->adj;
             int32_t ep = e + PREFETCH_AHEAD;
-            const int32_t *c = getme__ws_nodes(ws, t, ep);
-            for (int i = 0; i < nv; i++) {
-                __builtin_prefetch(run->facc + 4 * (int64_t)c[i], 1, 3);
-                __builtin_prefetch(adj->nsum + c[i], 0, 3);
-            }
             const int32_t *f = getme__adj_faces(adj, ws, t, ep);
             for (int k = 0; k < getme__faces[t].num_faces; k++)
                 if (f[k] >= 0)
                     __builtin_prefetch(run->q + f[k], 0, 3);
             if (ws->dim == 3) {
+                const int32_t *c = getme__ws_nodes(ws, t, ep);
                 const uint8_t *slot = getme__adj_slots(adj, ws, t, ep);
                 for (int k = 0; k < getme__edges[t].num_edges; k++)
                     if (slot[k] != GETME_NO_SLOT) /* else: irregular */
@@ -144,11 +181,96 @@ static inline void transform_block(int t, getme_run *run, int32_t e0,
                             0, 3);
             }
         }
+        int64_t wf = -1;
         if (ws->free_elem[e] && getme__owned(run, e)) {
-            *ovf |= add_transformed(run, t, e, sigma);
-            (*count)++;
+            double w;
+            if (adj->irregular[e]) {
+                w = getme__weight_union(run, t, e);
+            } else {
+                const uint16_t *lc = getme__blocks_lnodes(blk, ws, t, e);
+                uint64_t sv = 0;
+                for (int i = 0; i < nv; i++)
+                    sv += (uint64_t)ls[lc[i]];
+                w = sqrt(getme__adj_nsum_sv(adj, ws, run->q, t, e, sv) /
+                         ((double)adj->count[e] * run->q[e]));
+            }
+            wf = getme__fx64(w, run->wscale);
+        }
+        wfs[e - e0] = wf;
+    }
+    int o = 0;
+    int32_t n = 0;
+    if (t == GETME_TET || t == GETME_HEX) { /* GETME_LANES at a time */
+        int32_t *list = scr->list;
+        for (int32_t e = e0; e < e1; e++)
+            if (wfs[e - e0] >= 0)
+                list[n++] = e;
+        for (int32_t j = 0; j < n; j += GETME_LANES) {
+            double x[3 * GETME_MAX_NV][GETME_LANES], y[3 * GETME_MAX_NV][GETME_LANES];
+            for (int l = 0; l < GETME_LANES; l++) {
+                /* a short last batch repeats its first element */
+                int32_t e = list[j + l < n ? j + l : j];
+                const uint16_t *lc = getme__blocks_lnodes(blk, ws, t, e);
+                for (int i = 0; i < nv; i++)
+                    for (int d = 0; d < 3; d++)
+                        x[3 * i + d][l] = xl[3 * lc[i] + d];
+            }
+            if (t == GETME_TET)
+                getme__transform_tet_lanes((const double(*)[GETME_LANES])x,
+                                           sigma, y);
+            else
+                getme__transform_hex_lanes((const double(*)[GETME_LANES])x,
+                                           sigma, y);
+            for (int l = 0; l < GETME_LANES && j + l < n; l++) {
+                int32_t e = list[j + l];
+                const uint16_t *lc = getme__blocks_lnodes(blk, ws, t, e);
+                for (int i = 0; i < nv; i++) {
+                    int k = lc[i];
+                    if (flag[k] & 1) /* fixed */
+                        continue;
+                    double yi[3] = {y[3 * i][l], y[3 * i + 1][l], y[3 * i + 2][l]};
+                    o |= add_sum(run, acc + 4 * k, wfs[e - e0], yi);
+                    flag[k] = 2;
+                }
+            }
+        }
+    } else {
+        for (int32_t e = e0; e < e1; e++) {
+            int64_t wf = wfs[e - e0];
+            if (wf < 0)
+                continue;
+            const uint16_t *lc = getme__blocks_lnodes(blk, ws, t, e);
+            double x[3 * GETME_MAX_NV], y[3 * GETME_MAX_NV];
+            for (int i = 0; i < nv; i++) {
+                const double *p = xl + 3 * lc[i];
+                x[3 * i] = p[0], x[3 * i + 1] = p[1], x[3 * i + 2] = p[2];
+            }
+            getme__transform(t, x, sigma, y);
+            for (int i = 0; i < nv; i++) {
+                int k = lc[i];
+                if (flag[k] & 1) /* fixed */
+                    continue;
+                o |= add_sum(run, acc + 4 * k, wf, y + 3 * i);
+                flag[k] = 2;
+            }
+            n++;
         }
     }
+    getme_fx *facc = run->facc;
+    for (int32_t k = 0; k < m; k++) {
+        if (k + PREFETCH_AHEAD < m)
+            __builtin_prefetch(facc + 4 * (int64_t)gn[k + PREFETCH_AHEAD], 1, 3);
+        if (flag[k] == 2) {
+            int64_t g = gn[k];
+            facc[4 * g] += acc[4 * k];
+            facc[4 * g + 1] += acc[4 * k + 1];
+            facc[4 * g + 2] += acc[4 * k + 2];
+            facc[4 * g + 3] += acc[4 * k + 3];
+            run->in_t[g] = 1;
+        }
+    }
+    *count += n;
+    *ovf |= o;
 }
 
 /* q_mean stage: every free element is transformed.  Blocks run colour by
@@ -167,9 +289,8 @@ static int32_t scatter_all(getme_run *run, double sigma)
     reduction(+ : count) reduction(| : ovf)
         for (int32_t k = b0; k < b1; k++) {
             int32_t b = ws->colour_blocks[k];
-            int32_t e0 = ws->block_start[b], e1 = ws->block_start[b + 1];
-            GETME_FOR_TYPE(getme__ws_type(ws, e0), transform_block, run, e0,
-                           e1, sigma, &count, &ovf);
+            GETME_FOR_TYPE(getme__ws_type(ws, ws->block_start[b]),
+                           transform_block, run, b, sigma, &count, &ovf);
         }
         total += count;
         run->overflow |= ovf;

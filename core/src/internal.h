@@ -91,6 +91,20 @@ double getme__quality_quad(const double *x);
 void getme__transform(int type, const double *x, double sigma, double *out);
 
 void getme__transform_tet(const double *x, double sigma, double *out);
+/* Elements per batch of the lane kernels (*_lanes): 8 doubles, one
+   AVX-512 register or two AVX2 ones. */
+#define GETME_LANES 8
+/* getme__transform_tet of GETME_LANES tets at once: x[3 i + d][l] is
+   coordinate d of node i of tet l; out likewise.  Bit-identical per lane. */
+void getme__transform_tet_lanes(const double (*x)[GETME_LANES], double sigma,
+                                double (*out)[GETME_LANES]);
+/* The same for hexahedra (transform_dual.c). */
+void getme__transform_hex_lanes(const double (*x)[GETME_LANES], double sigma,
+                                double (*out)[GETME_LANES]);
+/* getme__quality of GETME_LANES elements of type type at once (x in
+   lanes as above) into q; bit-identical per lane.  Returns 0 (nothing
+   done) for a type without a lane kernel (only tets and hexes have one). */
+int getme__quality_lanes(int type, const double (*x)[GETME_LANES], double *q);
 void getme__transform_hex(const double *x, double sigma, double *out);
 void getme__transform_prism(const double *x, double sigma, double *out);
 void getme__transform_pyramid(const double *x, double sigma, double *out);

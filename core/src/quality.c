@@ -196,6 +196,82 @@ double getme__quality_hex(const double *x)
     return valid_or_zero(ok, 0.125 * s);
 }
 
+/* ---- GETME_LANES elements at once --------------------------------------- */
+
+/* getme__quality_tet and getme__quality_hex of GETME_LANES elements, x in
+   lanes (x[3 i + d][l]: coordinate d of node i of element l).  The same
+   operations in the same order per lane as the one-element kernels, and
+   cube_root8 is bit-identical to cube_root, so every lane's q is the same
+   bits; written as loops over the lanes so that they become vector
+   instructions (the relaxation evaluates every element this way). */
+static void quality_tet_lanes(const double (*x)[GETME_LANES], double *q)
+{
+    enum { L = GETME_LANES };
+    double det[L], frob2[L], c[L];
+#pragma omp simd
+    for (int l = 0; l < L; l++) {
+        double e1[3], e2[3], e3[3], s2[3], s3[3];
+        for (int d = 0; d < 3; d++) {
+            e1[d] = x[3 + d][l] - x[d][l];
+            e2[d] = x[6 + d][l] - x[d][l];
+            e3[d] = x[9 + d][l] - x[d][l];
+        }
+        for (int d = 0; d < 3; d++) {
+            s2[d] = (2.0 * e2[d] - e1[d]) * GETME_INV_SQRT3;
+            s3[d] = (3.0 * e3[d] - e1[d] - e2[d]) * GETME_INV_SQRT6;
+        }
+        det[l] = GETME_SQRT2 * det3(e1, e2, e3);
+        frob2[l] = dot3(e1, e1) + dot3(s2, s2) + dot3(s3, s3);
+    }
+    cube_root8(det, c);
+#pragma omp simd
+    for (int l = 0; l < L; l++)
+        q[l] = valid_or_zero(det[l] > 0.0, 3.0 * c[l] * c[l] / frob2[l]);
+}
+
+static void quality_hex_lanes(const double (*x)[GETME_LANES], double *q)
+{
+    enum { L = GETME_LANES };
+    double s[L];
+    int ok[L];
+    for (int l = 0; l < L; l++)
+        s[l] = 0.0, ok[l] = 1;
+    for (int k = 0; k < 8; k++) {
+        int a = 3 * hex_corners[k][0], b = 3 * hex_corners[k][1],
+            c1 = 3 * hex_corners[k][2], d1 = 3 * hex_corners[k][3];
+        double det[L], frob2[L], c[L];
+#pragma omp simd
+        for (int l = 0; l < L; l++) {
+            double e1[3], e2[3], e3[3];
+            for (int d = 0; d < 3; d++) {
+                e1[d] = x[b + d][l] - x[a + d][l];
+                e2[d] = x[c1 + d][l] - x[a + d][l];
+                e3[d] = x[d1 + d][l] - x[a + d][l];
+            }
+            det[l] = det3(e1, e2, e3);
+            frob2[l] = dot3(e1, e1) + dot3(e2, e2) + dot3(e3, e3);
+        }
+        cube_root8(det, c);
+#pragma omp simd
+        for (int l = 0; l < L; l++) {
+            s[l] += 3.0 * c[l] * c[l] / frob2[l];
+            ok[l] &= det[l] > 0.0;
+        }
+    }
+#pragma omp simd
+    for (int l = 0; l < L; l++)
+        q[l] = valid_or_zero(ok[l], 0.125 * s[l]);
+}
+
+int getme__quality_lanes(int type, const double (*x)[GETME_LANES], double *q)
+{
+    switch (type) {
+    case GETME_TET: quality_tet_lanes(x, q); return 1;
+    case GETME_HEX: quality_hex_lanes(x, q); return 1;
+    default: return 0;
+    }
+}
+
 /* ---- prism -------------------------------------------------------------- */
 
 /*

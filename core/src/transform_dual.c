@@ -172,6 +172,75 @@ void getme__transform_hex(const double *x, double sigma, double *out)
     getme__rescale3(out, x, t->nv, t->ne, t->edges);
 }
 
+/* getme__transform_hex of GETME_LANES hexes at once (internal.h): the
+   same operations in the same order per lane as dual_step and
+   getme__rescale3, as loops over the lanes (vector instructions), so
+   every lane's result is bit-identical to the one-element kernel's. */
+void getme__transform_hex_lanes(const double (*x)[GETME_LANES], double sigma,
+                                double (*out)[GETME_LANES])
+{
+    enum { L = GETME_LANES };
+    const dual_topology *t = &hex_topo;
+    double c[6][3][L];
+    for (int f = 0; f < 6; f++)
+        for (int d = 0; d < 3; d++) {
+            double s[L];
+#pragma omp simd
+            for (int l = 0; l < L; l++)
+                s[l] = 0.0;
+            for (int j = 0; j < 4; j++) {
+                const double *xj = x[3 * t->face[f][j] + d];
+#pragma omp simd
+                for (int l = 0; l < L; l++)
+                    s[l] += xj[l];
+            }
+#pragma omp simd
+            for (int l = 0; l < L; l++)
+                c[f][d][l] = s[l] / 4;
+        }
+    for (int i = 0; i < 8; i++) {
+        double m[3][L], n[3][L];
+        for (int d = 0; d < 3; d++) {
+#pragma omp simd
+            for (int l = 0; l < L; l++)
+                m[d][l] = n[d][l] = 0.0;
+            for (int j = 0; j < 3; j++) {
+                const double *cj = c[t->around[i][j]][d];
+#pragma omp simd
+                for (int l = 0; l < L; l++)
+                    m[d][l] += cj[l];
+            }
+#pragma omp simd
+            for (int l = 0; l < L; l++)
+                m[d][l] /= 3;
+        }
+        for (int j = 0; j < 3; j++) {
+            double(*a)[L] = c[t->around[i][j]];
+            double(*b)[L] = c[t->around[i][(j + 1) % 3]];
+#pragma omp simd
+            for (int l = 0; l < L; l++) {
+                double u0 = a[0][l] - m[0][l], u1 = a[1][l] - m[1][l],
+                       u2 = a[2][l] - m[2][l];
+                double v0 = b[0][l] - m[0][l], v1 = b[1][l] - m[1][l],
+                       v2 = b[2][l] - m[2][l];
+                n[0][l] += 0.5 * (u1 * v2 - u2 * v1);
+                n[1][l] += 0.5 * (u2 * v0 - u0 * v2);
+                n[2][l] += 0.5 * (u0 * v1 - u1 * v0);
+            }
+        }
+#pragma omp simd
+        for (int l = 0; l < L; l++) {
+            double nn = n[0][l] * n[0][l] + n[1][l] * n[1][l] + n[2][l] * n[2][l];
+            /* = sigma * getme__inv_sqrt_norm(n) */
+            double f = sigma * (1.0 / sqrt(sqrt(getme__at_least(nn, DBL_MIN))));
+            out[3 * i][l] = m[0][l] + f * n[0][l];
+            out[3 * i + 1][l] = m[1][l] + f * n[1][l];
+            out[3 * i + 2][l] = m[2][l] + f * n[2][l];
+        }
+    }
+    getme__rescale3_lanes(out, x, 8, 12, t->edges);
+}
+
 /* ---- prism -------------------------------------------------------------- */
 
 /*

@@ -49,3 +49,30 @@ void getme__transform_tet(const double *x, double sigma, double *out)
             out[3 * i + d] = x[3 * i + d] + f[i] * n[i][d];
     getme__rescale3(out, x, 4, 6, tet_edges);
 }
+
+/* The same operations as getme__transform_tet, in the same order per
+   lane, as loops over GETME_LANES tets (vector instructions). */
+void getme__transform_tet_lanes(const double (*x)[GETME_LANES], double sigma,
+                                double (*out)[GETME_LANES])
+{
+    for (int i = 0; i < 4; i++) {
+        int a = 3 * tet_opposite[i][0], b = 3 * tet_opposite[i][1],
+            c = 3 * tet_opposite[i][2];
+#pragma omp simd
+        for (int l = 0; l < GETME_LANES; l++) {
+            double u0 = x[b][l] - x[a][l], u1 = x[b + 1][l] - x[a + 1][l],
+                   u2 = x[b + 2][l] - x[a + 2][l];
+            double v0 = x[c][l] - x[a][l], v1 = x[c + 1][l] - x[a + 1][l],
+                   v2 = x[c + 2][l] - x[a + 2][l];
+            double n0 = u1 * v2 - u2 * v1, n1 = u2 * v0 - u0 * v2,
+                   n2 = u0 * v1 - u1 * v0;
+            double nn = n0 * n0 + n1 * n1 + n2 * n2;
+            /* = sigma * getme__inv_sqrt_norm(n) */
+            double f = sigma * (1.0 / sqrt(sqrt(getme__at_least(nn, DBL_MIN))));
+            out[3 * i][l] = x[3 * i][l] + f * n0;
+            out[3 * i + 1][l] = x[3 * i + 1][l] + f * n1;
+            out[3 * i + 2][l] = x[3 * i + 2][l] + f * n2;
+        }
+    }
+    getme__rescale3_lanes(out, x, 4, 6, tet_edges);
+}

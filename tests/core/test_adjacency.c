@@ -180,6 +180,39 @@ static double brute(const getme_ws *ws, const double *q, int32_t e,
     return s;
 }
 
+/* The blocks' node lists (block_local.h, built with adj): each block
+   lists its elements' nodes once each, and the local connectivity maps
+   back to the workspace's. */
+static void check_blocks(const getme_blocks *blk, const getme_ws *ws)
+{
+    uint32_t *seen = calloc((size_t)ws->nn, sizeof *seen);
+    int ok = blk->nptr[0] == 0;
+    int32_t big = 0;
+    for (int32_t b = 0; b < ws->num_blocks; b++) {
+        const int32_t *gn = blk->nodes + blk->nptr[b];
+        int32_t m = (int32_t)(blk->nptr[b + 1] - blk->nptr[b]);
+        big = m > big ? m : big;
+        for (int32_t k = 0; k < m; k++) { /* distinct */
+            ok &= seen[gn[k]] != (uint32_t)b + 1;
+            seen[gn[k]] = (uint32_t)b + 1;
+        }
+        int32_t used = 0;
+        for (int32_t e = ws->block_start[b]; e < ws->block_start[b + 1]; e++) {
+            int t = getme__ws_type(ws, e);
+            const int32_t *c = getme__ws_nodes(ws, t, e);
+            const uint16_t *lc = getme__blocks_lnodes(blk, ws, t, e);
+            for (int i = 0; i < getme__nv[t]; i++) {
+                ok &= lc[i] < m && gn[lc[i]] == c[i];
+                used = lc[i] + 1 > used ? lc[i] + 1 : used;
+            }
+        }
+        ok &= used == m; /* no node listed that no element uses */
+    }
+    CHECK(ok);
+    CHECK_EQ_INT(blk->max_nodes, big);
+    free(seen);
+}
+
 /* Build ws + adj for g with nt threads; check every regular element's
    formula sum and count against the brute force; return the irregular
    flags (caller frees) in ws element order, and the ws (caller frees). */
@@ -210,6 +243,7 @@ static uint8_t *check_formula(const gen *g, int nt, getme_ws *ws,
         }
     }
     CHECK(exact);
+    check_blocks(&adj.blk, ws);
     uint8_t *irr = malloc((size_t)ws->ne);
     memcpy(irr, adj.irregular, (size_t)ws->ne);
     getme__adj_free(&adj);

@@ -1,0 +1,148 @@
+/*
+ * block_local.c -- the blocks' node lists and local connectivity
+ * (block_local.h says why).
+ *
+ * Two parallel passes over the blocks, each block writing only its own
+ * entries: count each block's distinct nodes, then list them in the order
+ * its elements first use them and renumber its elements' nodes into that
+ * list.  A per-thread mark array (the block's number + 1 per node seen)
+ * finds the distinct nodes, so the result does not depend on the threads.
+ */
+#include "block_local.h"
+#include "internal.h"
+
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+void getme__blocks_free(getme_blocks *blk)
+{
+    if (blk->scratch)
+        free(blk->scratch[0].acc); /* one allocation for all threads */
+    free(blk->scratch);
+    free(blk->nptr);
+    free(blk->nodes);
+    free(blk->lconn);
+    memset(blk, 0, sizeof *blk);
+}
+
+/* Block b's distinct nodes: with list == NULL only counted; else listed
+   into list and each element node's local index written to lconn. */
+static int32_t block_nodes(const getme_ws *ws, int32_t b, int32_t *mark,
+                           uint16_t *local, int32_t *list, uint16_t *lconn)
+{
+    int32_t e0 = ws->block_start[b], e1 = ws->block_start[b + 1];
+    if (e1 <= e0)
+        return 0;
+    int t = getme__ws_type(ws, e0), nv = getme__nv[t];
+    const int32_t *c = getme__ws_nodes(ws, t, e0);
+    int64_t off = c - ws->conn;
+    int32_t m = 0;
+    for (int64_t k = 0; k < (int64_t)(e1 - e0) * nv; k++) {
+        int32_t n = c[k];
+        if (mark[n] != b + 1) {
+            mark[n] = b + 1;
+            local[n] = (uint16_t)m;
+            if (list)
+                list[m] = n;
+            m++;
+        }
+        if (lconn)
+            lconn[off + k] = local[n];
+    }
+    return m;
+}
+
+/* Each thread's scratch, in one 64-byte aligned allocation: a block's
+   exact sums start on a cache line, and the four of a node fill one. */
+static getme_status alloc_scratch(getme_blocks *blk, int nt)
+{
+    size_t m = (size_t)(blk->max_nodes ? blk->max_nodes : 1);
+    m = (m + 7) & ~(size_t)7; /* every part a multiple of 64 bytes */
+    size_t me = (size_t)(blk->max_elems ? blk->max_elems : 1);
+    size_t per = m * (4 * sizeof(getme_fx) + 3 * sizeof(double) +
+                      sizeof(int64_t) + 1) +
+                 me * (sizeof(int64_t) + sizeof(int32_t));
+    per = (per + 63) & ~(size_t)63;
+    blk->scratch = calloc((size_t)nt, sizeof *blk->scratch);
+    char *p = aligned_alloc(64, per * (size_t)nt);
+    if (!blk->scratch || !p) {
+        free(p);
+        return GETME_ERR_NOMEM;
+    }
+    for (int k = 0; k < nt; k++) {
+        char *q = p + per * (size_t)k;
+        blk->scratch[k].acc = (getme_fx *)(void *)q;
+        q += m * 4 * sizeof(getme_fx);
+        blk->scratch[k].x = (double *)(void *)q;
+        q += m * 3 * sizeof(double);
+        blk->scratch[k].nsum = (int64_t *)(void *)q;
+        q += m * sizeof(int64_t);
+        blk->scratch[k].wf = (int64_t *)(void *)q;
+        q += me * sizeof(int64_t);
+        blk->scratch[k].list = (int32_t *)(void *)q;
+        q += me * sizeof(int32_t);
+        blk->scratch[k].flag = (uint8_t *)q;
+    }
+    return GETME_OK;
+}
+
+getme_status getme__blocks_build(getme_blocks *blk, const getme_ws *ws)
+{
+    memset(blk, 0, sizeof *blk);
+    int nt = ws->nt;
+    int64_t nconn = ws->coff[GETME_NUM_TYPES - 1] +
+                    (int64_t)(ws->tstart[GETME_NUM_TYPES] -
+                              ws->tstart[GETME_NUM_TYPES - 1]) *
+                        getme__nv[GETME_NUM_TYPES - 1];
+    size_t nn = (size_t)(ws->nn ? ws->nn : 1);
+    blk->nptr = malloc(((size_t)ws->num_blocks + 1) * sizeof *blk->nptr);
+    blk->lconn = malloc((size_t)(nconn ? nconn : 1) * sizeof *blk->lconn);
+    int32_t *mark = malloc((size_t)nt * nn * sizeof *mark);
+    uint16_t *local = malloc((size_t)nt * nn * sizeof *local);
+    getme_status st = GETME_ERR_NOMEM;
+    if (!blk->nptr || !blk->lconn || !mark || !local)
+        goto done;
+    memset(mark, 0, (size_t)nt * nn * sizeof *mark);
+    blk->nptr[0] = 0;
+#pragma omp parallel for schedule(dynamic, 16) num_threads(nt)
+    for (int32_t b = 0; b < ws->num_blocks; b++) {
+        size_t o = (size_t)omp_get_thread_num() * nn;
+        blk->nptr[b + 1] = block_nodes(ws, b, mark + o, local + o, NULL, NULL);
+    }
+    int32_t big = 0, bige = 0;
+    for (int32_t b = 0; b < ws->num_blocks; b++) {
+        int64_t m = blk->nptr[b + 1];
+        int32_t me = ws->block_start[b + 1] - ws->block_start[b];
+        big = m > big ? (int32_t)m : big;
+        bige = me > bige ? me : bige;
+        blk->nptr[b + 1] += blk->nptr[b];
+    }
+    blk->max_nodes = big;
+    blk->max_elems = bige;
+    if (big > UINT16_MAX + 1) { /* not with the workspace's 512-element
+                                   blocks; refuse rather than wrap */
+        st = GETME_ERR_NOMEM;
+        goto done;
+    }
+    blk->nodes = malloc((size_t)(blk->nptr[ws->num_blocks] ? blk->nptr[ws->num_blocks] : 1) *
+                        sizeof *blk->nodes);
+    if (!blk->nodes)
+        goto done;
+    if (alloc_scratch(blk, nt) != GETME_OK)
+        goto done;
+    memset(mark, 0, (size_t)nt * nn * sizeof *mark);
+#pragma omp parallel for schedule(dynamic, 16) num_threads(nt)
+    for (int32_t b = 0; b < ws->num_blocks; b++) {
+        size_t o = (size_t)omp_get_thread_num() * nn;
+        block_nodes(ws, b, mark + o, local + o, blk->nodes + blk->nptr[b],
+                    blk->lconn);
+    }
+    st = GETME_OK;
+done:
+    free(mark);
+    free(local);
+    if (st != GETME_OK)
+        getme__blocks_free(blk);
+    return st;
+}
