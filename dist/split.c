@@ -438,9 +438,8 @@ void dist_split_free(dist_split *s)
     free(s->docs);
     free(s->node), free(s->elem), free(s->optr), free(s->orank);
     free(s->whole_tag);
-    getme_mesh_free(s->whole);
     s->docs = NULL, s->node = NULL, s->elem = NULL, s->optr = NULL;
-    s->orank = NULL, s->whole_tag = NULL, s->whole = NULL;
+    s->orank = NULL, s->whole_tag = NULL;
 }
 
 /* Output part k's path: OUT_k.msh for split files (OUT.msh named), OUT
