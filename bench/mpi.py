@@ -21,6 +21,8 @@ against every rank reading its own split files: the whole command's wall
 time, the set-up / loop split and the peak RSS of every rank over the
 whole run (reading and writing included); and whether the output parts,
 joined by node tag, hold the rank-0 run's coordinates bit for bit.
+--before EXE adds, per rank count, an older getme-mpi on the same split
+files (before/after of the per-rank input's finishing step).
 """
 import argparse
 import json
@@ -118,17 +120,22 @@ def split_bench(a, lines):
                 lines.append(f"| {name} | {ranks} | whole file, rank 0 | {w:.1f} | "
                              f"{lp:.1f} | {'/'.join(f'{x:.0f}' for x in rss)} | |")
                 print(lines[-1], flush=True)
-                out = os.path.join(tmp, "o")
-                w, lp, rss = run_whole(a.mpi, stem + "_1.msh", ranks, out + ".msh")
-                got = node_bits([f"{out}_{k}.msh" for k in range(1, nparts + 1)])
                 want = node_bits([ref])
-                same = len(got) == len(want) and all(got.get(t) == b
-                                                     for t, b in want.items())
-                lines.append(f"| {name} | {ranks} | {nparts} split files, per rank | "
-                             f"{w:.1f} | {lp:.1f} | "
-                             f"{'/'.join(f'{x:.0f}' for x in rss)} | "
-                             f"{'yes' if same else 'NO'} |")
-                print(lines[-1], flush=True)
+                runs = [("", a.mpi)] + ([(" (before)", a.before)] if a.before
+                                        else [])
+                for label, exe in runs:
+                    out = os.path.join(tmp, "o")
+                    w, lp, rss = run_whole(exe, stem + "_1.msh", ranks,
+                                           out + ".msh")
+                    got = node_bits([f"{out}_{k}.msh"
+                                     for k in range(1, nparts + 1)])
+                    same = len(got) == len(want) and all(
+                        got.get(t) == b for t, b in want.items())
+                    lines.append(f"| {name} | {ranks} | {nparts} split files, "
+                                 f"per rank{label} | {w:.1f} | {lp:.1f} | "
+                                 f"{'/'.join(f'{x:.0f}' for x in rss)} | "
+                                 f"{'yes' if same else 'NO'} |")
+                    print(lines[-1], flush=True)
 
 
 def run_threads(exe, mesh, threads, out, rep):
@@ -150,6 +157,7 @@ def main():
     ap.add_argument("--ranks", default="1,2,4")
     ap.add_argument("--out")
     ap.add_argument("--split", type=int, default=0)
+    ap.add_argument("--before", default="")
     a = ap.parse_args()
     if a.split:
         lines = []

@@ -129,9 +129,8 @@ typedef struct dist_split {
     double box[6];
     int64_t tag_min;
     int dense_tags;
-    /* rank 0: the whole mesh for the finishing step (until that step runs
-       on gathered patches): nodes in ascending tag */
-    getme_mesh *whole;
+    /* rank 0, one partitioned file: the tags of the gathered positions
+       (dist_split_gather), ascending */
     int32_t whole_nn;
     uint64_t *whole_tag;
 } dist_split;
@@ -155,14 +154,25 @@ int dist_split_read(dist_split *s, const getme_doc_options *opts, char *msg,
 /* Collective: skin, interfaces, fixed marks, ghost layer, neighbours:
    the part into c. */
 int dist_split_setup(dist_split *s, dist_ctx *c, unsigned fix_flags);
-/* Collective: rank 0 builds s->whole (the finishing step's mesh). */
-int dist_split_whole(dist_split *s, dist_ctx *c, char *msg, size_t size);
-int32_t whole_index(const dist_split *s, uint64_t tag);
-/* Collective: the part's positions of counted nodes into rank 0's xyz. */
+/* split_finish.c.  Collective: node ids (tags) and element indices in the
+   single-process order (c->gid, c->egid) for finish_sub.c's keys; frees
+   the set-up's tables.  0, or -1 on every rank with msg. */
+int dist_split_ids(dist_split *s, dist_ctx *c, char *msg, size_t size);
+/* Collective: the whole mesh's getme_mesh_quality_stats on rank 0,
+   reduced over the parts' owned elements.  0, or -1 on every rank. */
+int dist_split_stats(dist_ctx *c, getme_mesh *part,
+                     getme_quality_stats *out);
+/* Collective: getme smooth's "Measures" lines on rank 0, reduced over the
+   parts: ranges and minima (exact); not the means (element-order double
+   sums). */
+struct cli_log;
+void dist_split_measures(dist_ctx *c, getme_mesh *part,
+                         const struct cli_log *log, const char *title);
+/* Collective, one partitioned file: the counted nodes' positions on rank
+   0 (*xyz, by s->whole_tag ascending; NULL elsewhere). */
 void dist_split_gather(dist_split *s, dist_ctx *c, const double *part_xyz,
-                       double *xyz);
-/* Collective: rank 0's final xyz to the ranks' node tables. */
-void dist_split_scatter(dist_split *s, dist_ctx *c, const double *xyz);
+                       double **xyz);
+int32_t whole_index(const dist_split *s, uint64_t tag);
 /* Collective: write the output parts (temporary files, agreement,
    renames).  0, or -1 with rank 0's message. */
 int dist_split_write(dist_split *s, dist_ctx *c, const char *output,

@@ -335,8 +335,9 @@ static void log_peak_rss(dist_ctx *c, const cli_log *log)
 
 /* Gmsh-partitioned input read per rank (split.c, docs/distributed.md §3):
    every rank reads its own parts, the ranks build the parts among
-   themselves, rank 0 runs the finishing step on the whole mesh it
-   gathered, every rank writes its own output parts.  The exit code. */
+   themselves, the finishing step runs on a sub-mesh of the worst
+   elements' patches (finish_sub.c), every rank writes its own output
+   parts.  The exit code. */
 static int run_split(dist_ctx *c, args *a, dist_split *s)
 {
     cli_smooth_opts *so = &a->o;
@@ -397,8 +398,8 @@ static int run_split(dist_ctx *c, args *a, dist_split *s)
         return rcode;
     }
 
-    /* 2. the parts: skin, interfaces, ghost layer, neighbours; rank 0's
-       whole mesh for the finishing step */
+    /* 2. the parts: skin, interfaces, ghost layer, neighbours; node ids
+       and element indices for the finishing step's keys */
     double tp = MPI_Wtime();
     if (dist_split_setup(s, c, flags) != 0) {
         if (c->rank == 0)
@@ -406,25 +407,11 @@ static int run_split(dist_ctx *c, args *a, dist_split *s)
                       "written");
         return 1;
     }
-    code = dist_split_whole(s, c, msg, sizeof msg) != 0;
-    MPI_Bcast(&code, 1, MPI_INT, 0, c->comm);
+    code = dist_split_ids(s, c, msg, sizeof msg) != 0;
     if (code) {
         if (c->rank == 0)
             cli_error("%s; no output written", msg);
         return 1;
-    }
-    getme_quality_stats before;
-    cli_measures mbefore;
-    if (c->rank == 0) {
-        getme_mesh *w = s->whole;
-        cli_info(log, "Parts set up in %.2f s: %ld elements, %ld nodes (%ld "
-                 "fixed), %lld interface nodes, %lld ghost elements",
-                 MPI_Wtime() - tp, (long)getme_mesh_num_elements(w),
-                 (long)getme_mesh_num_nodes(w), (long)getme_mesh_num_fixed(w),
-                 (long long)c->interface_nodes, (long long)c->ghost_elements);
-        getme_mesh_quality_stats(w, -1, &before);
-        cli_print_stats(log, "Quality before", &before);
-        cli_measures_log(log, w, "Measures before", &mbefore);
     }
     getme_status st = build_part(c, &part);
     msg[0] = 0;
@@ -441,55 +428,82 @@ static int run_split(dist_ctx *c, args *a, dist_split *s)
         getme_mesh_free(part);
         return 1;
     }
+    /* the whole mesh's statistics, reduced over the parts (no mesh on
+       rank 0 holds it) */
+    getme_quality_stats before, after;
+    if (dist_split_stats(c, part, &before) != 0) {
+        if (c->rank == 0)
+            cli_error("out of memory for the statistics; no output written");
+        getme_mesh_free(part);
+        return 1;
+    }
+    int64_t nodes[2] = {0, 0}; /* the whole mesh's nodes, fixed ones */
+    for (int32_t i = 0; i < c->nn; i++) {
+        nodes[0] += c->counted[i];
+        nodes[1] += c->counted[i] && c->fixed[i];
+    }
+    MPI_Allreduce(MPI_IN_PLACE, nodes, 2, MPI_INT64_T, MPI_SUM, c->comm);
+    if (c->rank == 0) {
+        cli_info(log, "Parts set up in %.2f s: %lld elements, %lld nodes "
+                 "(%lld fixed), %lld interface nodes, %lld ghost elements",
+                 MPI_Wtime() - tp, (long long)before.num_elements,
+                 (long long)nodes[0], (long long)nodes[1],
+                 (long long)c->interface_nodes, (long long)c->ghost_elements);
+        cli_print_stats(log, "Quality before", &before);
+    }
+    dist_split_measures(c, part, log, "Measures before");
 
-    /* 3. smooth; the finishing step on rank 0 */
+    /* 3. smooth; the finishing step on a sub-mesh (finish_sub.c) */
     getme_params params = so->params;
     double loop_seconds = 0.0;
     if (smooth_parts(c, a, part, &params, &res, &loop_seconds) != 0) {
         getme_mesh_free(part);
         return 1;
     }
-    if (c->rank == 0) {
-        xyz = malloc((size_t)s->whole_nn * 3 * sizeof *xyz);
-        if (!xyz) {
-            cli_error("out of memory; no output written");
-            MPI_Abort(c->comm, 1);
-        }
-        getme_mesh_get_coords(s->whole, xyz);
+    double tf = MPI_Wtime();
+    params.progress = c->rank == 0 ? cli_smooth_progress : NULL;
+    params.progress_data = so; /* rank 0 alone: getme smooth's lines */
+    if (dist_finish(c, part, NULL, &params, &res, err, sizeof err) != 0) {
+        if (c->rank == 0)
+            cli_error("%s: %s; no output written", a->input, err);
+        getme_mesh_free(part);
+        return 1;
     }
-    dist_split_gather(s, c, getme_mesh_coords(part), xyz);
+    double finish_seconds = MPI_Wtime() - tf;
+    if (c->sub_tries && log->verbose)
+        cli_info(log, "Finishing step on rank 0 on a sub-mesh of %lld "
+                 "elements (%lld node copies gathered, %d tr%s)",
+                 (long long)c->sub_elements, (long long)c->sub_nodes,
+                 c->sub_tries, c->sub_tries == 1 ? "y" : "ies");
+    if (dist_split_stats(c, part, &after) != 0) {
+        if (c->rank == 0)
+            cli_error("out of memory for the statistics; no output written");
+        getme_mesh_free(part);
+        return 1;
+    }
+    if (c->rank == 0) {
+        cli_info(log, "GETMe adaptive: %d iterations (%d q_mean, %d "
+                 "q*_min in %d cycles) in %.2f s on %d ranks, finishing "
+                 "%d passes in %.2f s",
+                 res.iterations, res.iterations_mean, res.iterations_min,
+                 res.cycles_min, loop_seconds, c->size, res.passes_finish,
+                 finish_seconds);
+        cli_smooth_done(so, &res);
+        cli_print_stats(log, "Quality after ", &after);
+    }
+    dist_split_measures(c, part, log, "Measures after ");
+    /* the final positions: into the node tables (split files, each rank
+       writes its own) or on rank 0 (one file) */
+    if (s->mode == DIST_SPLIT_FILES)
+        for (int32_t i = 0; i < s->nn; i++)
+            memcpy(s->node[i].x, getme_mesh_coords(part) + 3 * (size_t)i,
+                   sizeof s->node[i].x);
+    else
+        dist_split_gather(s, c, getme_mesh_coords(part), &xyz);
     getme_mesh_free(part);
-    if (c->rank == 0) {
-        double tf = MPI_Wtime();
-        params.progress = cli_smooth_progress; /* rank 0 alone */
-        params.progress_data = so;
-        st = getme_smooth_finish(s->whole, &params, xyz, &res);
-        if (st != GETME_OK) {
-            cli_error("%s: %s; no output written", a->input,
-                      getme_mesh_error(s->whole));
-            code = 1;
-        } else {
-            cli_info(log, "GETMe adaptive: %d iterations (%d q_mean, %d "
-                     "q*_min in %d cycles) in %.2f s on %d ranks, finishing "
-                     "%d passes in %.2f s",
-                     res.iterations, res.iterations_mean, res.iterations_min,
-                     res.cycles_min, loop_seconds, c->size,
-                     res.passes_finish, MPI_Wtime() - tf);
-            cli_smooth_done(so, &res);
-            getme_quality_stats after;
-            cli_measures mafter;
-            getme_mesh_quality_stats(s->whole, -1, &after);
-            cli_print_stats(log, "Quality after ", &after);
-            cli_measures_log(log, s->whole, "Measures after ", &mafter);
-            getme_mesh_get_coords(s->whole, xyz);
-        }
-    }
-    MPI_Bcast(&code, 1, MPI_INT, 0, c->comm);
 
     /* 4. every rank writes its own output parts */
     if (code == 0) {
-        if (s->mode == DIST_SPLIT_FILES)
-            dist_split_scatter(s, c, xyz);
         cli_guard guard = {0};
         cli_write_guard(&guard, 1);
         cli_info(log, "Writing '%s'%s...", a->output,

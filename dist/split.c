@@ -24,13 +24,13 @@
  * the reader fixes (not classified on a volume or one of its partition
  * pieces; --fix groups), the whole mesh's skin, region interfaces.
  *
- * The finishing step (getme_smooth_finish) still runs on rank 0 on the
- * whole mesh, which rank 0 gathers for it (split_whole.c); only that step
- * changes when the finishing step runs on gathered patches instead.
+ * The finishing step runs on the worst elements' patches (finish_sub.c),
+ * keyed by the node ids and element indices of split_finish.c: no rank
+ * holds the whole mesh.
  *
  * This file: finding the parts, reading them, writing the output parts;
- * split_setup.c: the three exchange rounds; split_whole.c: the whole mesh
- * on rank 0 for the finishing step.
+ * split_setup.c: the three exchange rounds; split_finish.c: ids, element
+ * indices and statistics for the finishing step and the log.
  */
 #include "dist.h"
 #include "cli.h"
@@ -438,9 +438,8 @@ void dist_split_free(dist_split *s)
     free(s->docs);
     free(s->node), free(s->elem), free(s->optr), free(s->orank);
     free(s->whole_tag);
-    getme_mesh_free(s->whole);
     s->docs = NULL, s->node = NULL, s->elem = NULL, s->optr = NULL;
-    s->orank = NULL, s->whole_tag = NULL, s->whole = NULL;
+    s->orank = NULL, s->whole_tag = NULL;
 }
 
 /* Output part k's path: OUT_k.msh for split files (OUT.msh named), OUT

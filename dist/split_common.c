@@ -1,6 +1,6 @@
 /*
  * split_common.c -- what the per-rank input's files share (split.c,
- * split_setup.c, split_whole.c; docs/distributed.md §3): the set-up's
+ * split_setup.c, split_finish.c; docs/distributed.md §3): the set-up's
  * allocation (a failure there stops the run), the node table's lookup and
  * merge by tag.
  */

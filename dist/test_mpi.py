@@ -130,6 +130,28 @@ with tempfile.TemporaryDirectory() as tmp:
     c.check(not os.path.exists(out), "failure: no output")
     c.check(not [f for f in os.listdir(tmp) if "getme-tmp" in f],
             "failure: no temporary file left")
+    # out of memory inside the loop on one rank (the q*_min threshold's
+    # histogram, failed by an LD_PRELOAD shim): every rank stops with one
+    # error, none waits for the one that gave up (timeout: a hang fails)
+    shim = os.environ.get("GETME_TEST_FAIL_ALLOC")
+    if shim:
+        env = dict(ENV, LD_PRELOAD=shim, GETME_TEST_FAIL_HIST_RANK="1")
+        try:
+            p = subprocess.run([MPIEXEC, "--oversubscribe", "-x", "LD_PRELOAD",
+                                "-x", "GETME_TEST_FAIL_HIST_RANK", "-np", "3",
+                                GETME_MPI, "smooth", inp, "-o", out],
+                               capture_output=True, text=True, env=env,
+                               timeout=120)
+            errors = [l for l in p.stderr.splitlines() if l.startswith("Error")]
+            # (every rank stops with GETME_ERR_NOMEM: the lowest is named)
+            c.check(p.returncode == 1 and len(errors) == 1 and
+                    "smoothing: out of memory" in errors[0] and
+                    not os.path.exists(out),
+                    f"out of memory in the loop on rank 1: exit {p.returncode},"
+                    f" {errors}, no output")
+        except subprocess.TimeoutExpired:
+            c.check(False, "out of memory in the loop on rank 1: the other "
+                           "ranks wait (timeout)")
     # an unreadable input: rank 0's one error, no output
     p = mpirun(2, "smooth", os.path.join(tmp, "missing.msh"), "-o", out)
     errors = [line for line in p.stderr.splitlines() if line.startswith("Error")]

@@ -16,6 +16,9 @@ every rank reading its own parts with the native reader, must give:
    2 on the one file; hexes: 2 ranks;
  - the same number of fixed nodes as getme smooth (skin, interfaces of
    the mixed mesh's 4 physical volumes across the partition cuts);
+ - rank 0's -v log: the finishing step ran on a sub-mesh, and the
+   "Quality before/after" lines with their histograms and the measures'
+   ranges and minima are getme smooth's (reduced over the parts);
  - each output part the size of its input part (binary: only coordinates
    change) and Gmsh opening the output parts with their 3 partitions;
  - a truncated or a missing part at -np 2 and 3: one error line naming
@@ -92,6 +95,18 @@ def parts(stem):
     return [f"{stem}_{k}.msh" for k in range(1, N + 1)]
 
 
+def stats_logged(text):
+    """The 'Quality before/after' lines with their histograms, and the
+    measures' ranges and minima (getme-mpi does not print the means)."""
+    out = []
+    for line in text.splitlines():
+        if "Quality" in line or "< quality <" in line:
+            out.append(line)
+        elif "Measures" in line:
+            out.append(",".join(f.split(" mean ")[0] for f in line.split(",")))
+    return out
+
+
 def fixed_logged(text):
     """The fixed-node count of getme-mpi's 'Parts set up' line."""
     for line in text.splitlines():
@@ -110,8 +125,9 @@ with tempfile.TemporaryDirectory() as tmp:
         stem = os.path.join(tmp, case)
         write_inputs(dist, stem)
         ref, rep = os.path.join(tmp, f"{case}-ref.msh"), os.path.join(tmp, "r.json")
-        c.run("smooth", stem + "-whole.msh", "-o", ref, "-q", "--report", rep,
-              env=ENV)
+        p = c.run("smooth", stem + "-whole.msh", "-o", ref, "-v", "--report",
+                  rep, env=ENV)
+        want_stats = stats_logged(p.stdout + p.stderr)
         want_fixed = json.load(open(rep))["fixed_nodes"]
         want, _ = nodes([ref])
         inputs, _ = nodes([stem + "-whole.msh"])
@@ -121,7 +137,21 @@ with tempfile.TemporaryDirectory() as tmp:
         ranks = {"mixed": (1, 2, 3, 4), "tet": (3,), "hex": (2,)}[case]
         for np in ranks:
             out = os.path.join(tmp, f"{case}-o{np}")
-            p = mpirun(np, "smooth", stem + "_1.msh", "-o", out + ".msh")
+            # -v: the finishing step's sub-mesh line, the histograms; np 2:
+            # element indices ranked on rank 0 as for tags that are not one
+            # dense run (the code path; the bits here do not depend on the
+            # indices: ties in the finishing step's order are rare)
+            p = mpirun(np, "smooth", stem + "_1.msh", "-o", out + ".msh", "-v",
+                       env={"GETME_MPI_RANK_TAGS": "1"} if np == 2 else None)
+            if np <= N:
+                log = p.stdout + p.stderr
+                c.check("Finishing step on rank 0 on a sub-mesh of" in log,
+                        f"{case} -np {np}: the finishing step ran on a "
+                        "sub-mesh (rank 0's log)")
+                got_stats = stats_logged(log)
+                c.check(got_stats == want_stats and len(want_stats) >= 24,
+                        f"{case} -np {np}: quality statistics and measures "
+                        f"as getme smooth's: {got_stats} / {want_stats}")
             outs = parts(out)
             ok = p.returncode == 0 and all(map(os.path.exists, outs))
             c.check(ok and not os.path.exists(out + ".msh"),

@@ -420,7 +420,10 @@ static getme_status update_after(getme_run *run, double qt)
         }
     }
 
-    if (tlist_reserve(run, (int64_t)run->num_t + run->num_elems) != 0)
+    /* distributed: every process stops if one has no room (else the
+       others would wait for it in their next hook) */
+    if (getme__dist_any(run, tlist_reserve(run, (int64_t)run->num_t +
+                                                    run->num_elems) != 0))
         return GETME_ERR_NOMEM;
     int32_t n = 0;
     for (int32_t k = 0; k < run->num_t; k++) {
@@ -454,7 +457,7 @@ static getme_status start_tlist(getme_run *run, double qt)
             ws->free_elem[e] && getme__owned(run, e) && run->q[e] <= qt;
         n += run->tflag[e];
     }
-    if (tlist_reserve(run, n) != 0)
+    if (getme__dist_any(run, tlist_reserve(run, n) != 0)) /* all stop */
         return GETME_ERR_NOMEM;
     n = 0;
     for (int32_t e = 0; e < ws->ne; e++)
@@ -688,8 +691,10 @@ double getme__threshold(getme_run *run, double fraction, int32_t min_count)
         pos = (double)min_count - 1.0;
     int64_t k = pos >= (double)(n - 1) ? n - 1 : pos <= 0.0 ? 0 : (int64_t)pos;
     int64_t *hist = malloc(65536 * sizeof *hist);
-    if (!hist)
+    if (getme__dist_any(run, hist == NULL)) { /* all stop, not only this one */
+        free(hist);
         return -1.0;
+    }
     uint64_t prefix = 0, mask = 0;
     int64_t in_bin = n;
     /* Distributed: the histograms are summed over processes, and two more
