@@ -22,6 +22,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#ifdef GETME_HAVE_CLI_GMSH
 /* The folder of the running program (with a trailing '/'), or "". */
 static void program_dir(char *dir, size_t size)
 {
@@ -33,6 +34,7 @@ static void program_dir(char *dir, size_t size)
     else
         dir[0] = '\0';
 }
+#endif
 
 const getme_format *cli_gmsh_format(void)
 {
