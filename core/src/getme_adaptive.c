@@ -468,7 +468,7 @@ static getme_status start_tlist(getme_run *run, double qt)
 }
 
 /* ComputeNewNodes: p-hat = weighted sum / weight sum, for I_T, from the
-   exact sums (which are cleared for the next iteration).  The quotient of
+   exact sums, written over them (cleared by getme__reset_nodes).  The quotient of
    the two integers' doubles is scaled back by 1 / pscale, a power of two,
    so the only roundings are the two conversions and the division. */
 static void compute_new_nodes(getme_run *run)
@@ -478,13 +478,13 @@ static void compute_new_nodes(getme_run *run)
     if (run->num_nodes > GETME_PAR_MIN)
     for (int32_t k = 0; k < run->num_nodes; k++) {
         int64_t n = run->nodes[k];
-        getme_fx *f = run->facc + 4 * n;
-        double *a = run->acc + 4 * n;
+        const getme_fx *f = run->facc + 4 * n;
         double inv = 1.0 / (double)f[3];
-        a[0] = (double)f[0] * inv * back;
-        a[1] = (double)f[1] * inv * back;
-        a[2] = (double)f[2] * inv * back;
-        f[0] = f[1] = f[2] = f[3] = 0;
+        double a[3] = {(double)f[0] * inv * back, (double)f[1] * inv * back,
+                       (double)f[2] * inv * back};
+        /* p-hat over the node's sums (run->phat): getme__reset_nodes
+           zeroes them again before the next scatter. */
+        memcpy(run->phat + n * run->phat_step, a, sizeof a);
     }
 }
 
@@ -751,6 +751,8 @@ static getme_status alloc_adaptive(getme_run *run)
         memset(run->facc, 0, fbytes);
     if (!run->tflag || !run->facc)
         return GETME_ERR_NOMEM;
+    run->phat = (unsigned char *)run->facc;
+    run->phat_step = 4 * (int64_t)sizeof *run->facc;
     if (run->adj->num_irregular == 0)
         return GETME_OK;
     run->stamps = calloc((size_t)ws->nt, sizeof *run->stamps);
@@ -769,6 +771,7 @@ static void free_adaptive(getme_run *run)
     free(run->qold);
     free(run->facc);
     run->facc = NULL;
+    run->phat = NULL;
     run->qold = NULL, run->cap_qold = 0, run->cap_t = 0;
     if (run->stamps)
         for (int t = 0; t < run->ws->nt; t++)

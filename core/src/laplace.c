@@ -11,6 +11,7 @@
 
 #include <omp.h>
 #include <stdlib.h>
+#include <string.h>
 
 /* Local edges of each type (pairs of local node indices). */
 static const int8_t EDGES_TET[] = {0, 1, 1, 2, 2, 0, 0, 3, 1, 3, 2, 3};
@@ -75,7 +76,7 @@ static double star_quality_at(const getme_ws *ws, int32_t i, const double *p)
     return sum / (double)(ws->star_ptr[i + 1] - ws->star_ptr[i]);
 }
 
-/* Candidate moves of all free nodes into acc / in_t; returns the count. */
+/* Candidate moves of all free nodes into phat / in_t; returns the count. */
 static int32_t propose(getme_run *run, int32_t *scratch, int32_t per_thread)
 {
     const getme_ws *ws = run->ws;
@@ -94,8 +95,7 @@ static int32_t propose(getme_run *run, int32_t *scratch, int32_t per_thread)
                 before += run->q[ws->star[k]];
             before /= (double)(ws->star_ptr[i + 1] - ws->star_ptr[i]);
             if (star_quality_at(ws, i, m) > before) {
-                double *a = run->acc + 4 * (int64_t)i;
-                a[0] = m[0], a[1] = m[1], a[2] = m[2], a[3] = 1.0;
+                memcpy(run->phat + i * run->phat_step, m, sizeof m);
                 run->in_t[i] = 1;
                 accepted++;
             }
@@ -113,8 +113,14 @@ getme_status getme__laplace(getme_run *run)
        apex), hence 4 * max_star entries per thread. */
     int32_t per_thread = 4 * (ws->max_star > 0 ? ws->max_star : 1);
     int32_t *scratch = malloc((size_t)ws->nt * per_thread * sizeof *scratch);
-    if (!scratch)
+    run->phat_step = 3 * sizeof(double);
+    run->phat = malloc((size_t)(ws->nn ? ws->nn : 1) * (size_t)run->phat_step);
+    if (!scratch || !run->phat) {
+        free(scratch);
+        free(run->phat);
+        run->phat = NULL;
         return GETME_ERR_NOMEM;
+    }
     static const double R[2] = {1.0, 0.0};
     double q_mean = res->q_mean_initial, q_min = res->q_min_star_initial;
     getme_status st = GETME_OK;
@@ -140,5 +146,7 @@ getme_status getme__laplace(getme_run *run)
     }
     getme__ws_summary(ws, run->q, &res->q_mean, &res->q_min_star, &res->q_min);
     free(scratch);
+    free(run->phat);
+    run->phat = NULL;
     return st;
 }

@@ -9,13 +9,15 @@
 #include "smooth_internal.h"
 
 #include <stdlib.h>
+#include <string.h>
 
 /* Eq. 10 for node i with table entry rho.  rho = 0 and rho = 1 are taken
    literally so that a reset node gets its old coordinates bit for bit. */
 static inline void place(getme_run *run, int32_t i, double rho)
 {
     const double *x = run->ws->x + 3 * (int64_t)i;
-    const double *ph = run->acc + 4 * (int64_t)i;
+    double ph[3];
+    memcpy(ph, run->phat + i * run->phat_step, sizeof ph);
     double *xn = run->xnew + 3 * (int64_t)i;
     for (int d = 0; d < 3; d++)
         xn[d] = rho == 0.0 ? x[d]

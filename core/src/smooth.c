@@ -15,7 +15,6 @@ getme_status getme__run_alloc(getme_run *run)
     const getme_ws *ws = run->ws;
     size_t nn = (size_t)(ws->nn ? ws->nn : 1), ne = (size_t)(ws->ne ? ws->ne : 1);
     run->q = malloc(ne * sizeof *run->q);
-    run->acc = calloc(nn * 4, sizeof *run->acc);
     run->xnew = malloc(nn * 3 * sizeof *run->xnew);
     run->in_t = calloc(nn, 1);
     run->flag = calloc(nn, 1);
@@ -24,7 +23,7 @@ getme_status getme__run_alloc(getme_run *run)
     run->nodes = malloc(nn * sizeof *run->nodes);
     run->elems = malloc(ne * sizeof *run->elems);
     run->list = malloc(nn * sizeof *run->list);
-    if (!run->q || !run->acc || !run->xnew || !run->in_t || !run->flag ||
+    if (!run->q || !run->xnew || !run->in_t || !run->flag ||
         !run->ridx || !run->eflag || !run->nodes || !run->elems || !run->list)
         return GETME_ERR_NOMEM;
     memcpy(run->xnew, ws->x, (size_t)ws->nn * 3 * sizeof *run->xnew);
@@ -34,7 +33,6 @@ getme_status getme__run_alloc(getme_run *run)
 void getme__run_free(getme_run *run)
 {
     free(run->q);
-    free(run->acc);
     free(run->xnew);
     free(run->in_t);
     free(run->flag);
@@ -107,8 +105,10 @@ void getme__reset_nodes(getme_run *run)
     for (int32_t k = 0; k < run->num_nodes; k++) {
         int32_t i = run->nodes[k];
         run->in_t[i] = 0;
-        double *a = run->acc + 4 * (int64_t)i;
-        a[0] = a[1] = a[2] = a[3] = 0.0;
+        if (run->facc) { /* stored as sums again: zero as sums */
+            getme_fx *f = run->facc + 4 * (int64_t)i;
+            f[0] = f[1] = f[2] = f[3] = 0;
+        }
     }
 }
 

@@ -27,8 +27,13 @@ typedef struct getme_run {
     getme_result *result;
     double t0;          /* omp_get_wtime() at start                        */
     double *q;          /* ne: quality at ws->x                            */
-    double *acc;        /* 4 * nn: weighted position sums and weight sums,
-                           then (after normalising) the target p-hat        */
+    /* The target p-hat of node i: 3 doubles at phat + i * phat_step bytes,
+       read and written with memcpy: in GETMe adaptive they are the first
+       24 bytes of the node's exact sums (facc), which are zero from
+       ComputeNewNodes to getme__reset_nodes, so p-hat needs no array of
+       its own (32 B per node less); Laplace owns a 3 * nn array. */
+    unsigned char *phat;
+    int64_t phat_step;
     double *xnew;       /* 3 * nn: trial coordinates; equals ws->x outside
                            the relaxation step                              */
     uint8_t *in_t;      /* nn: node is in I_T (moves this iteration)        */
@@ -106,7 +111,7 @@ void getme__collect(getme_run *run);
 
 /*
  * IterativeNodeRelaxation (paper Sec. 2.2, Eq. 10): move every node of
- * run->nodes to (1 - rho) x + rho p-hat (p-hat in run->acc, stride 4) with
+ * run->nodes to (1 - rho) x + rho p-hat (run->phat) with
  * rho from table R, re-evaluate the elements of run->elems, and step the
  * nodes of invalid elements down the table until no element is invalid.
  * R's last entry is 0, so a node can always go back to where it was and the
@@ -115,7 +120,8 @@ void getme__collect(getme_run *run);
  */
 int32_t getme__relax(getme_run *run, const double *R, int nR);
 
-/* Clear run->in_t, run->acc for the nodes of run->nodes. */
+/* Clear run->in_t for the nodes of run->nodes, and their exact sums
+   (run->facc, holding p-hat since ComputeNewNodes) if there are. */
 void getme__reset_nodes(getme_run *run);
 
 /* Report progress; returns nonzero if the callback asks to stop. */
