@@ -40,6 +40,7 @@ import tempfile
 
 import gmsh
 import meshes
+from gmsh_helpers import merged_nodes
 from mpi_checks import GETME_MPI, MPIEXEC, SANITIZED, ENV, c
 
 N = 3
@@ -53,20 +54,8 @@ def mpirun(np, *args, env=None):
 
 def nodes(paths):
     """{tag: coordinate bits} of the MSH files merged, and the partitions."""
-    gmsh.initialize(["test"])
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.open(paths[0])
-        for p in paths[1:]:
-            gmsh.merge(p)
-        tags, xyz, _ = gmsh.model.mesh.getNodes()
-        bits = {int(t): struct.pack("<3d", *xyz[3 * i:3 * i + 3])
-                for i, t in enumerate(tags)}
-        parts = max((max(gmsh.model.getPartitions(d, t), default=0)
-                     for d, t in gmsh.model.getEntities()), default=0)
-        return bits, parts
-    finally:
-        gmsh.finalize()
+    xyz, parts = merged_nodes(paths)
+    return {t: struct.pack("<3d", *p) for t, p in xyz.items()}, parts
 
 
 def write_inputs(src, stem):

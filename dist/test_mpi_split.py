@@ -24,23 +24,8 @@ import tempfile
 import meshes
 from mpi_checks import GETME_MPI, GETME, MPIEXEC, ENV, c
 import gmsh
+from gmsh_helpers import merged_nodes as nodes
 N = 3
-
-
-def nodes(paths):
-    """{tag: (x, y, z)} of the MSH files merged, and their partitions."""
-    gmsh.initialize(["test"])
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.open(paths[0])
-        for p in paths[1:]:
-            gmsh.merge(p)
-        tags, xyz, _ = gmsh.model.mesh.getNodes()
-        return ({int(t): tuple(xyz[3 * i:3 * i + 3]) for i, t in enumerate(tags)},
-                max((max(gmsh.model.getPartitions(d, t), default=0)
-                     for d, t in gmsh.model.getEntities()), default=0))
-    finally:
-        gmsh.finalize()
 
 
 def parts(stem):

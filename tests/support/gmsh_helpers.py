@@ -25,3 +25,22 @@ def structured_hex_volume(volume, divisions):
         gm.mesh.setTransfiniteSurface(surface)
         gm.mesh.setRecombine(2, surface)
     gm.mesh.setTransfiniteVolume(volume)
+
+
+def merged_nodes(paths):
+    """{tag: (x, y, z)} of the MSH files opened together (the first opened,
+    the others merged: a mesh's parts), and the highest partition number
+    of their entities (0 if unpartitioned)."""
+    gmsh.initialize(["test"])
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.open(paths[0])
+        for p in paths[1:]:
+            gmsh.merge(p)
+        tags, xyz, _ = gmsh.model.mesh.getNodes()
+        return ({int(t): tuple(xyz[3 * i:3 * i + 3])
+                 for i, t in enumerate(tags)},
+                max((max(gmsh.model.getPartitions(d, t), default=0)
+                     for d, t in gmsh.model.getEntities()), default=0))
+    finally:
+        gmsh.finalize()
