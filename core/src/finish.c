@@ -138,10 +138,7 @@ static double sub_bound(const getme_run *run, double fraction,
     int64_t n = ws->num_free_elem + rest->num_free_elements;
     if (n == 0)
         return 0.0;
-    double pos = fraction * (double)n;
-    if (pos < (double)min_count - 1.0)
-        pos = (double)min_count - 1.0;
-    int64_t k = pos >= (double)(n - 1) ? n - 1 : pos <= 0.0 ? 0 : (int64_t)pos;
+    int64_t k = getme__quantile_pos(n, fraction, min_count);
     if (k >= ws->num_free_elem) {
         *incomplete = 1;
         return 0.0;

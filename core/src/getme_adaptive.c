@@ -686,10 +686,7 @@ double getme__threshold(getme_run *run, double fraction, int32_t min_count)
     }
     if (n == 0)
         return 0.0;
-    double pos = fraction * (double)n;
-    if (pos < (double)min_count - 1.0)
-        pos = (double)min_count - 1.0;
-    int64_t k = pos >= (double)(n - 1) ? n - 1 : pos <= 0.0 ? 0 : (int64_t)pos;
+    int64_t k = getme__quantile_pos(n, fraction, min_count);
     int64_t *hist = malloc(65536 * sizeof *hist);
     if (getme__dist_any(run, hist == NULL)) { /* all stop, not only this one */
         free(hist);

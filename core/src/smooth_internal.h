@@ -138,6 +138,19 @@ getme_status getme__adaptive(getme_run *run);
    getme__adaptive() sets it (corner guard and floor). */
 getme_status getme__adaptive_finish(getme_run *run);
 
+/* The 0-based position of getme__threshold's quantile among n > 0 sorted
+   values: fraction * n, at least min_count - 1, at most n - 1.  One
+   function, because the finishing step on a sub-mesh (finish.c) must pick
+   exactly the position the whole mesh's threshold picks. */
+static inline int64_t getme__quantile_pos(int64_t n, double fraction,
+                                          int32_t min_count)
+{
+    double pos = fraction * (double)n;
+    if (pos < (double)min_count - 1.0)
+        pos = (double)min_count - 1.0;
+    return pos >= (double)(n - 1) ? n - 1 : pos <= 0.0 ? 0 : (int64_t)pos;
+}
+
 /* The quality at position fraction * n (at least min_count - 1, at most
    n - 1) of the sorted qualities of the free elements; 0 without free
    elements, -1 if out of memory (getme_adaptive.c). */
