@@ -18,25 +18,12 @@
 #include <stdint.h>
 #include <string.h>
 
-#define GETME_TEST_PI 3.14159265358979323846
 #define NUM_ELEMENTS 1000
 #define NUM_STEPS 50
 #define TARGET_Q 0.999
 
-/* ---- a small deterministic PRNG (splitmix64) ---------------------------- */
-
-static uint64_t rng_state = 0x7a11cafe2024ULL;
-
-static double urand(void) /* in [0, 1) */
-{
-    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    z ^= z >> 31;
-    return (double)(z >> 11) * (1.0 / 9007199254740992.0);
-}
-
-static double srand1(void) { return 2.0 * urand() - 1.0; }
+#define RANDOM_GEOMETRY_SEED 0x7a11cafe2024ULL
+#include "random_geometry.h"
 
 /* ---- element tables ----------------------------------------------------- */
 
@@ -88,37 +75,6 @@ static void random_element(int t, double amp, double *x)
     if (is_planar(t))
         for (int i = 0; i < nodes_of(t); i++)
             x[3 * i + 2] = srand1();
-}
-
-/* out = R x + b (R row-major) */
-static void rigid(const double *x, int nv, const double R[9], const double b[3],
-                  double *out)
-{
-    for (int i = 0; i < nv; i++)
-        for (int r = 0; r < 3; r++)
-            out[3 * i + r] = R[3 * r] * x[3 * i] + R[3 * r + 1] * x[3 * i + 1] +
-                             R[3 * r + 2] * x[3 * i + 2] + b[r];
-}
-
-static void random_rotation(int planar, double R[9])
-{
-    if (planar) {
-        double a = 2.0 * GETME_TEST_PI * urand(), c = cos(a), s = sin(a);
-        double P[9] = {c, -s, 0, s, c, 0, 0, 0, 1};
-        memcpy(R, P, sizeof P);
-        return;
-    }
-    double q[4], n;
-    do {
-        for (int k = 0; k < 4; k++)
-            q[k] = srand1();
-        n = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-    } while (n < 0.1 || n > 1.0);
-    double w = q[0] / n, x = q[1] / n, y = q[2] / n, z = q[3] / n;
-    double Q[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
-                   2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-                   2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)};
-    memcpy(R, Q, sizeof Q);
 }
 
 /* largest coordinate difference between the vertex means of a and b */
@@ -219,7 +175,7 @@ static void test_regular_fixed_point(void)
                 R[r] *= (r == 8 && is_planar(t)) ? 1.0 : size;
             for (int d = 0; d < 3; d++)
                 b[d] = 10.0 * size * srand1();
-            rigid(regular[t], nv, R, b, x);
+            affine(regular[t], nv, R, b, x);
             double sigma = sigmas[trial % 4];
             CHECK(getme_element_transform((getme_elem_type)t, x, sigma, out) == GETME_OK);
             CHECK_NEAR(max_abs_diff(out, x, 3 * nv) / size, 0.0, 1e-12);
@@ -243,10 +199,10 @@ static void test_equivariance(void)
             random_rotation(is_planar(t), R);
             for (int d = 0; d < 3; d++)
                 b[d] = is_planar(t) && d == 2 ? 0.0 : 5.0 * srand1();
-            rigid(x, nv, R, b, y);
+            affine(x, nv, R, b, y);
             getme_element_transform((getme_elem_type)t, x, 1.5, tx);
             getme_element_transform((getme_elem_type)t, y, 1.5, ty);
-            rigid(tx, nv, R, b, rtx);
+            affine(tx, nv, R, b, rtx);
             CHECK_NEAR(max_abs_diff(ty, rtx, 3 * nv), 0.0, 1e-12);
         }
     }
