@@ -26,6 +26,11 @@ import h5py
 import meshio
 import numpy as np
 
+# the bundled CGNS example's model (examples/cgns/make_example.py), coarser
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                                "..", "..", "examples", "cgns"))
+from make_example import hybrid_geometry  # noqa: E402
+
 TOOL, WORK = sys.argv[1], sys.argv[2]
 os.makedirs(WORK, exist_ok=True)
 failures = []
@@ -48,26 +53,7 @@ def path(name):
 def hybrid_mesh(msh):
     """Hex block, tet blocks (with pyramids where they meet the hexes) and
     an extruded prism cylinder."""
-    gmsh.initialize()
-    gmsh.option.setNumber("General.Terminal", 0)
-    occ = gmsh.model.occ
-    b1 = occ.addBox(0, 0, 0, 1, 1, 1)
-    b2 = occ.addBox(1, 0, 0, 1, 1, 1)
-    b3 = occ.addBox(0, 1, 0, 2, 1, 1)
-    occ.fragment([(3, b1)], [(3, b2), (3, b3)])
-    disk = occ.addDisk(3.5, 0.5, 0, 0.5, 0.5)
-    occ.extrude([(2, disk)], 0, 0, 1, numElements=[3], recombine=True)
-    occ.synchronize()
-    gmsh.option.setNumber("Mesh.MeshSizeMax", 0.34)
-    for dim, tag in gmsh.model.getBoundary([(3, b1)], combined=False,
-                                           oriented=False, recursive=True):
-        if dim == 1:
-            gmsh.model.mesh.setTransfiniteCurve(tag, 4)
-    for dim, tag in gmsh.model.getBoundary([(3, b1)], combined=False,
-                                           oriented=False):
-        gmsh.model.mesh.setTransfiniteSurface(tag)
-        gmsh.model.mesh.setRecombine(2, tag)
-    gmsh.model.mesh.setTransfiniteVolume(b1)
+    hybrid_geometry(size=0.34, edge_nodes=4, layers=3)
     gmsh.model.mesh.generate(3)
     tags, _, _ = gmsh.model.mesh.getNodes()
     index = {int(t): i for i, t in enumerate(tags)}
