@@ -279,4 +279,24 @@ int cli_write_report(const char *path, const char *input, const char *output,
                      const getme_result *result, const cli_history *history,
                      const char *format_name, const cli_report_extra *extra);
 
+/* The end of a smoothing command (smooth_end.c), after the library's last
+   call: "Done optimizing", the quality and measure lines after, the worst
+   elements, OUT written under the write guard, then the --report file
+   (never over a file OUT just wrote).  The exit code, 0 on success. */
+typedef struct cli_smooth_end {
+    const char *input, *output;           /* as the user named them       */
+    const cli_paths *paths;               /* checked by cli_check_paths   */
+    getme_doc *doc;                       /* the smoothed document        */
+    const getme_quality_stats *before;
+    const cli_measures *mbefore;
+    const cli_ho_ratio *ho_before;        /* NULL: none in the report     */
+    int32_t worst;                        /* --worst N                    */
+} cli_smooth_end;
+int cli_smooth_end_run(const cli_smooth_opts *so, const cli_smooth_end *e,
+                       const getme_result *res);
+/* "Writing WHAT'OUT'...", the document to paths->out, "Done writing": 0,
+   or the exit code after printing the error. */
+int cli_write_doc(const cli_log *log, getme_doc *doc, const cli_paths *paths,
+                  const char *output, const char *what);
+
 #endif /* GETME_CLI_H */

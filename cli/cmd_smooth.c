@@ -3,7 +3,6 @@
  */
 #include "cli.h"
 
-#include <errno.h>
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
@@ -56,19 +55,6 @@ static int parse(int argc, char **argv, smooth_args *a)
 }
 
 /* Writing the output (termination signals held). */
-static int write_output(const smooth_args *a, const cli_paths *paths,
-                        getme_doc *doc, const char *what)
-{
-    cli_info(&a->o.log, "Writing %s'%s'...", what, a->output);
-    getme_formats_status ios = getme_doc_write(doc, paths->out);
-    if (ios != GETME_FORMATS_OK) {
-        cli_error("%s", getme_doc_error(doc));
-        return cli_exit_code(ios);
-    }
-    cli_info(&a->o.log, "Done writing '%s'", a->output);
-    return 0;
-}
-
 static int run(smooth_args *a)
 {
     cli_smooth_opts *so = &a->o;
@@ -98,14 +84,12 @@ static int run(smooth_args *a)
     if (getme_doc_info(doc)[0])
         cli_info(log, "%s", getme_doc_info(doc));
 
-    getme_quality_stats before = *getme_doc_stats(doc), after;
+    getme_quality_stats before = *getme_doc_stats(doc);
     cli_print_stats(log, "Quality before", &before);
-    cli_measures mbefore, mafter;
+    cli_measures mbefore;
     cli_measures_log(log, mesh, "Measures before", &mbefore);
-    cli_ho_ratio ho_before = {0}, ho_after = {0};
+    cli_ho_ratio ho_before = {0};
     cli_ho_log(log, doc, "before", &ho_before);
-    cli_worst_list worst = {0}, worst_free = {0};
-    cli_guard guard = {0};
     getme_untangle_result ur;
     memset(&ur, 0, sizeof ur);
     code = 0;
@@ -116,8 +100,10 @@ static int run(smooth_args *a)
     if ((before.num_invalid > 0 || ho_invalid) &&
         (code = cli_untangle(&a->o, a->input, doc, &ur)) != 0) {
         if (code == CLI_EXIT_TANGLED && so->allow_invalid) {
+            cli_guard guard = {0};
             cli_write_guard(&guard, 1);
-            write_output(a, &paths, doc, "partly untangled, not smoothed, ");
+            cli_write_doc(log, doc, &paths, a->output,
+                          "partly untangled, not smoothed, ");
             cli_write_guard(&guard, 0);
         }
         goto out;
@@ -135,46 +121,10 @@ static int run(smooth_args *a)
                                             : CLI_EXIT_INTERNAL;
         goto out;
     }
-    cli_smooth_done(so, &res);
-    getme_mesh_quality_stats(mesh, -1, &after);
-    cli_print_stats(log, "Quality after ", &after);
-    cli_measures_log(log, mesh, "Measures after ", &mafter);
-    cli_ho_log(log, doc, "after", &ho_after);
-    if (cli_log_after(log, doc, (int32_t)a->worst, &after, &res, &worst,
-                      &worst_free) != 0) {
-        code = CLI_EXIT_INTERNAL;
-        goto out;
-    }
-
-    cli_write_guard(&guard, 1);
-    cli_file_stamp report_was;
-    cli_stamp(paths.rep, &report_was);
-    if ((code = write_output(a, &paths, doc, "")) != 0) {
-        /* the message is printed */
-    } else if (so->report && cli_replaced(paths.rep, &report_was)) {
-        /* the report names a file the output wrote (an INP include copy) */
-        cli_error("report %s: it is a file the output just wrote; not "
-                  "replacing it (choose another report file)", so->report);
-        code = EXIT_USAGE;
-    } else {
-        cli_mesh_counts counts;
-        cli_count_mesh(mesh, &counts);
-        cli_report_extra extra = {doc,      &worst,     &worst_free,
-                                  &mbefore, &mafter,    &ho_before,
-                                  &ho_after};
-        if (so->report &&
-            cli_write_report(paths.rep, a->input, a->output, &so->params,
-                             &counts, &before, &after, &res, &so->history,
-                             getme_format_name(getme_doc_format(doc)), &extra) != 0) {
-            cli_error("%s: cannot write the report: %s", so->report,
-                      strerror(errno));
-            code = CLI_EXIT_WRITE;
-        }
-    }
-    cli_write_guard(&guard, 0);
+    cli_smooth_end end = {a->input, a->output, &paths,   doc,
+                          &before,  &mbefore,  &ho_before, (int32_t)a->worst};
+    code = cli_smooth_end_run(so, &end, &res);
 out:
-    free(worst.items);
-    free(worst_free.items);
     getme_doc_close(doc);
     return code;
 }

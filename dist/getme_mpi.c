@@ -19,7 +19,6 @@
 #include "dist.h"
 #include "cli.h"
 
-#include <errno.h>
 #include <omp.h>
 #include <sys/resource.h>
 #include <stdio.h>
@@ -252,63 +251,15 @@ static int read_input(args *a, cli_paths *paths, int size, getme_doc **doc,
     return 0;
 }
 
-/* Rank 0 after the finishing step: log, write OUT and the report.  The
-   exit code. */
+/* Rank 0 after the finishing step: log, write OUT and the report as
+   `getme smooth` does (cli_smooth_end_run).  The exit code. */
 static int finish_output(args *a, const cli_paths *paths, getme_doc *doc,
                          const getme_quality_stats *before,
                          const cli_measures *mbefore, const getme_result *res)
 {
-    cli_smooth_opts *so = &a->o;
-    const cli_log *log = &so->log;
-    getme_mesh *mesh = getme_doc_mesh(doc);
-    getme_quality_stats after;
-    cli_measures mafter;
-    cli_smooth_done(so, res);
-    getme_mesh_quality_stats(mesh, -1, &after);
-    cli_print_stats(log, "Quality after ", &after);
-    cli_measures_log(log, mesh, "Measures after ", &mafter);
-    cli_ho_log(log, doc, "after", NULL);
-    cli_worst_list worst = {0}, worst_free = {0};
-    int code = 0;
-    if (cli_log_after(log, doc, (int32_t)a->worst, &after, res, &worst,
-                      &worst_free) != 0) {
-        code = CLI_EXIT_INTERNAL;
-        goto out;
-    }
-    cli_guard guard = {0};
-    cli_write_guard(&guard, 1);
-    cli_file_stamp report_was;
-    cli_stamp(paths->rep, &report_was);
-    cli_info(log, "Writing '%s'...", a->output);
-    getme_formats_status ws = getme_doc_write(doc, paths->out);
-    if (ws != GETME_FORMATS_OK) {
-        cli_error("%s", getme_doc_error(doc));
-        code = cli_exit_code(ws);
-    } else if (so->report && cli_replaced(paths->rep, &report_was)) {
-        cli_error("report %s: it is a file the output just wrote; not "
-                  "replacing it (choose another report file)", so->report);
-        code = EXIT_USAGE;
-    } else {
-        cli_info(log, "Done writing '%s'", a->output);
-        cli_mesh_counts counts;
-        cli_count_mesh(mesh, &counts);
-        cli_report_extra extra = {doc,     &worst, &worst_free,
-                                  mbefore, &mafter, NULL, NULL};
-        if (so->report &&
-            cli_write_report(paths->rep, a->input, a->output, &so->params,
-                             &counts, before, &after, res, &so->history,
-                             getme_format_name(getme_doc_format(doc)),
-                             &extra) != 0) {
-            cli_error("%s: cannot write the report: %s", so->report,
-                      strerror(errno));
-            code = CLI_EXIT_WRITE;
-        }
-    }
-    cli_write_guard(&guard, 0);
-out:
-    free(worst.items);
-    free(worst_free.items);
-    return code;
+    cli_smooth_end end = {a->input, a->output, paths, doc,
+                          before,   mbefore,   NULL,  (int32_t)a->worst};
+    return cli_smooth_end_run(&a->o, &end, res);
 }
 
 /* With -v, at the end (collective): every rank's peak RSS over the whole
