@@ -223,6 +223,8 @@ static getme_status build_stars(getme_ws *ws)
                     (int64_t)(ws->tstart[GETME_NUM_TYPES] -
                               ws->tstart[GETME_NUM_TYPES - 1]) *
                         getme__nv[GETME_NUM_TYPES - 1];
+    if (total > INT32_MAX)
+        return GETME_ERR_NOMEM; /* star_ptr is 32-bit (workspace.h) */
     ws->star = malloc((size_t)(total ? total : 1) * sizeof *ws->star);
     if (!ws->star_ptr || !ws->star)
         return GETME_ERR_NOMEM;
@@ -230,12 +232,12 @@ static getme_status build_stars(getme_ws *ws)
         ws->star_ptr[ws->conn[k] + 1]++;
     ws->max_star = 0;
     for (int32_t i = 0; i < ws->nn; i++) {
-        int64_t c = ws->star_ptr[i + 1];
+        int32_t c = ws->star_ptr[i + 1];
         if (c > ws->max_star)
-            ws->max_star = (int32_t)c;
+            ws->max_star = c;
         ws->star_ptr[i + 1] += ws->star_ptr[i];
     }
-    int64_t *pos = malloc((size_t)(ws->nn ? ws->nn : 1) * sizeof *pos);
+    int32_t *pos = malloc((size_t)(ws->nn ? ws->nn : 1) * sizeof *pos);
     if (!pos)
         return GETME_ERR_NOMEM;
     memcpy(pos, ws->star_ptr, (size_t)ws->nn * sizeof *pos);

@@ -37,7 +37,9 @@ typedef struct getme_ws {
     uint8_t *free_elem;  /* ne, 1 = has at least one free node              */
     int32_t num_free_elem;
     int32_t num_free_nodes; /* free nodes used by at least one element       */
-    int64_t *star_ptr;   /* nn + 1                                           */
+    int32_t *star_ptr;   /* nn + 1; 32-bit: the stars hold every element's
+                            nodes, so fewer than 2^31 entries (the build
+                            fails with GETME_ERR_NOMEM beyond)              */
     int32_t *star;       /* incident elements of each node, ascending       */
     int32_t max_star;    /* largest star                                     */
     /* colour-blocks */
