@@ -53,6 +53,8 @@ typedef struct getme_ws {
     getme_ho_ws *ho;      /* second-order elements' dependent nodes, or NULL */
     int conn_lent;        /* the mesh's block lent its connectivity
                              (getme__ws_lend_conn)                          */
+    int x_lent;           /* the mesh lent its coordinates (getme__ws_lend_x)
+                                                                            */
     int32_t *faces;       /* the face table (getme__ws_faces) the boundary
                              search computed, for getme__adj_build to take
                              over, or NULL                                  */
@@ -79,6 +81,15 @@ void getme__ws_keep(getme_ws *ws, getme_mesh *mesh);
 void getme__ws_lend_conn(getme_ws *ws, getme_mesh *mesh);
 void getme__ws_return_conn(getme_ws *ws, getme_mesh *mesh);
 
+/* The same for the coordinates, if the caller allowed it
+   (getme_mesh_lend_coords; first-order meshes): the mesh frees its array
+   (24 B per node) and getme__ws_return_x makes ws->x, put back in the
+   caller's order (in place), the mesh's array.  The smoother calls it once
+   the input is checked, so only a failure in the loop itself (out of
+   memory) leaves the mesh partly smoothed. */
+void getme__ws_lend_x(getme_ws *ws, getme_mesh *mesh);
+void getme__ws_return_x(getme_ws *ws, getme_mesh *mesh);
+
 /* The 30-bit Morton key the element order uses (renumber = 1): each
    coordinate's (x - lo) * scale clamped to [0, 1023] and truncated, its
    bits spread to every third bit from bit d (scale = 1023 / extent, 0 for
@@ -86,8 +97,9 @@ void getme__ws_return_conn(getme_ws *ws, getme_mesh *mesh);
 uint32_t getme__morton(const double *x, const double lo[3],
                        const double scale[3]);
 
-/* Write the workspace coordinates back to the mesh (undoing mirror/order). */
-void getme__ws_store(const getme_ws *ws, getme_mesh *mesh);
+/* Write the workspace coordinates back to the mesh (undoing mirror/order);
+   lent coordinates are returned (getme__ws_return_x). */
+void getme__ws_store(getme_ws *ws, getme_mesh *mesh);
 
 static inline int getme__ws_type(const getme_ws *ws, int32_t e)
 {
