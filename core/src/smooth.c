@@ -279,6 +279,7 @@ getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
         goto done;
     }
     getme__ws_lend_x(&ws, mesh); /* the input is checked: back at store */
+    getme__ws_pack_map(&ws);     /* unread until the end */
     st = params->method == GETME_METHOD_SMART_LAPLACE ? getme__laplace(&run)
                                                       : getme__adaptive(&run);
     if (st == GETME_OK || st == GETME_ERR_CANCELLED) {
@@ -294,6 +295,7 @@ done:
     getme__ws_return_x(&ws, mesh); /* a failure in the loop: partly smoothed */
     getme__run_free(&run);
     getme__adj_free(&adj);
+    getme__ws_unpack_map(&ws); /* into the stars' array: no allocation */
     getme__ws_return_conn(&ws, mesh); /* after the rest is freed: no peak */
     getme__ws_free(&ws);
     result->seconds = omp_get_wtime() - t0;

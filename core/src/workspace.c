@@ -32,6 +32,7 @@ void getme__ws_free(getme_ws *ws)
     free(ws->colour_ptr);
     free(ws->colour_blocks);
     free(ws->faces);
+    getme__packed_free(&ws->elem_packed);
     getme__ho_free(ws->ho);
     memset(ws, 0, sizeof *ws);
 }
@@ -461,6 +462,23 @@ void getme__ws_return_conn(getme_ws *ws, getme_mesh *mesh)
     bl->conn = c;
     ws->conn = NULL;
     ws->conn_lent = 0;
+}
+
+void getme__ws_pack_map(getme_ws *ws)
+{
+    if (ws->elem_orig && getme__pack(&ws->elem_packed, ws->elem_orig, ws->ne)) {
+        free(ws->elem_orig);
+        ws->elem_orig = NULL;
+    }
+}
+
+void getme__ws_unpack_map(getme_ws *ws)
+{
+    if (ws->elem_orig || ws->elem_packed.n == 0)
+        return;
+    getme__unpack(&ws->elem_packed, ws->star);
+    ws->elem_orig = ws->star;
+    ws->star = NULL;
 }
 
 void getme__ws_lend_x(getme_ws *ws, getme_mesh *mesh)

@@ -18,6 +18,7 @@
 #define GETME_WORKSPACE_H
 
 #include "highorder.h"
+#include "pack.h"
 
 #include <stdint.h>
 
@@ -55,6 +56,8 @@ typedef struct getme_ws {
                              (getme__ws_lend_conn)                          */
     int x_lent;           /* the mesh lent its coordinates (getme__ws_lend_x)
                                                                             */
+    getme_packed elem_packed; /* elem_orig while packed (getme__ws_pack_map),
+                                 elem_orig then NULL                        */
     int32_t *faces;       /* the face table (getme__ws_faces) the boundary
                              search computed, for getme__adj_build to take
                              over, or NULL                                  */
@@ -89,6 +92,14 @@ void getme__ws_return_conn(getme_ws *ws, getme_mesh *mesh);
    memory) leaves the mesh partly smoothed. */
 void getme__ws_lend_x(getme_ws *ws, getme_mesh *mesh);
 void getme__ws_return_x(getme_ws *ws, getme_mesh *mesh);
+
+/* During getme_smooth's loop nothing reads elem_orig: it is held packed
+   (pack.h; 4 B per element less where that saves memory).
+   getme__ws_unpack_map writes it back into the stars' array, which must
+   no longer be needed (ws->star becomes NULL; no allocation, so it cannot
+   fail: the stars have at least one entry per element). */
+void getme__ws_pack_map(getme_ws *ws);
+void getme__ws_unpack_map(getme_ws *ws);
 
 /* The 30-bit Morton key the element order uses (renumber = 1): each
    coordinate's (x - lo) * scale clamped to [0, 1023] and truncated, its
