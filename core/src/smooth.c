@@ -282,6 +282,7 @@ getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
     getme__ws_pack_map(&ws);     /* unread until the end */
     st = params->method == GETME_METHOD_SMART_LAPLACE ? getme__laplace(&run)
                                                       : getme__adaptive(&run);
+    getme__ws_unpack_map(&ws); /* into the stars' array: no allocation */
     if (st == GETME_OK || st == GETME_ERR_CANCELLED) {
         result->corner_sj = getme__ws_corner_min(&ws);
         getme__ws_store(&ws, mesh);
@@ -292,10 +293,10 @@ getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
     else if (st != GETME_OK)
         getme__fail(mesh, st, "%s", getme_status_string(st));
 done:
+    getme__ws_unpack_map(&ws);
     getme__ws_return_x(&ws, mesh); /* a failure in the loop: partly smoothed */
     getme__run_free(&run);
     getme__adj_free(&adj);
-    getme__ws_unpack_map(&ws); /* into the stars' array: no allocation */
     getme__ws_return_conn(&ws, mesh); /* after the rest is freed: no peak */
     getme__ws_free(&ws);
     result->seconds = omp_get_wtime() - t0;

@@ -22,7 +22,8 @@ void getme__ws_free(getme_ws *ws)
 {
     free(ws->conn);
     free(ws->elem_orig);
-    free(ws->node_orig);
+    if (ws->maps_packed != 2) /* else inside elem_orig's block */
+        free(ws->node_orig);
     free(ws->x);
     free(ws->fixed);
     free(ws->free_elem);
@@ -33,6 +34,7 @@ void getme__ws_free(getme_ws *ws)
     free(ws->colour_blocks);
     free(ws->faces);
     getme__packed_free(&ws->elem_packed);
+    getme__packed_free(&ws->node_packed);
     getme__ho_free(ws->ho);
     memset(ws, 0, sizeof *ws);
 }
@@ -464,21 +466,41 @@ void getme__ws_return_conn(getme_ws *ws, getme_mesh *mesh)
     ws->conn_lent = 0;
 }
 
+/* Entries in ws->star. */
+static int64_t star_total(const getme_ws *ws)
+{
+    return ws->coff[GETME_NUM_TYPES - 1] +
+           (int64_t)(ws->tstart[GETME_NUM_TYPES] -
+                     ws->tstart[GETME_NUM_TYPES - 1]) *
+               getme__nv[GETME_NUM_TYPES - 1];
+}
+
 void getme__ws_pack_map(getme_ws *ws)
 {
-    if (ws->elem_orig && getme__pack(&ws->elem_packed, ws->elem_orig, ws->ne)) {
-        free(ws->elem_orig);
-        ws->elem_orig = NULL;
+    if (ws->maps_packed || !ws->star || ws->ho ||
+        star_total(ws) < (int64_t)ws->ne + ws->nn)
+        return; /* no room to unpack both without allocating */
+    if (!getme__pack(&ws->elem_packed, ws->elem_orig, ws->ne))
+        return;
+    if (!getme__pack(&ws->node_packed, ws->node_orig, ws->nn)) {
+        getme__packed_free(&ws->elem_packed);
+        return;
     }
+    free(ws->elem_orig), free(ws->node_orig);
+    ws->elem_orig = ws->node_orig = NULL;
+    ws->maps_packed = 1;
 }
 
 void getme__ws_unpack_map(getme_ws *ws)
 {
-    if (ws->elem_orig || ws->elem_packed.n == 0)
+    if (ws->maps_packed != 1)
         return;
     getme__unpack(&ws->elem_packed, ws->star);
-    ws->elem_orig = ws->star;
+    getme__unpack(&ws->node_packed, ws->star + ws->ne);
+    ws->elem_orig = ws->star; /* one block: getme__ws_free frees it */
+    ws->node_orig = ws->star + ws->ne;
     ws->star = NULL;
+    ws->maps_packed = 2;
 }
 
 void getme__ws_lend_x(getme_ws *ws, getme_mesh *mesh)

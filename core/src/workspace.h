@@ -56,8 +56,11 @@ typedef struct getme_ws {
                              (getme__ws_lend_conn)                          */
     int x_lent;           /* the mesh lent its coordinates (getme__ws_lend_x)
                                                                             */
-    getme_packed elem_packed; /* elem_orig while packed (getme__ws_pack_map),
-                                 elem_orig then NULL                        */
+    /* elem_orig and node_orig while packed (getme__ws_pack_map), both then
+       NULL; maps_packed: 0 never, 1 packed, 2 unpacked into ws->star's
+       block (node_orig then points inside it, after elem_orig)            */
+    getme_packed elem_packed, node_packed;
+    int maps_packed;
     int32_t *faces;       /* the face table (getme__ws_faces) the boundary
                              search computed, for getme__adj_build to take
                              over, or NULL                                  */
@@ -93,11 +96,11 @@ void getme__ws_return_conn(getme_ws *ws, getme_mesh *mesh);
 void getme__ws_lend_x(getme_ws *ws, getme_mesh *mesh);
 void getme__ws_return_x(getme_ws *ws, getme_mesh *mesh);
 
-/* During getme_smooth's loop nothing reads elem_orig: it is held packed
-   (pack.h; 4 B per element less where that saves memory).
-   getme__ws_unpack_map writes it back into the stars' array, which must
+/* During getme_smooth's loop nothing reads elem_orig and node_orig: they
+   are held packed (pack.h; tets 1.5 B per element and per node less).
+   getme__ws_unpack_map writes them back into the stars' array, which must
    no longer be needed (ws->star becomes NULL; no allocation, so it cannot
-   fail: the stars have at least one entry per element). */
+   fail; packing is skipped unless the stars have room for both). */
 void getme__ws_pack_map(getme_ws *ws);
 void getme__ws_unpack_map(getme_ws *ws);
 
