@@ -110,6 +110,9 @@ static int run(smooth_args *a)
     }
     cli_smooth_begin(so, NULL);
     getme_result res;
+    /* nothing is written if smoothing fails: the smoother may work in the
+       mesh's own coordinate array (24 B per node less) */
+    getme_mesh_lend_coords(mesh, 1);
     getme_status st = getme_smooth(mesh, &so->params, &res);
     res.num_invalid_initial = ur.num_invalid_before;
     res.untangle_sweeps = ur.sweeps;

@@ -7,6 +7,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 static const char HELP[] =
     "getme " GETME_VERSION_STRING
@@ -65,9 +68,26 @@ static void prefer_passive_waiting(char **argv)
     execv("/proc/self/exe", argv);
 }
 
+/* glibc serves a large block with mmap() only up to a threshold that
+   rises to the size of every such block freed (up to 32 MiB), and then
+   serves blocks below it from the heap, whose freed middle parts stay
+   resident.  The smoother frees the caller's arrays and its set-up
+   temporaries (several MiB each) before its peak, so with the moving
+   threshold the peak's resident size was ~20 MiB above its heap on the
+   medium hexes (214.8 MiB against 192.9); a fixed 1 MiB threshold returns
+   every freed large block to the system (194.7 MiB; ~1 % more CPU for the
+   page faults of fresh blocks). */
+static void return_freed_memory(void)
+{
+#ifdef __GLIBC__
+    mallopt(M_MMAP_THRESHOLD, 1 << 20);
+#endif
+}
+
 int main(int argc, char **argv)
 {
     prefer_passive_waiting(argv);
+    return_freed_memory();
     if (argc < 2) {
         fputs(HELP, stderr);
         return EXIT_USAGE;

@@ -166,7 +166,9 @@ GETME_API int32_t getme_mesh_num_elements_of_type(const getme_mesh *mesh,
 GETME_API int getme_mesh_get_element(const getme_mesh *mesh, int32_t e,
                                      getme_elem_type *type, int32_t *nodes);
 
-/* Read-only view of the current coordinates (3 per node, caller's order). */
+/* Read-only view of the current coordinates (3 per node, caller's order);
+   valid until the coordinates are set, or the mesh is smoothed with
+   getme_mesh_lend_coords() on. */
 GETME_API const double *getme_mesh_coords(const getme_mesh *mesh);
 /* Copy the current coordinates into coords (3 * num_nodes doubles). */
 GETME_API getme_status getme_mesh_get_coords(const getme_mesh *mesh,
@@ -174,6 +176,17 @@ GETME_API getme_status getme_mesh_get_coords(const getme_mesh *mesh,
 /* Replace all coordinates (3 * num_nodes doubles). */
 GETME_API getme_status getme_mesh_set_coords(getme_mesh *mesh,
                                              const double *coords);
+/*
+ * on = 1: getme_smooth() may take the mesh's coordinate array as its own
+ * working copy once the input is checked (24 bytes per node less at the
+ * peak; first-order meshes), and gives it back reordered in place.  The
+ * price: a failure during the smoothing loop itself (GETME_ERR_NOMEM)
+ * then leaves the mesh valid but partly smoothed, as a cancellation does,
+ * instead of unchanged.  Failures before the loop (invalid input,
+ * arguments, memory for the set-up) still leave it unchanged.  Default 0;
+ * the getme command sets it, as it writes nothing when smoothing fails.
+ */
+GETME_API void getme_mesh_lend_coords(getme_mesh *mesh, int on);
 
 /* ---- second-order elements (docs/highorder.md) ------------------------- */
 

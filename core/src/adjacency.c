@@ -203,7 +203,8 @@ static void counts_and_flags(getme_adj *adj, const getme_ws *ws,
         }
         bad |= cnt > UINT16_MAX;
         adj->count[e] = (uint16_t)(bad ? 0 : cnt);
-        adj->irregular[e] = (uint8_t)(bad != 0);
+        if (bad) /* only then: see getme__adj_build */
+            adj->irregular[e] = 1;
     }
 }
 
@@ -302,7 +303,9 @@ getme_status getme__adj_build(getme_adj *adj, getme_ws *ws)
                                    sizeof *adj->fnb);
     ws->faces = NULL;
     adj->count = malloc(ne * sizeof *adj->count);
-    adj->irregular = malloc(ne);
+    /* Zeroed, and only irregular elements written: on a mesh with none
+       (tets) its pages are never touched, so they take no memory. */
+    adj->irregular = calloc(ne, 1);
     adj->nsum = malloc(nn * sizeof *adj->nsum);
     /* The fixed-point scale of the sums (adjacency.h). */
     adj->qscale = 0x1p61 / getme__pow2_ceil((double)ws->max_star + 1.0);

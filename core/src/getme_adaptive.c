@@ -24,6 +24,7 @@
  *    q*_min in its last, unsuccessful cycle).
  */
 #include "adjacency.h"
+#include "best.h"
 #include "smooth_internal.h"
 
 #include <math.h>
@@ -795,13 +796,10 @@ getme_status getme__adaptive(getme_run *run)
     getme_ws *ws = run->ws;
     const getme_params *p = run->params;
     getme_result *res = run->result;
-    double *best = NULL;
+    getme_best best; /* best.h: an undo log, not a copy */
     getme_status st = alloc_adaptive(run);
-    if (st == GETME_OK) {
-        best = p->keep_best ? malloc((size_t)ws->nn * 3 * sizeof *best) : NULL;
-        if (p->keep_best && !best)
-            st = GETME_ERR_NOMEM;
-    }
+    if (getme__best_init(&best, run, p->keep_best) != GETME_OK)
+        st = GETME_ERR_NOMEM;
     /* Distributed: all processes stop if one has no memory (the others
        would wait for it in the first hook). */
     if (getme__dist_any(run, st != GETME_OK)) {
@@ -829,6 +827,9 @@ getme_status getme__adaptive(getme_run *run)
         int32_t ntrans, nrelax;
         getme_stage stage = state == MEAN_RUNNING ? GETME_STAGE_MEAN
                                                   : GETME_STAGE_MIN;
+        if (stage == GETME_STAGE_MIN &&
+            (st = getme__best_note(&best, run)) != GETME_OK)
+            break;
         if ((st = iterate(run, state == MEAN_RUNNING, qt, q_min, R, nR,
                           &ntrans, &nrelax)) != GETME_OK)
             break;
@@ -845,8 +846,7 @@ getme_status getme__adaptive(getme_run *run)
             res->iterations_min++;
         if (stage == GETME_STAGE_MIN && q_min > best_min) {
             best_min = q_min;
-            if (best)
-                memcpy(best, ws->x, (size_t)ws->nn * 3 * sizeof *best);
+            getme__best_take(&best, ws);
         }
         if (getme__report(run, it, stage, res->cycles_min, q_min, q_mean, qt,
                           ntrans, nrelax) &&
@@ -861,8 +861,11 @@ getme_status getme__adaptive(getme_run *run)
             R = p->relax_min;
             nR = p->num_relax_min;
             best_min = q_min; /* the end of stage 1 is the first candidate */
-            if (best)
-                memcpy(best, ws->x, (size_t)ws->nn * 3 * sizeof *best);
+            getme__best_take(&best, ws);
+            /* Only the q_mean stage's scatter_all uses the block kernel's
+               local connectivity: freed before the q*_min stage's lists
+               grow (10 B per tet, 18 B per hex less at the peak). */
+            getme__blocks_free(&run->adj->blk);
         }
         if (state == MIN_RUNNING) {
             if (!(q_min > prev_min + p->min_tol))
@@ -894,9 +897,9 @@ getme_status getme__adaptive(getme_run *run)
         }
     }
 
-    if (best && best_min > q_min) {
-        /* Fixed nodes are equal in both copies, so this keeps them exact. */
-        memcpy(ws->x, best, (size_t)ws->nn * 3 * sizeof *best);
+    if (best.on && best_min > q_min) {
+        /* Fixed nodes never move, so this keeps them exact. */
+        getme__best_restore(&best, ws);
         getme__ws_qualities(ws, run->q);
         getme__summary(run, &q_mean, &q_min, NULL);
     }
@@ -908,7 +911,7 @@ getme_status getme__adaptive(getme_run *run)
         st = GETME_ERR_COMM;
     res->threshold = qt;
 done:
-    free(best);
+    getme__best_free(&best);
     free_adaptive(run);
     return st;
 }

@@ -140,6 +140,8 @@ struct getme_mesh {
        the smoother so that it is built once (workspace.c); dropped when
        coordinates or elements change, as its order depends on both. */
     struct getme_ws *ws_cache;
+    int lend_coords;  /* getme_mesh_lend_coords(): getme_smooth() may use
+                         coords as its working copy                      */
     char error[512];  /* message of the last failure */
 };
 

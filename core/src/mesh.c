@@ -213,6 +213,12 @@ int getme_mesh_get_element(const getme_mesh *mesh, int32_t e,
     return nv;
 }
 
+void getme_mesh_lend_coords(getme_mesh *mesh, int on)
+{
+    if (mesh)
+        mesh->lend_coords = on != 0;
+}
+
 const double *getme_mesh_coords(const getme_mesh *mesh)
 {
     return mesh ? mesh->coords : NULL;

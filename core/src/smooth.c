@@ -278,8 +278,11 @@ getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
         result->stop_reason = GETME_STOP_NOTHING_TO_DO;
         goto done;
     }
+    getme__ws_lend_x(&ws, mesh); /* the input is checked: back at store */
+    getme__ws_pack_map(&ws);     /* unread until the end */
     st = params->method == GETME_METHOD_SMART_LAPLACE ? getme__laplace(&run)
                                                       : getme__adaptive(&run);
+    getme__ws_unpack_map(&ws); /* into the stars' array: no allocation */
     if (st == GETME_OK || st == GETME_ERR_CANCELLED) {
         result->corner_sj = getme__ws_corner_min(&ws);
         getme__ws_store(&ws, mesh);
@@ -290,6 +293,8 @@ getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
     else if (st != GETME_OK)
         getme__fail(mesh, st, "%s", getme_status_string(st));
 done:
+    getme__ws_unpack_map(&ws);
+    getme__ws_return_x(&ws, mesh); /* a failure in the loop: partly smoothed */
     getme__run_free(&run);
     getme__adj_free(&adj);
     getme__ws_return_conn(&ws, mesh); /* after the rest is freed: no peak */

@@ -22,7 +22,8 @@ void getme__ws_free(getme_ws *ws)
 {
     free(ws->conn);
     free(ws->elem_orig);
-    free(ws->node_orig);
+    if (ws->maps_packed != 2) /* else inside elem_orig's block */
+        free(ws->node_orig);
     free(ws->x);
     free(ws->fixed);
     free(ws->free_elem);
@@ -32,6 +33,8 @@ void getme__ws_free(getme_ws *ws)
     free(ws->colour_ptr);
     free(ws->colour_blocks);
     free(ws->faces);
+    getme__packed_free(&ws->elem_packed);
+    getme__packed_free(&ws->node_packed);
     getme__ho_free(ws->ho);
     memset(ws, 0, sizeof *ws);
 }
@@ -223,6 +226,8 @@ static getme_status build_stars(getme_ws *ws)
                     (int64_t)(ws->tstart[GETME_NUM_TYPES] -
                               ws->tstart[GETME_NUM_TYPES - 1]) *
                         getme__nv[GETME_NUM_TYPES - 1];
+    if (total > INT32_MAX)
+        return GETME_ERR_NOMEM; /* star_ptr is 32-bit (workspace.h) */
     ws->star = malloc((size_t)(total ? total : 1) * sizeof *ws->star);
     if (!ws->star_ptr || !ws->star)
         return GETME_ERR_NOMEM;
@@ -230,12 +235,12 @@ static getme_status build_stars(getme_ws *ws)
         ws->star_ptr[ws->conn[k] + 1]++;
     ws->max_star = 0;
     for (int32_t i = 0; i < ws->nn; i++) {
-        int64_t c = ws->star_ptr[i + 1];
+        int32_t c = ws->star_ptr[i + 1];
         if (c > ws->max_star)
-            ws->max_star = (int32_t)c;
+            ws->max_star = c;
         ws->star_ptr[i + 1] += ws->star_ptr[i];
     }
-    int64_t *pos = malloc((size_t)(ws->nn ? ws->nn : 1) * sizeof *pos);
+    int32_t *pos = malloc((size_t)(ws->nn ? ws->nn : 1) * sizeof *pos);
     if (!pos)
         return GETME_ERR_NOMEM;
     memcpy(pos, ws->star_ptr, (size_t)ws->nn * sizeof *pos);
@@ -415,47 +420,120 @@ void getme__ws_lend_conn(getme_ws *ws, getme_mesh *mesh)
     ws->conn_lent = 1;
 }
 
+/* Rows of size bytes (at most 3 * GETME_MAX_NV * 8) in place: row e goes
+   to row dest[e], a permutation of [0, n).  Follows each cycle, marking
+   the rows placed as -1 - dest (restored after): no allocation. */
+static void permute_rows(void *rows, size_t size, int32_t *dest, int32_t n)
+{
+    unsigned char *r = rows;
+    unsigned char carry[3 * GETME_MAX_NV * 8], tmp[3 * GETME_MAX_NV * 8];
+    for (int32_t e = 0; e < n; e++) {
+        if (dest[e] < 0)
+            continue;
+        memcpy(carry, r + (size_t)e * size, size);
+        for (int32_t cur = e;;) {
+            int32_t d = dest[cur];
+            dest[cur] = -1 - d;
+            unsigned char *row = r + (size_t)d * size;
+            if (d == e) {
+                memcpy(row, carry, size);
+                break;
+            }
+            memcpy(tmp, row, size);
+            memcpy(row, carry, size);
+            memcpy(carry, tmp, size);
+            cur = d;
+        }
+    }
+    for (int32_t e = 0; e < n; e++)
+        dest[e] = -1 - dest[e];
+}
+
 void getme__ws_return_conn(getme_ws *ws, getme_mesh *mesh)
 {
     if (!ws->conn_lent)
         return;
     getme_block *bl = &mesh->blocks[0];
     int nv = getme__nv[bl->type];
-    int32_t *c = ws->conn, *orig = ws->elem_orig;
+    int32_t *c = ws->conn;
     int64_t len = (int64_t)ws->ne * nv;
 #pragma omp parallel for schedule(static) num_threads(ws->nt)
     for (int64_t k = 0; k < len; k++)
         c[k] = ws->node_orig[c[k]];
-    /* Row e goes to row orig[e]: follow each cycle of the permutation,
-       marking the rows placed as -1 - orig (restored after). */
-    for (int32_t e = 0; e < ws->ne; e++) {
-        if (orig[e] < 0)
-            continue;
-        int32_t carry[GETME_MAX_NV], tmp[GETME_MAX_NV];
-        memcpy(carry, c + (int64_t)e * nv, (size_t)nv * sizeof *carry);
-        for (int32_t cur = e;;) {
-            int32_t d = orig[cur];
-            orig[cur] = -1 - d;
-            int32_t *row = c + (int64_t)d * nv;
-            if (d == e) {
-                memcpy(row, carry, (size_t)nv * sizeof *row);
-                break;
-            }
-            memcpy(tmp, row, (size_t)nv * sizeof *tmp);
-            memcpy(row, carry, (size_t)nv * sizeof *row);
-            memcpy(carry, tmp, (size_t)nv * sizeof *carry);
-            cur = d;
-        }
-    }
-    for (int32_t e = 0; e < ws->ne; e++)
-        orig[e] = -1 - orig[e];
+    permute_rows(c, (size_t)nv * sizeof *c, ws->elem_orig, ws->ne);
     bl->conn = c;
     ws->conn = NULL;
     ws->conn_lent = 0;
 }
 
-void getme__ws_store(const getme_ws *ws, getme_mesh *mesh)
+/* Entries in ws->star. */
+static int64_t star_total(const getme_ws *ws)
 {
+    return ws->coff[GETME_NUM_TYPES - 1] +
+           (int64_t)(ws->tstart[GETME_NUM_TYPES] -
+                     ws->tstart[GETME_NUM_TYPES - 1]) *
+               getme__nv[GETME_NUM_TYPES - 1];
+}
+
+void getme__ws_pack_map(getme_ws *ws)
+{
+    if (ws->maps_packed || !ws->star || ws->ho ||
+        star_total(ws) < (int64_t)ws->ne + ws->nn)
+        return; /* no room to unpack both without allocating */
+    if (!getme__pack(&ws->elem_packed, ws->elem_orig, ws->ne))
+        return;
+    if (!getme__pack(&ws->node_packed, ws->node_orig, ws->nn)) {
+        getme__packed_free(&ws->elem_packed);
+        return;
+    }
+    free(ws->elem_orig), free(ws->node_orig);
+    ws->elem_orig = ws->node_orig = NULL;
+    ws->maps_packed = 1;
+}
+
+void getme__ws_unpack_map(getme_ws *ws)
+{
+    if (ws->maps_packed != 1)
+        return;
+    getme__unpack(&ws->elem_packed, ws->star);
+    getme__unpack(&ws->node_packed, ws->star + ws->ne);
+    ws->elem_orig = ws->star; /* one block: getme__ws_free frees it */
+    ws->node_orig = ws->star + ws->ne;
+    ws->star = NULL;
+    ws->maps_packed = 2;
+}
+
+void getme__ws_lend_x(getme_ws *ws, getme_mesh *mesh)
+{
+    if (!mesh->lend_coords || ws->ho || mesh->ho || ws->x_lent)
+        return;
+    free(mesh->coords);
+    mesh->coords = NULL;
+    ws->x_lent = 1;
+}
+
+void getme__ws_return_x(getme_ws *ws, getme_mesh *mesh)
+{
+    if (!ws->x_lent)
+        return;
+    getme__mesh_drop_ws(mesh); /* its order was made for the old coordinates */
+    if (mesh->mirror == 1) /* negating twice is exact: fixed nodes keep
+                              their bits */
+#pragma omp parallel for schedule(static) num_threads(ws->nt)
+        for (int32_t i = 0; i < ws->nn; i++)
+            ws->x[3 * (int64_t)i + 1] = -ws->x[3 * (int64_t)i + 1];
+    permute_rows(ws->x, 3 * sizeof *ws->x, ws->node_orig, ws->nn);
+    mesh->coords = ws->x;
+    ws->x = NULL;
+    ws->x_lent = 0;
+}
+
+void getme__ws_store(getme_ws *ws, getme_mesh *mesh)
+{
+    if (ws->x_lent) {
+        getme__ws_return_x(ws, mesh);
+        return;
+    }
     getme__mesh_drop_ws(mesh); /* its order was made for the old coordinates */
     double ysign = mesh->mirror == 1 ? -1.0 : 1.0;
     for (int32_t i = 0; i < ws->nn; i++) {

@@ -18,6 +18,7 @@
 #define GETME_WORKSPACE_H
 
 #include "highorder.h"
+#include "pack.h"
 
 #include <stdint.h>
 
@@ -37,7 +38,9 @@ typedef struct getme_ws {
     uint8_t *free_elem;  /* ne, 1 = has at least one free node              */
     int32_t num_free_elem;
     int32_t num_free_nodes; /* free nodes used by at least one element       */
-    int64_t *star_ptr;   /* nn + 1                                           */
+    int32_t *star_ptr;   /* nn + 1; 32-bit: the stars hold every element's
+                            nodes, so fewer than 2^31 entries (the build
+                            fails with GETME_ERR_NOMEM beyond)              */
     int32_t *star;       /* incident elements of each node, ascending       */
     int32_t max_star;    /* largest star                                     */
     /* colour-blocks */
@@ -51,6 +54,13 @@ typedef struct getme_ws {
     getme_ho_ws *ho;      /* second-order elements' dependent nodes, or NULL */
     int conn_lent;        /* the mesh's block lent its connectivity
                              (getme__ws_lend_conn)                          */
+    int x_lent;           /* the mesh lent its coordinates (getme__ws_lend_x)
+                                                                            */
+    /* elem_orig and node_orig while packed (getme__ws_pack_map), both then
+       NULL; maps_packed: 0 never, 1 packed, 2 unpacked into ws->star's
+       block (node_orig then points inside it, after elem_orig)            */
+    getme_packed elem_packed, node_packed;
+    int maps_packed;
     int32_t *faces;       /* the face table (getme__ws_faces) the boundary
                              search computed, for getme__adj_build to take
                              over, or NULL                                  */
@@ -77,6 +87,23 @@ void getme__ws_keep(getme_ws *ws, getme_mesh *mesh);
 void getme__ws_lend_conn(getme_ws *ws, getme_mesh *mesh);
 void getme__ws_return_conn(getme_ws *ws, getme_mesh *mesh);
 
+/* The same for the coordinates, if the caller allowed it
+   (getme_mesh_lend_coords; first-order meshes): the mesh frees its array
+   (24 B per node) and getme__ws_return_x makes ws->x, put back in the
+   caller's order (in place), the mesh's array.  The smoother calls it once
+   the input is checked, so only a failure in the loop itself (out of
+   memory) leaves the mesh partly smoothed. */
+void getme__ws_lend_x(getme_ws *ws, getme_mesh *mesh);
+void getme__ws_return_x(getme_ws *ws, getme_mesh *mesh);
+
+/* During getme_smooth's loop nothing reads elem_orig and node_orig: they
+   are held packed (pack.h; tets 1.5 B per element and per node less).
+   getme__ws_unpack_map writes them back into the stars' array, which must
+   no longer be needed (ws->star becomes NULL; no allocation, so it cannot
+   fail; packing is skipped unless the stars have room for both). */
+void getme__ws_pack_map(getme_ws *ws);
+void getme__ws_unpack_map(getme_ws *ws);
+
 /* The 30-bit Morton key the element order uses (renumber = 1): each
    coordinate's (x - lo) * scale clamped to [0, 1023] and truncated, its
    bits spread to every third bit from bit d (scale = 1023 / extent, 0 for
@@ -84,8 +111,9 @@ void getme__ws_return_conn(getme_ws *ws, getme_mesh *mesh);
 uint32_t getme__morton(const double *x, const double lo[3],
                        const double scale[3]);
 
-/* Write the workspace coordinates back to the mesh (undoing mirror/order). */
-void getme__ws_store(const getme_ws *ws, getme_mesh *mesh);
+/* Write the workspace coordinates back to the mesh (undoing mirror/order);
+   lent coordinates are returned (getme__ws_return_x). */
+void getme__ws_store(getme_ws *ws, getme_mesh *mesh);
 
 static inline int getme__ws_type(const getme_ws *ws, int32_t e)
 {

@@ -68,6 +68,8 @@ int getme__msh_header(const char *path, double *version, int *binary);
 typedef struct getme__nodemap {
     uint64_t max_tag;
     int32_t *dense;       /* max_tag + 1 entries (-1: absent), or NULL  */
+    int ordered;          /* tags 1..n in order: tag t is index t - 1 and
+                             no table is kept (4 B per node less)          */
     uint64_t *sorted_tag; /* sparse numbering: sorted tags...           */
     int32_t *sorted_idx;  /* ... and their indices                      */
     size_t n;
@@ -79,7 +81,8 @@ getme_status getme__nodemap_build(getme__nodemap *map, const uint64_t *tags,
                                   size_t n, uint64_t *repeated);
 /* Index of tag, -1 if absent. */
 int32_t getme__nodemap_find(const getme__nodemap *map, uint64_t tag);
-/* Every stored index i becomes loc[i] (a renumbering). */
+/* Every stored index i becomes loc[i] (a renumbering); once per map, as
+   it may drop the table (ordered). */
 void getme__nodemap_relabel(getme__nodemap *map, const int32_t *loc);
 void getme__nodemap_free(getme__nodemap *map);
 

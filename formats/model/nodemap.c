@@ -5,7 +5,11 @@
  * from a file may use any positive tags.  A direct table is the fastest
  * lookup and costs 4 bytes per possible tag, so it is used while the tags
  * are dense enough (the largest within about twice the node count);
- * otherwise the tags are sorted once and looked up by bisection.
+ * otherwise the tags are sorted once and looked up by bisection.  When the
+ * table says tag t is node t - 1 for every t once the nodes are numbered
+ * (getme__nodemap_relabel; Gmsh's own numbering read back), it is dropped
+ * and the index computed: it would stay alive, 4 B per node, through the
+ * whole smoothing run.
  */
 #include "model.h"
 
@@ -51,6 +55,19 @@ static getme_status build_sorted(getme__nodemap *map, const uint64_t *tags,
     return st;
 }
 
+/* Drop a dense table that maps every tag t in 1..n to t - 1. */
+static void drop_if_ordered(getme__nodemap *map)
+{
+    if (!map->dense || map->max_tag != map->n || map->dense[0] != -1)
+        return;
+    for (uint64_t t = 1; t <= map->max_tag; t++)
+        if (map->dense[t] != (int32_t)(t - 1))
+            return;
+    free(map->dense);
+    map->dense = NULL;
+    map->ordered = 1;
+}
+
 getme_status getme__nodemap_build(getme__nodemap *map, const uint64_t *tags,
                                   size_t n, uint64_t *repeated)
 {
@@ -77,6 +94,8 @@ getme_status getme__nodemap_build(getme__nodemap *map, const uint64_t *tags,
 
 int32_t getme__nodemap_find(const getme__nodemap *map, uint64_t tag)
 {
+    if (map->ordered)
+        return tag >= 1 && tag <= map->max_tag ? (int32_t)(tag - 1) : -1;
     if (map->dense)
         return tag <= map->max_tag ? map->dense[tag] : -1;
     size_t lo = 0, hi = map->n;
@@ -97,6 +116,7 @@ void getme__nodemap_relabel(getme__nodemap *map, const int32_t *loc)
         for (uint64_t t = 0; t <= map->max_tag; t++)
             if (map->dense[t] >= 0)
                 map->dense[t] = loc[map->dense[t]];
+        drop_if_ordered(map);
         return;
     }
     for (size_t i = 0; i < map->n; i++)

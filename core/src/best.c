@@ -1,0 +1,121 @@
+/*
+ * best.c -- keep_best's best mesh as an undo log (best.h says why).
+ */
+#include "best.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static size_t coord_bytes(const getme_ws *ws)
+{
+    return (size_t)(ws->nn ? ws->nn : 1) * 3 * sizeof(double);
+}
+
+getme_status getme__best_init(getme_best *b, const getme_run *run, int on)
+{
+    memset(b, 0, sizeof *b);
+    b->on = on;
+    if (!on)
+        return GETME_OK;
+    const getme_ws *ws = run->ws;
+    if (run->comm) {
+        b->whole = malloc(coord_bytes(ws));
+        return b->whole ? GETME_OK : GETME_ERR_NOMEM;
+    }
+    b->seen = calloc(((size_t)ws->nn + 63) / 64 + 1, sizeof *b->seen);
+    return b->seen ? GETME_OK : GETME_ERR_NOMEM;
+}
+
+void getme__best_take(getme_best *b, const getme_ws *ws)
+{
+    if (!b->on)
+        return;
+    if (b->whole) {
+        memcpy(b->whole, ws->x, (size_t)ws->nn * 3 * sizeof *b->whole);
+        return;
+    }
+    for (int64_t k = 0; k < b->n; k++) /* the log starts again, empty */
+        b->seen[b->node[k] >> 6] &= ~((uint64_t)1 << (b->node[k] & 63));
+    b->n = 0;
+}
+
+/* The log becomes a whole copy: the current coordinates with the logged
+   ones put back.  0, or -1 if out of memory (the log stays). */
+static int to_whole(getme_best *b, const getme_ws *ws)
+{
+    b->whole = malloc(coord_bytes(ws));
+    if (!b->whole)
+        return -1;
+    memcpy(b->whole, ws->x, (size_t)ws->nn * 3 * sizeof *b->whole);
+    for (int64_t k = 0; k < b->n; k++)
+        memcpy(b->whole + 3 * (int64_t)b->node[k], b->x + 3 * k,
+               3 * sizeof *b->x);
+    free(b->seen), free(b->node), free(b->x);
+    b->seen = NULL, b->node = NULL, b->x = NULL;
+    b->n = b->cap = 0;
+    return 0;
+}
+
+/* Room for n more entries in the log. */
+static int reserve(getme_best *b, int64_t more)
+{
+    if (b->n + more <= b->cap)
+        return 0;
+    int64_t cap = b->n + more > 2 * b->cap ? b->n + more : 2 * b->cap;
+    cap = cap < 1024 ? 1024 : cap;
+    int32_t *node = realloc(b->node, (size_t)cap * sizeof *node);
+    if (!node)
+        return -1;
+    b->node = node;
+    double *x = realloc(b->x, (size_t)cap * 3 * sizeof *x);
+    if (!x)
+        return -1;
+    b->x = x;
+    b->cap = cap;
+    return 0;
+}
+
+getme_status getme__best_note(getme_best *b, const getme_run *run)
+{
+    if (!b->on || b->whole)
+        return GETME_OK;
+    const getme_ws *ws = run->ws;
+    for (int32_t k = 0; k < run->num_t; k++) {
+        int32_t e = run->tlist[k];
+        int t = getme__ws_type(ws, e);
+        const int32_t *c = getme__ws_nodes(ws, t, e);
+        int nv = getme__nv[t];
+        if (reserve(b, nv) != 0)
+            return to_whole(b, ws) == 0 ? GETME_OK : GETME_ERR_NOMEM;
+        for (int i = 0; i < nv; i++) {
+            int32_t u = c[i];
+            uint64_t bit = (uint64_t)1 << (u & 63);
+            if (ws->fixed[u] || (b->seen[u >> 6] & bit))
+                continue;
+            b->seen[u >> 6] |= bit;
+            b->node[b->n] = u;
+            memcpy(b->x + 3 * b->n, ws->x + 3 * (int64_t)u, 3 * sizeof *b->x);
+            b->n++;
+        }
+        if (b->n > ws->nn / 4) /* no longer smaller than a whole copy */
+            return to_whole(b, ws) == 0 ? GETME_OK : GETME_ERR_NOMEM;
+    }
+    return GETME_OK;
+}
+
+void getme__best_restore(getme_best *b, getme_ws *ws)
+{
+    if (b->whole) {
+        memcpy(ws->x, b->whole, (size_t)ws->nn * 3 * sizeof *ws->x);
+        return;
+    }
+    for (int64_t k = 0; k < b->n; k++)
+        memcpy(ws->x + 3 * (int64_t)b->node[k], b->x + 3 * k,
+               3 * sizeof *b->x);
+}
+
+void getme__best_free(getme_best *b)
+{
+    free(b->whole), free(b->seen), free(b->node), free(b->x);
+    memset(b, 0, sizeof *b);
+}
