@@ -102,6 +102,25 @@ static inline int32_t getme__adj_edge(const getme_adj *adj, const int32_t *c,
     return adj->eptr[a < b ? a : b] + slot;
 }
 
+/* Add d to the S_v of element e's nodes and the S_e of its edges (type
+   t; nodes c), in wrapping uint64 arithmetic: d is an element's
+   fixed-point quality, or the difference of its new and old ones, which
+   gives the same bits as a recomputation (the sums are exact). */
+static inline void getme__adj_add(getme_adj *adj, const getme_ws *ws, int t,
+                                  int32_t e, const int32_t *c, uint64_t d)
+{
+    for (int i = 0; i < getme__nv[t]; i++)
+        adj->nsum[c[i]] = (int64_t)((uint64_t)adj->nsum[c[i]] + d);
+    if (ws->dim != 3)
+        return; /* planar: no edge sums (and no edge arrays) */
+    const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
+    for (int j = 0; j < getme__edges[t].num_edges; j++)
+        if (slot[j] != GETME_NO_SLOT) {
+            int64_t *s = &adj->esum[getme__adj_edge(adj, c, t, j, slot[j])];
+            *s = (int64_t)((uint64_t)*s + d);
+        }
+}
+
 /* Sum of q over N(e) for a regular element e of type t (see above), as
    the nearest double to the exact sum of the fixed-point qualities: the
    inclusion-exclusion is exact in integers, so it equals the union walk's

@@ -23,6 +23,9 @@ void getme__blocks_free(getme_blocks *blk)
     free(blk->nptr);
     free(blk->nodes);
     free(blk->lconn);
+    free(blk->order);
+    free(blk->part_ptr);
+    free(blk->col_ptr);
     memset(blk, 0, sizeof *blk);
 }
 
@@ -87,6 +90,79 @@ static getme_status alloc_scratch(getme_blocks *blk, int nt)
     return GETME_OK;
 }
 
+/* The visiting order (block_local.h), from the blocks' node lists; part[]
+   has room for ws->nn entries (scratch).  Block b is in part
+   b * num_parts / num_blocks. */
+static getme_status build_order(getme_blocks *blk, const getme_ws *ws,
+                                int32_t *part)
+{
+    int np = ws->nt > 0 ? ws->nt : 1;
+    int32_t nb = ws->num_blocks;
+    blk->num_parts = np;
+    blk->order = malloc((size_t)(nb ? nb : 1) * sizeof *blk->order);
+    blk->part_ptr = calloc((size_t)np + 1, sizeof *blk->part_ptr);
+    blk->col_ptr = calloc((size_t)ws->num_colours + 1, sizeof *blk->col_ptr);
+    uint8_t *inner = malloc((size_t)(nb ? nb : 1));
+    if (!blk->order || !blk->part_ptr || !blk->col_ptr || !inner) {
+        free(inner);
+        return GETME_ERR_NOMEM;
+    }
+    /* part[n]: the one part whose blocks use node n, or -2 if several. */
+    for (int32_t n = 0; n < ws->nn; n++)
+        part[n] = -1;
+    for (int32_t b = 0; b < nb; b++) {
+        int32_t p = (int32_t)((int64_t)b * np / nb);
+        for (int64_t k = blk->nptr[b]; k < blk->nptr[b + 1]; k++) {
+            int32_t n = blk->nodes[k];
+            part[n] = part[n] == -1 || part[n] == p ? p : -2;
+        }
+    }
+    int32_t m = 0;
+    for (int32_t b = 0; b < nb; b++) {
+        int32_t p = (int32_t)((int64_t)b * np / nb);
+        inner[b] = 1;
+        for (int64_t k = blk->nptr[b]; inner[b] && k < blk->nptr[b + 1]; k++)
+            inner[b] = part[blk->nodes[k]] == p;
+        if (inner[b]) {
+            blk->order[m++] = b;
+            blk->part_ptr[p + 1] = m;
+        }
+    }
+    for (int p = 0; p < np; p++) /* parts without interior blocks */
+        if (blk->part_ptr[p + 1] < blk->part_ptr[p])
+            blk->part_ptr[p + 1] = blk->part_ptr[p];
+    for (int c = 0; c < ws->num_colours; c++) {
+        blk->col_ptr[c] = m;
+        for (int32_t k = ws->colour_ptr[c]; k < ws->colour_ptr[c + 1]; k++)
+            if (!inner[ws->colour_blocks[k]])
+                blk->order[m++] = ws->colour_blocks[k];
+    }
+    blk->col_ptr[ws->num_colours] = m;
+    free(inner);
+    return GETME_OK;
+}
+
+int64_t getme__blocks_run(const getme_blocks *blk, const getme_ws *ws,
+                          int64_t (*f)(void *ctx, int32_t b), void *ctx)
+{
+    int64_t total = 0;
+    int np = blk->num_parts;
+#pragma omp parallel for schedule(static, 1) num_threads(np) \
+    reduction(+ : total) if (np > 1)
+    for (int p = 0; p < np; p++)
+        for (int32_t k = blk->part_ptr[p]; k < blk->part_ptr[p + 1]; k++)
+            total += f(ctx, blk->order[k]);
+    for (int c = 0; c < ws->num_colours; c++) {
+        int32_t k0 = blk->col_ptr[c], k1 = blk->col_ptr[c + 1];
+        int nt = c == ws->serial_colour ? 1 : ws->nt;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(nt) \
+    reduction(+ : total) if (k1 - k0 > 1)
+        for (int32_t k = k0; k < k1; k++)
+            total += f(ctx, blk->order[k]);
+    }
+    return total;
+}
+
 getme_status getme__blocks_build(getme_blocks *blk, const getme_ws *ws)
 {
     memset(blk, 0, sizeof *blk);
@@ -138,7 +214,7 @@ getme_status getme__blocks_build(getme_blocks *blk, const getme_ws *ws)
         block_nodes(ws, b, mark + o, local + o, blk->nodes + blk->nptr[b],
                     blk->lconn);
     }
-    st = GETME_OK;
+    st = build_order(blk, ws, mark);
 done:
     free(mark);
     free(local);

@@ -273,29 +273,28 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
     *ovf |= o;
 }
 
-/* q_mean stage: every free element is transformed.  Blocks run colour by
-   colour: blocks of one colour share no node, so they scatter without
-   atomics; the sums are exact (exact.h), so their order does not matter. */
-static int32_t scatter_all(getme_run *run, double sigma)
+/* One block of scatter_all: the number of elements transformed, plus
+   2^32 on a bound overflow (add_sum). */
+static int64_t scatter_block(void *ctx, int32_t b)
 {
+    getme_run *run = ctx;
     const getme_ws *ws = run->ws;
-    int32_t total = 0;
-    for (int c = 0; c < ws->num_colours; c++) {
-        int32_t b0 = ws->colour_ptr[c], b1 = ws->colour_ptr[c + 1];
-        int nt = c == ws->serial_colour ? 1 : ws->nt;
-        int32_t count = 0;
-        int ovf = 0;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(nt) \
-    reduction(+ : count) reduction(| : ovf)
-        for (int32_t k = b0; k < b1; k++) {
-            int32_t b = ws->colour_blocks[k];
-            GETME_FOR_TYPE(getme__ws_type(ws, ws->block_start[b]),
-                           transform_block, run, b, sigma, &count, &ovf);
-        }
-        total += count;
-        run->overflow |= ovf;
-    }
-    return total;
+    int32_t count = 0;
+    int ovf = 0;
+    GETME_FOR_TYPE(getme__ws_type(ws, ws->block_start[b]), transform_block,
+                   run, b, run->params->sigma, &count, &ovf);
+    return count + ((int64_t)(ovf != 0) << 32);
+}
+
+/* q_mean stage: every free element is transformed, block by block in the
+   blocks' race-free order (block_local.h): blocks that run at the same
+   time share no node, so they scatter without atomics; the sums are exact
+   (exact.h), so their order does not matter. */
+static int32_t scatter_all(getme_run *run)
+{
+    int64_t r = getme__blocks_run(&run->adj->blk, run->ws, scatter_block, run);
+    run->overflow |= (r >> 32) != 0;
+    return (int32_t)(r & 0xffffffff);
 }
 
 /* The q_mean stage's I_T (every free node in use) and element list (every
@@ -406,18 +405,7 @@ static getme_status update_after(getme_run *run, double qt)
         uint64_t d = (uint64_t)getme__fx64(run->q[e], adj->qscale) -
                      (uint64_t)getme__fx64(run->qold[k], adj->qscale);
         int t = getme__ws_type(ws, e);
-        const int32_t *c = getme__ws_nodes(ws, t, e);
-        for (int i = 0; i < getme__nv[t]; i++)
-            adj->nsum[c[i]] = (int64_t)((uint64_t)adj->nsum[c[i]] + d);
-        if (ws->dim == 3) {
-            const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
-            for (int j = 0; j < getme__edges[t].num_edges; j++)
-                if (slot[j] != GETME_NO_SLOT) {
-                    int64_t *s =
-                        &adj->esum[getme__adj_edge(adj, c, t, j, slot[j])];
-                    *s = (int64_t)((uint64_t)*s + d);
-                }
-        }
+        getme__adj_add(adj, ws, t, e, getme__ws_nodes(ws, t, e), d);
     }
 
     /* distributed: every process stops if one has no room (else the
@@ -577,12 +565,13 @@ static getme_status iterate(getme_run *run, int mean_stage, double qt,
                             int32_t *num_transformed, int32_t *num_relaxed)
 {
     double sigma = run->params->sigma;
-    if (mean_stage)
-        getme__adj_sums_all(run->adj, run->ws, run->q);
+    /* The q_mean stage's relaxation keeps the Eq. 9 sums at run->q (relax.c);
+       in the q*_min stage update_after brings them up to date. */
+    run->live = mean_stage ? run->adj : NULL;
     for (;;) {
         set_scales(run, q_lo);
         run->overflow = 0;
-        *num_transformed = mean_stage ? scatter_all(run, sigma)
+        *num_transformed = mean_stage ? scatter_all(run)
                                       : scatter_some(run, qt, sigma);
         if (!getme__dist_any(run, run->overflow))
             break;
@@ -604,6 +593,7 @@ static getme_status iterate(getme_run *run, int mean_stage, double qt,
             run->qold[k] = run->q[run->elems[k]];
     }
     *num_relaxed = getme__relax(run, R, nR);
+    run->live = NULL;
     if (run->comm) { /* counts of the whole mesh, each node once */
         int64_t c[2] = {*num_transformed, 0};
         for (int32_t k = 0; k < run->num_nodes; k++)
@@ -810,6 +800,9 @@ getme_status getme__adaptive(getme_run *run)
     }
     lists_all(run);
     set_bounds(run);
+    /* The Eq. 9 sums at the input's qualities; from here on every change of
+       run->q updates them (the relaxation, update_after). */
+    getme__adj_sums_all(run->adj, ws, run->q);
     run->guard = p->corner_guard;
     set_corner_floor(run, p->corner_floor > res->corner_sj_initial
                               ? p->corner_floor
