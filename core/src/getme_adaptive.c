@@ -157,30 +157,12 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
     /* The weights first, in a loop of loads with little arithmetic, so the
        out-of-order core keeps the scattered ones (face neighbours' q, S_e)
        of several elements in flight; -1 marks an element not transformed
-       (a weight is >= 0). */
+       (a weight is >= 0).  No software prefetch: since the blocks run in
+       element order (block_local.h) their data is mostly in cache, and the
+       prefetches' own address loads (eptr, fnb 8 elements ahead) cost
+       14 % of the scatter (perf, 1M tets, one thread). */
     int64_t *wfs = scr->wf;
     for (int32_t e = e0; e < e1; e++) {
-        /* Prefetch the scattered inputs of the weight PREFETCH_AHEAD
-           elements on: the face neighbours' q and S_e (their misses were
-           most of this loop's samples, perf annotate).  Written inline:
-           gcc deems a function of prefetches only free of side effects
-           and deletes its calls. */
-        if (e + PREFETCH_AHEAD < e1) {
-            int32_t ep = e + PREFETCH_AHEAD;
-            const int32_t *f = getme__adj_faces(adj, ws, t, ep);
-            for (int k = 0; k < getme__faces[t].num_faces; k++)
-                if (f[k] >= 0)
-                    __builtin_prefetch(run->q + f[k], 0, 3);
-            if (ws->dim == 3) {
-                const int32_t *c = getme__ws_nodes(ws, t, ep);
-                const uint8_t *slot = getme__adj_slots(adj, ws, t, ep);
-                for (int k = 0; k < getme__edges[t].num_edges; k++)
-                    if (slot[k] != GETME_NO_SLOT) /* else: irregular */
-                        __builtin_prefetch(
-                            adj->esum + getme__adj_edge(adj, c, t, k, slot[k]),
-                            0, 3);
-            }
-        }
         int64_t wf = -1;
         if (ws->free_elem[e] && getme__owned(run, e)) {
             double w;
