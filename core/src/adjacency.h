@@ -73,8 +73,11 @@ typedef struct getme_adj {
 getme_status getme__adj_build(getme_adj *adj, getme_ws *ws);
 void getme__adj_free(getme_adj *adj);
 
-/* S_v and S_e of every node and edge from q: a colour-ordered scatter, so
-   sums are added in an order independent of the thread count. */
+/* S_v and S_e of every node and edge from q, in the blocks' race-free
+   order (block_local.h); integer sums, so the order does not matter.
+   GETMe adaptive calls it once per run (and at a q*_min cycle's start):
+   from then on every change of a quality moves the sums by its exact
+   difference (getme__adj_add; relax.c, update_after). */
 void getme__adj_sums_all(getme_adj *adj, const getme_ws *ws, const double *q);
 
 /* The edge slots of element e (type t): getme__edges[t].num_edges. */

@@ -10,7 +10,8 @@
  * each local sum to its node once replaces ~2000 read-modify-writes of
  * 64-byte node sums at scattered addresses by ~200; the same for the
  * coordinates the block reads and the S_v sums of its weights.  Blocks of
- * one colour share no node, so the per-node additions need no atomics, and
+ * one colour share no node (nor do blocks run at the same time in the
+ * order below), so the per-node additions need no atomics, and
  * the sums are exact integers (exact.h), so their order does not matter:
  * the result stays the same bits for any thread count.
  *
@@ -29,9 +30,9 @@
  * thread runs its part's interior blocks in element order (no two parts'
  * interior blocks share a node).  The blocks left (the parts' interfaces:
  * ~30 % of the 1M tets' blocks with 2 parts) are dealt into parts again
- * along the interfaces, twice, and the few left after that run colour by
- * colour as before.  Any race-free order gives the same bits: the sums are exact
- * integers (exact.h) and every other result is per element.
+ * by position across the interfaces, twice, and the few left after that run colour by
+ * colour as before.  Any race-free order gives the same bits: the sums are
+ * exact integers (exact.h) and every other result is per element.
  */
 #ifndef GETME_BLOCK_LOCAL_H
 #define GETME_BLOCK_LOCAL_H
