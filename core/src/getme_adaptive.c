@@ -537,6 +537,29 @@ static void qold_reserve(getme_run *run)
         run->cap_qold = 0;
 }
 
+#ifdef GETME_CHECK_SUMS
+/* Test builds (tests/core): are the Eq. 9 sums, kept up to date by exact
+   differences as qualities change, the bits a recomputation gives?
+   (recomputes them, which gives the same bits when they are) */
+static int sums_current(getme_run *run)
+{
+    getme_adj *adj = run->adj;
+    size_t nb = (size_t)run->ws->nn * sizeof *adj->nsum;
+    size_t eb = (size_t)adj->num_edges * sizeof *adj->esum;
+    int64_t *n = malloc(nb ? nb : 1), *e = malloc(eb ? eb : 1);
+    int same = n && e;
+    if (same) {
+        memcpy(n, adj->nsum, nb);
+        if (eb)
+            memcpy(e, adj->esum, eb);
+        getme__adj_sums_all(adj, run->ws, run->q);
+        same = memcmp(n, adj->nsum, nb) == 0 && (!eb || memcmp(e, adj->esum, eb) == 0);
+    }
+    free(n), free(e);
+    return same;
+}
+#endif
+
 /* One iteration of the main loop (Fig. 3 lines 5-9).  mean_stage: the
    q_mean stage, where every free element is transformed over the lists
    lists_all() built; otherwise the elements with q <= qt (run->tlist).
@@ -585,7 +608,12 @@ static getme_status iterate(getme_run *run, int mean_stage, double qt,
         *num_relaxed = (int32_t)c[1];
     }
     getme__reset_nodes(run);
-    return mean_stage ? GETME_OK : update_after(run, qt);
+    getme_status st = mean_stage ? GETME_OK : update_after(run, qt);
+#ifdef GETME_CHECK_SUMS
+    if (st == GETME_OK && !sums_current(run))
+        st = GETME_ERR_STATE;
+#endif
+    return st;
 }
 
 /* Swap a <= b for quickselect. */

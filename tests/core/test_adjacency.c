@@ -302,6 +302,49 @@ static void check_block_order(void)
     free_gen(&g);
 }
 
+/* GETMe adaptive on a 24^3 Kuhn grid distorted like the benchmark meshes
+   (getme_mesh_distort to q_mean 0.45), 1 and 2 threads: this
+   test is built with GETME_CHECK_SUMS, so every iteration compares the
+   Eq. 9 sums it keeps by differences (relaxation, update_after) with a
+   recomputation and fails with GETME_ERR_STATE if they differ.  The
+   q_mean stage's relaxation steps nodes back (num_relaxed > 0), so the
+   corrections after its first trial pass run (without them: status 5). */
+static int count_relaxed(const getme_progress *pr, void *data)
+{
+    if (pr->stage == GETME_STAGE_MEAN)
+        *(int64_t *)data += pr->num_relaxed;
+    return 0;
+}
+
+static void check_live_sums(void)
+{
+    N = 24;
+    gen g = make("tet");
+    N = 5;
+    double q_mean[3];
+    for (int nt = 1; nt <= 2; nt++) {
+        getme_mesh *mesh = to_mesh(&g);
+        CHECK(getme_mesh_fix_boundary(mesh, GETME_FIX_SKIN, NULL) == GETME_OK);
+        /* as the benchmark meshes: q_mean down to 0.45 */
+        CHECK(getme_mesh_distort(mesh, 1, 0.5, 0.45, 200) == GETME_OK);
+        getme_params p;
+        getme_params_init(&p);
+        p.num_threads = nt;
+        int64_t relaxed = 0;
+        p.progress = count_relaxed;
+        p.progress_data = &relaxed;
+        getme_result r;
+        CHECK_EQ_INT(getme_smooth(mesh, &p, &r), GETME_OK);
+        CHECK(relaxed > 0); /* the step corrections ran */
+        CHECK(r.iterations_mean >= 3 && r.iterations_min >= 1);
+        CHECK(r.q_mean > r.q_mean_initial);
+        q_mean[nt] = r.q_mean;
+        getme_mesh_free(mesh);
+    }
+    CHECK(memcmp(&q_mean[1], &q_mean[2], sizeof *q_mean) == 0);
+    free_gen(&g);
+}
+
 /* Build ws + adj for g with nt threads; check every regular element's
    formula sum and count against the brute force; return the irregular
    flags (caller frees) in ws element order, and the ws (caller frees). */
@@ -437,5 +480,6 @@ int main(void)
         check_conforming(kinds[i]);
     check_nonconforming();
     check_block_order();
+    check_live_sums();
     return check_summary("test_adjacency");
 }
