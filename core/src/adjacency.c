@@ -345,29 +345,28 @@ fail:
     return st;
 }
 
-/* S_v and S_e contributions of the elements [e0, e1), all of type t (a
+/* S_v and S_e contributions of the elements of block b, all of type t (a
    constant in each copy, see GETME_FOR_TYPE). */
 static inline void add_block_sums(int t, getme_adj *adj, const getme_ws *ws,
-                                  const double *q, int32_t e0, int32_t e1)
+                                  const double *q, int32_t b)
 {
-    int nv = getme__nv[t];
-    int ned = ws->dim == 3 ? getme__edges[t].num_edges : 0;
-    for (int32_t e = e0; e < e1; e++) {
-        /* uint64: wrap-around is defined; the true sums fit (adjacency.h) */
-        uint64_t v = (uint64_t)getme__fx64(q[e], adj->qscale);
-        const int32_t *c = getme__ws_nodes(ws, t, e);
-        for (int i = 0; i < nv; i++)
-            adj->nsum[c[i]] = (int64_t)((uint64_t)adj->nsum[c[i]] + v);
-        if (ned == 0)
-            continue; /* planar: no edge sums (and no edge arrays) */
-        const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
-        for (int j = 0; j < ned; j++)
-            if (slot[j] != GETME_NO_SLOT)
-            {
-                int64_t *d = &adj->esum[getme__adj_edge(adj, c, t, j, slot[j])];
-                *d = (int64_t)((uint64_t)*d + v);
-            }
-    }
+    for (int32_t e = ws->block_start[b]; e < ws->block_start[b + 1]; e++)
+        getme__adj_add(adj, ws, t, e, getme__ws_nodes(ws, t, e),
+                       (uint64_t)getme__fx64(q[e], adj->qscale));
+}
+
+typedef struct sums_pass {
+    getme_adj *adj;
+    const getme_ws *ws;
+    const double *q;
+} sums_pass;
+
+static int64_t sums_block(void *ctx, int32_t b)
+{
+    sums_pass *p = ctx;
+    GETME_FOR_TYPE(getme__ws_type(p->ws, p->ws->block_start[b]),
+                   add_block_sums, p->adj, p->ws, p->q, b);
+    return 0;
 }
 
 void getme__adj_sums_all(getme_adj *adj, const getme_ws *ws, const double *q)
@@ -375,16 +374,8 @@ void getme__adj_sums_all(getme_adj *adj, const getme_ws *ws, const double *q)
     memset(adj->nsum, 0, (size_t)ws->nn * sizeof *adj->nsum);
     if (adj->esum)
         memset(adj->esum, 0, (size_t)adj->num_edges * sizeof *adj->esum);
-    /* Blocks of one colour share no node, hence no edge: no atomics, and a
-       node's sum is added colour by colour whatever the thread count. */
-    for (int col = 0; col < ws->num_colours; col++) {
-        int32_t b0 = ws->colour_ptr[col], b1 = ws->colour_ptr[col + 1];
-        int nt = col == ws->serial_colour ? 1 : ws->nt;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(nt)
-        for (int32_t k = b0; k < b1; k++) {
-            int32_t b = ws->colour_blocks[k];
-            GETME_FOR_TYPE(getme__ws_type(ws, ws->block_start[b]), add_block_sums,
-                           adj, ws, q, ws->block_start[b], ws->block_start[b + 1]);
-        }
-    }
+    /* In the blocks' race-free order (block_local.h): no atomics, and the
+       integer sums are the same whatever the order. */
+    sums_pass p = {adj, ws, q};
+    getme__blocks_run(&adj->blk, ws, sums_block, &p);
 }

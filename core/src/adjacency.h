@@ -73,8 +73,11 @@ typedef struct getme_adj {
 getme_status getme__adj_build(getme_adj *adj, getme_ws *ws);
 void getme__adj_free(getme_adj *adj);
 
-/* S_v and S_e of every node and edge from q: a colour-ordered scatter, so
-   sums are added in an order independent of the thread count. */
+/* S_v and S_e of every node and edge from q, in the blocks' race-free
+   order (block_local.h); integer sums, so the order does not matter.
+   GETMe adaptive calls it once per run (and at a q*_min cycle's start):
+   from then on every change of a quality moves the sums by its exact
+   difference (getme__adj_add; relax.c, update_after). */
 void getme__adj_sums_all(getme_adj *adj, const getme_ws *ws, const double *q);
 
 /* The edge slots of element e (type t): getme__edges[t].num_edges. */
@@ -100,6 +103,25 @@ static inline int32_t getme__adj_edge(const getme_adj *adj, const int32_t *c,
 {
     int32_t a = c[getme__edges[t].node[j][0]], b = c[getme__edges[t].node[j][1]];
     return adj->eptr[a < b ? a : b] + slot;
+}
+
+/* Add d to the S_v of element e's nodes and the S_e of its edges (type
+   t; nodes c), in wrapping uint64 arithmetic: d is an element's
+   fixed-point quality, or the difference of its new and old ones, which
+   gives the same bits as a recomputation (the sums are exact). */
+static inline void getme__adj_add(getme_adj *adj, const getme_ws *ws, int t,
+                                  int32_t e, const int32_t *c, uint64_t d)
+{
+    for (int i = 0; i < getme__nv[t]; i++)
+        adj->nsum[c[i]] = (int64_t)((uint64_t)adj->nsum[c[i]] + d);
+    if (ws->dim != 3)
+        return; /* planar: no edge sums (and no edge arrays) */
+    const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
+    for (int j = 0; j < getme__edges[t].num_edges; j++)
+        if (slot[j] != GETME_NO_SLOT) {
+            int64_t *s = &adj->esum[getme__adj_edge(adj, c, t, j, slot[j])];
+            *s = (int64_t)((uint64_t)*s + d);
+        }
 }
 
 /* Sum of q over N(e) for a regular element e of type t (see above), as

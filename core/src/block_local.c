@@ -11,6 +11,7 @@
 #include "block_local.h"
 #include "internal.h"
 
+#include <math.h>
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,6 +24,9 @@ void getme__blocks_free(getme_blocks *blk)
     free(blk->nptr);
     free(blk->nodes);
     free(blk->lconn);
+    free(blk->order);
+    free(blk->part_ptr);
+    free(blk->col_ptr);
     memset(blk, 0, sizeof *blk);
 }
 
@@ -87,6 +91,147 @@ static getme_status alloc_scratch(getme_blocks *blk, int nt)
     return GETME_OK;
 }
 
+/* Block b's nodes are all in part p's territory (build_order). */
+static int interior(const getme_blocks *blk, const int32_t *part, int32_t b,
+                    int32_t p)
+{
+    for (int64_t k = blk->nptr[b]; k < blk->nptr[b + 1]; k++)
+        if (part[blk->nodes[k]] != p)
+            return 0;
+    return 1;
+}
+
+typedef struct block_key {
+    double key;
+    int32_t b;
+} block_key;
+
+static int cmp_key(const void *pa, const void *pb)
+{
+    const block_key *a = pa, *b = pb;
+    return a->key < b->key ? -1 : a->key > b->key ? 1 : (a->b > b->b) - (a->b < b->b);
+}
+
+/* Deal the blocks cur[0..n) into np parts by position along the axis
+   where they spread most (a block's position: its first node's): the
+   blocks left after a level lie along the parts' interfaces, so this cuts
+   across them, and the next level finds most of them interior. */
+static void deal_across(const getme_blocks *blk, const getme_ws *ws,
+                        const int32_t *cur, int32_t n, int np, int32_t *bpart,
+                        block_key *keys)
+{
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    for (int32_t k = 0; k < n; k++)
+        for (int d = 0; d < 3; d++) {
+            double v = ws->x[3 * (int64_t)blk->nodes[blk->nptr[cur[k]]] + d];
+            lo[d] = v < lo[d] ? v : lo[d];
+            hi[d] = v > hi[d] ? v : hi[d];
+        }
+    int a = 0;
+    for (int d = 1; d < 3; d++)
+        if (hi[d] - lo[d] > hi[a] - lo[a])
+            a = d;
+    for (int32_t k = 0; k < n; k++) {
+        keys[k].b = cur[k];
+        keys[k].key = ws->x[3 * (int64_t)blk->nodes[blk->nptr[cur[k]]] + a];
+    }
+    qsort(keys, (size_t)n, sizeof *keys, cmp_key);
+    for (int32_t k = 0; k < n; k++)
+        bpart[keys[k].b] = (int32_t)((int64_t)k * np / n);
+}
+
+/* The visiting order (block_local.h), from the blocks' node lists; part[]
+   has room for ws->nn entries (scratch).  Level 0: block b is in part
+   b * num_parts / num_blocks; the blocks left after a level are dealt
+   out again across the interfaces (deal_across). */
+static getme_status build_order(getme_blocks *blk, const getme_ws *ws,
+                                int32_t *part)
+{
+    int np = ws->nt > 0 ? ws->nt : 1;
+    int32_t nb = ws->num_blocks;
+    size_t nbs = (size_t)(nb ? nb : 1);
+    blk->num_parts = np;
+    blk->order = malloc(nbs * sizeof *blk->order);
+    blk->part_ptr = calloc((size_t)GETME_ORDER_LEVELS * np + 1,
+                           sizeof *blk->part_ptr);
+    blk->col_ptr = calloc((size_t)ws->num_colours + 1, sizeof *blk->col_ptr);
+    int32_t *cur = malloc(nbs * sizeof *cur), *bpart = malloc(nbs * sizeof *bpart);
+    block_key *keys = malloc(nbs * sizeof *keys);
+    uint8_t *left = malloc(nbs);
+    getme_status st = GETME_ERR_NOMEM;
+    if (!blk->order || !blk->part_ptr || !blk->col_ptr || !cur || !bpart ||
+        !keys || !left)
+        goto done;
+    for (int32_t b = 0; b < nb; b++) {
+        cur[b] = b;
+        bpart[b] = (int32_t)((int64_t)b * np / nb);
+        left[b] = 1;
+    }
+    int32_t ncur = nb, m = 0;
+    for (int l = 0; l < GETME_ORDER_LEVELS; l++) {
+        /* part[n]: the one part whose blocks left use node n, or -2 */
+        for (int32_t k = 0; k < ncur; k++)
+            for (int64_t j = blk->nptr[cur[k]]; j < blk->nptr[cur[k] + 1]; j++)
+                part[blk->nodes[j]] = -1;
+        for (int32_t k = 0; k < ncur; k++) {
+            int32_t p = bpart[cur[k]];
+            for (int64_t j = blk->nptr[cur[k]]; j < blk->nptr[cur[k] + 1]; j++) {
+                int32_t n = blk->nodes[j];
+                part[n] = part[n] == -1 || part[n] == p ? p : -2;
+            }
+        }
+        for (int p = 0; p < np; p++) {
+            for (int32_t k = 0; k < ncur; k++)
+                if (bpart[cur[k]] == p && interior(blk, part, cur[k], p)) {
+                    blk->order[m++] = cur[k];
+                    left[cur[k]] = 0;
+                }
+            blk->part_ptr[l * np + p + 1] = m;
+        }
+        int32_t n = 0;
+        for (int32_t k = 0; k < ncur; k++)
+            if (left[cur[k]])
+                cur[n++] = cur[k];
+        ncur = n;
+        deal_across(blk, ws, cur, ncur, np, bpart, keys);
+    }
+    for (int c = 0; c < ws->num_colours; c++) {
+        blk->col_ptr[c] = m;
+        for (int32_t k = ws->colour_ptr[c]; k < ws->colour_ptr[c + 1]; k++)
+            if (left[ws->colour_blocks[k]])
+                blk->order[m++] = ws->colour_blocks[k];
+    }
+    blk->col_ptr[ws->num_colours] = m;
+    st = GETME_OK;
+done:
+    free(cur), free(bpart), free(keys), free(left);
+    return st;
+}
+
+int64_t getme__blocks_run(const getme_blocks *blk, const getme_ws *ws,
+                          int64_t (*f)(void *ctx, int32_t b), void *ctx)
+{
+    int64_t total = 0;
+    int np = blk->num_parts;
+    for (int l = 0; l < GETME_ORDER_LEVELS; l++) {
+        const int32_t *ptr = blk->part_ptr + l * np;
+#pragma omp parallel for schedule(static, 1) num_threads(np) \
+    reduction(+ : total) if (np > 1 && ptr[np] > ptr[0])
+        for (int p = 0; p < np; p++)
+            for (int32_t k = ptr[p]; k < ptr[p + 1]; k++)
+                total += f(ctx, blk->order[k]);
+    }
+    for (int c = 0; c < ws->num_colours; c++) {
+        int32_t k0 = blk->col_ptr[c], k1 = blk->col_ptr[c + 1];
+        int nt = c == ws->serial_colour ? 1 : ws->nt;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(nt) \
+    reduction(+ : total) if (k1 - k0 > 1)
+        for (int32_t k = k0; k < k1; k++)
+            total += f(ctx, blk->order[k]);
+    }
+    return total;
+}
+
 getme_status getme__blocks_build(getme_blocks *blk, const getme_ws *ws)
 {
     memset(blk, 0, sizeof *blk);
@@ -138,7 +283,7 @@ getme_status getme__blocks_build(getme_blocks *blk, const getme_ws *ws)
         block_nodes(ws, b, mark + o, local + o, blk->nodes + blk->nptr[b],
                     blk->lconn);
     }
-    st = GETME_OK;
+    st = build_order(blk, ws, mark);
 done:
     free(mark);
     free(local);

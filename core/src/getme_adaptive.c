@@ -158,30 +158,12 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
     /* The weights first, in a loop of loads with little arithmetic, so the
        out-of-order core keeps the scattered ones (face neighbours' q, S_e)
        of several elements in flight; -1 marks an element not transformed
-       (a weight is >= 0). */
+       (a weight is >= 0).  No software prefetch: since the blocks run in
+       element order (block_local.h) their data is mostly in cache, and the
+       prefetches' own address loads (eptr, fnb 8 elements ahead) cost
+       14 % of the scatter (perf, 1M tets, one thread). */
     int64_t *wfs = scr->wf;
     for (int32_t e = e0; e < e1; e++) {
-        /* Prefetch the scattered inputs of the weight PREFETCH_AHEAD
-           elements on: the face neighbours' q and S_e (their misses were
-           most of this loop's samples, perf annotate).  Written inline:
-           gcc deems a function of prefetches only free of side effects
-           and deletes its calls. */
-        if (e + PREFETCH_AHEAD < e1) {
-            int32_t ep = e + PREFETCH_AHEAD;
-            const int32_t *f = getme__adj_faces(adj, ws, t, ep);
-            for (int k = 0; k < getme__faces[t].num_faces; k++)
-                if (f[k] >= 0)
-                    __builtin_prefetch(run->q + f[k], 0, 3);
-            if (ws->dim == 3) {
-                const int32_t *c = getme__ws_nodes(ws, t, ep);
-                const uint8_t *slot = getme__adj_slots(adj, ws, t, ep);
-                for (int k = 0; k < getme__edges[t].num_edges; k++)
-                    if (slot[k] != GETME_NO_SLOT) /* else: irregular */
-                        __builtin_prefetch(
-                            adj->esum + getme__adj_edge(adj, c, t, k, slot[k]),
-                            0, 3);
-            }
-        }
         int64_t wf = -1;
         if (ws->free_elem[e] && getme__owned(run, e)) {
             double w;
@@ -274,29 +256,28 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
     *ovf |= o;
 }
 
-/* q_mean stage: every free element is transformed.  Blocks run colour by
-   colour: blocks of one colour share no node, so they scatter without
-   atomics; the sums are exact (exact.h), so their order does not matter. */
-static int32_t scatter_all(getme_run *run, double sigma)
+/* One block of scatter_all: the number of elements transformed, plus
+   2^32 on a bound overflow (add_sum). */
+static int64_t scatter_block(void *ctx, int32_t b)
 {
+    getme_run *run = ctx;
     const getme_ws *ws = run->ws;
-    int32_t total = 0;
-    for (int c = 0; c < ws->num_colours; c++) {
-        int32_t b0 = ws->colour_ptr[c], b1 = ws->colour_ptr[c + 1];
-        int nt = c == ws->serial_colour ? 1 : ws->nt;
-        int32_t count = 0;
-        int ovf = 0;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(nt) \
-    reduction(+ : count) reduction(| : ovf)
-        for (int32_t k = b0; k < b1; k++) {
-            int32_t b = ws->colour_blocks[k];
-            GETME_FOR_TYPE(getme__ws_type(ws, ws->block_start[b]),
-                           transform_block, run, b, sigma, &count, &ovf);
-        }
-        total += count;
-        run->overflow |= ovf;
-    }
-    return total;
+    int32_t count = 0;
+    int ovf = 0;
+    GETME_FOR_TYPE(getme__ws_type(ws, ws->block_start[b]), transform_block,
+                   run, b, run->params->sigma, &count, &ovf);
+    return count + ((int64_t)(ovf != 0) << 32);
+}
+
+/* q_mean stage: every free element is transformed, block by block in the
+   blocks' race-free order (block_local.h): blocks that run at the same
+   time share no node, so they scatter without atomics; the sums are exact
+   (exact.h), so their order does not matter. */
+static int32_t scatter_all(getme_run *run)
+{
+    int64_t r = getme__blocks_run(&run->adj->blk, run->ws, scatter_block, run);
+    run->overflow |= (r >> 32) != 0;
+    return (int32_t)(r & 0xffffffff);
 }
 
 /* The q_mean stage's I_T (every free node in use) and element list (every
@@ -407,18 +388,7 @@ static getme_status update_after(getme_run *run, double qt)
         uint64_t d = (uint64_t)getme__fx64(run->q[e], adj->qscale) -
                      (uint64_t)getme__fx64(run->qold[k], adj->qscale);
         int t = getme__ws_type(ws, e);
-        const int32_t *c = getme__ws_nodes(ws, t, e);
-        for (int i = 0; i < getme__nv[t]; i++)
-            adj->nsum[c[i]] = (int64_t)((uint64_t)adj->nsum[c[i]] + d);
-        if (ws->dim == 3) {
-            const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
-            for (int j = 0; j < getme__edges[t].num_edges; j++)
-                if (slot[j] != GETME_NO_SLOT) {
-                    int64_t *s =
-                        &adj->esum[getme__adj_edge(adj, c, t, j, slot[j])];
-                    *s = (int64_t)((uint64_t)*s + d);
-                }
-        }
+        getme__adj_add(adj, ws, t, e, getme__ws_nodes(ws, t, e), d);
     }
 
     /* distributed: every process stops if one has no room (else the
@@ -568,6 +538,29 @@ static void qold_reserve(getme_run *run)
         run->cap_qold = 0;
 }
 
+#ifdef GETME_CHECK_SUMS
+/* Test builds (tests/core): are the Eq. 9 sums, kept up to date by exact
+   differences as qualities change, the bits a recomputation gives?
+   (recomputes them, which gives the same bits when they are) */
+static int sums_current(getme_run *run)
+{
+    getme_adj *adj = run->adj;
+    size_t nb = (size_t)run->ws->nn * sizeof *adj->nsum;
+    size_t eb = (size_t)adj->num_edges * sizeof *adj->esum;
+    int64_t *n = malloc(nb ? nb : 1), *e = malloc(eb ? eb : 1);
+    int same = n && e;
+    if (same) {
+        memcpy(n, adj->nsum, nb);
+        if (eb)
+            memcpy(e, adj->esum, eb);
+        getme__adj_sums_all(adj, run->ws, run->q);
+        same = memcmp(n, adj->nsum, nb) == 0 && (!eb || memcmp(e, adj->esum, eb) == 0);
+    }
+    free(n), free(e);
+    return same;
+}
+#endif
+
 /* One iteration of the main loop (Fig. 3 lines 5-9).  mean_stage: the
    q_mean stage, where every free element is transformed over the lists
    lists_all() built; otherwise the elements with q <= qt (run->tlist).
@@ -578,12 +571,13 @@ static getme_status iterate(getme_run *run, int mean_stage, double qt,
                             int32_t *num_transformed, int32_t *num_relaxed)
 {
     double sigma = run->params->sigma;
-    if (mean_stage)
-        getme__adj_sums_all(run->adj, run->ws, run->q);
+    /* The q_mean stage's relaxation keeps the Eq. 9 sums at run->q (relax.c);
+       in the q*_min stage update_after brings them up to date. */
+    run->live = mean_stage ? run->adj : NULL;
     for (;;) {
         set_scales(run, q_lo);
         run->overflow = 0;
-        *num_transformed = mean_stage ? scatter_all(run, sigma)
+        *num_transformed = mean_stage ? scatter_all(run)
                                       : scatter_some(run, qt, sigma);
         if (!getme__dist_any(run, run->overflow))
             break;
@@ -605,6 +599,7 @@ static getme_status iterate(getme_run *run, int mean_stage, double qt,
             run->qold[k] = run->q[run->elems[k]];
     }
     *num_relaxed = getme__relax(run, R, nR);
+    run->live = NULL;
     if (run->comm) { /* counts of the whole mesh, each node once */
         int64_t c[2] = {*num_transformed, 0};
         for (int32_t k = 0; k < run->num_nodes; k++)
@@ -614,7 +609,12 @@ static getme_status iterate(getme_run *run, int mean_stage, double qt,
         *num_relaxed = (int32_t)c[1];
     }
     getme__reset_nodes(run);
-    return mean_stage ? GETME_OK : update_after(run, qt);
+    getme_status st = mean_stage ? GETME_OK : update_after(run, qt);
+#ifdef GETME_CHECK_SUMS
+    if (st == GETME_OK && !sums_current(run))
+        st = GETME_ERR_STATE;
+#endif
+    return st;
 }
 
 /* Swap a <= b for quickselect. */
@@ -808,6 +808,9 @@ getme_status getme__adaptive(getme_run *run)
     }
     lists_all(run);
     set_bounds(run);
+    /* The Eq. 9 sums at the input's qualities; from here on every change of
+       run->q updates them (the relaxation, update_after). */
+    getme__adj_sums_all(run->adj, ws, run->q);
     run->guard = p->corner_guard;
     set_corner_floor(run, p->corner_floor > res->corner_sj_initial
                               ? p->corner_floor

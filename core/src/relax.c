@@ -6,8 +6,10 @@
  * element), so they need no atomics and give the same result for any
  * number of threads.
  */
+#include "adjacency.h"
 #include "smooth_internal.h"
 
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -54,6 +56,63 @@ static inline double trial_quality(const getme_run *run, int32_t e)
     int t = getme__ws_type(run->ws, e);
     getme__ws_gather(run->ws, run->xnew, t, e, x);
     return trial_check(run, e, t, getme__quality(t, x));
+}
+
+/* run->q[e] = v, and in the q_mean stage (run->live) the element's S_v
+   and S_e moved by the difference of its fixed-point qualities: exact
+   integers, so the sums stay the bits a recomputation at run->q gives. */
+static inline void set_q(getme_run *run, int t, int32_t e, double v)
+{
+    getme_adj *adj = run->live;
+    if (adj) {
+        uint64_t d = (uint64_t)getme__fx64(v, adj->qscale) -
+                     (uint64_t)getme__fx64(run->q[e], adj->qscale);
+        if (d)
+            getme__adj_add(adj, run->ws, t, e,
+                           getme__ws_nodes(run->ws, t, e), d);
+    }
+    run->q[e] = v;
+}
+
+/* The q_mean stage's first trial-quality pass over block b (its elements
+   all of type t, a constant in each copy, GETME_FOR_TYPE): every free
+   element's quality at xnew, GETME_LANES at a time in the lane kernel, and
+   its S_v / S_e updated (set_q).  Blocks that run at the same time share
+   no node, hence no edge (block_local.h), so the sums need no atomics. */
+__attribute__((always_inline)) /* one copy per type: t is a constant */
+static inline void trial_block(int t, getme_run *run, int32_t b)
+{
+    const getme_ws *ws = run->ws;
+    int32_t *list = run->adj->blk.scratch[omp_get_thread_num()].list;
+    int32_t n = 0;
+    for (int32_t e = ws->block_start[b]; e < ws->block_start[b + 1]; e++)
+        if (ws->free_elem[e])
+            list[n++] = e;
+    int nv = getme__nv[t];
+    for (int32_t j = 0; j < n; j += GETME_LANES) {
+        double x[3 * GETME_MAX_NV][GETME_LANES], q[GETME_LANES];
+        for (int l = 0; l < GETME_LANES; l++) {
+            /* a short last batch repeats its first element */
+            const int32_t *c = getme__ws_nodes(ws, t, list[j + l < n ? j + l : j]);
+            for (int i = 0; i < nv; i++)
+                for (int d = 0; d < 3; d++)
+                    x[3 * i + d][l] = run->xnew[3 * (int64_t)c[i] + d];
+        }
+        int lanes = getme__quality_lanes(t, (const double(*)[GETME_LANES])x, q);
+        for (int l = 0; l < GETME_LANES && j + l < n; l++) {
+            int32_t e = list[j + l];
+            set_q(run, t, e,
+                  lanes ? trial_check(run, e, t, q[l]) : trial_quality(run, e));
+        }
+    }
+}
+
+static int64_t trial_block_any(void *ctx, int32_t b)
+{
+    getme_run *run = ctx;
+    GETME_FOR_TYPE(getme__ws_type(run->ws, run->ws->block_start[b]),
+                   trial_block, run, b);
+    return 0;
 }
 
 /* trial_quality of the elements elems[k0..k0 + GETME_LANES) into run->q,
@@ -178,8 +237,10 @@ static void step_nodes(getme_run *run, const double *R, int32_t m)
     }
     for (int32_t j = 0; j < m; j++) {
         int32_t i = run->list[j];
-        for (int64_t k = ws->star_ptr[i]; k < ws->star_ptr[i + 1]; k++)
-            run->q[ws->star[k]] = trial_quality(run, ws->star[k]);
+        for (int64_t k = ws->star_ptr[i]; k < ws->star_ptr[i + 1]; k++) {
+            int32_t e = ws->star[k];
+            set_q(run, getme__ws_type(ws, e), e, trial_quality(run, e));
+        }
     }
 }
 
@@ -261,12 +322,16 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
         run->ridx[nodes[k]] = 0;
         place(run, nodes[k], R[0]);
     }
-    int32_t nbatch = ne / GETME_LANES;
+    if (run->live) { /* the q_mean stage: run->elems is every free element */
+        getme__blocks_run(&run->adj->blk, ws, trial_block_any, run);
+    } else {
+        int32_t nbatch = ne / GETME_LANES;
 #pragma omp parallel for schedule(static) num_threads(nt) if (ne > GETME_PAR_MIN)
-    for (int32_t j = 0; j < nbatch; j++)
-        trial_qualities_lanes(run, elems, j * GETME_LANES);
-    for (int32_t k = nbatch * GETME_LANES; k < ne; k++)
-        q[elems[k]] = trial_quality(run, elems[k]);
+        for (int32_t j = 0; j < nbatch; j++)
+            trial_qualities_lanes(run, elems, j * GETME_LANES);
+        for (int32_t k = nbatch * GETME_LANES; k < ne; k++)
+            q[elems[k]] = trial_quality(run, elems[k]);
+    }
 
     /* Step the nodes of invalid elements down the table until none is
        invalid.  Only elements around a stepped node change, so only they

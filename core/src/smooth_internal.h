@@ -46,6 +46,11 @@ typedef struct getme_run {
     int32_t *list;      /* nn: scratch node list (relaxation, sum updates)  */
     /* GETMe adaptive only (getme_adaptive.c): */
     struct getme_adj *adj; /* Eq. 9 sums (adjacency.h)                      */
+    /* Set (to adj) in the q_mean stage, where run->elems is every free
+       element: getme__relax then keeps adj's S_v and S_e equal to the sums
+       at run->q as it changes q, in the pass that computes the new
+       qualities (relax.c), instead of a sweep of its own. */
+    struct getme_adj *live;
     getme_stamp *stamps;/* one per thread, only if adj has irregular ones   */
     int32_t *tlist;     /* q*_min stage: the elements with q <= q_t, sorted */
     int32_t num_t;

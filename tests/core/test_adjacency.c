@@ -52,7 +52,8 @@ static void free_gen(gen *g)
         free(g->conn[t]);
 }
 
-#define N 5
+/* Cells per side of the grids (5; a larger grid for the block order). */
+static int N = 5;
 static int32_t grid(int i, int j, int k) { return (k * (N + 1) + j) * (N + 1) + i; }
 
 static void grid_nodes(gen *g, int dim)
@@ -180,6 +181,8 @@ static double brute(const getme_ws *ws, const double *q, int32_t e,
     return s;
 }
 
+static int32_t check_order(const getme_blocks *blk, const getme_ws *ws);
+
 /* The blocks' node lists (block_local.h, built with adj): each block
    lists its elements' nodes once each, and the local connectivity maps
    back to the workspace's. */
@@ -211,6 +214,135 @@ static void check_blocks(const getme_blocks *blk, const getme_ws *ws)
     CHECK(ok);
     CHECK_EQ_INT(blk->max_nodes, big);
     free(seen);
+    check_order(blk, ws);
+}
+
+/* The blocks' visiting order (getme__blocks_run): every block once, and
+   no node shared by two blocks that may run at the same time: the parts
+   of one level, or two blocks of one colour (but the serial one).
+   Returns how many blocks the parts' levels hold. */
+static int32_t check_order(const getme_blocks *blk, const getme_ws *ws)
+{
+    int32_t nb = ws->num_blocks, np = blk->num_parts;
+    int32_t *own = malloc((size_t)ws->nn * sizeof *own);
+    int32_t *seen = calloc((size_t)(nb ? nb : 1), sizeof *seen);
+    int ok = blk->part_ptr[0] == 0 &&
+             blk->col_ptr[0] == blk->part_ptr[GETME_ORDER_LEVELS * np] &&
+             blk->col_ptr[ws->num_colours] == nb;
+    for (int32_t k = 0; ok && k < nb; k++)
+        seen[blk->order[k]]++;
+    for (int32_t b = 0; ok && b < nb; b++)
+        ok &= seen[b] == 1;
+    /* groups: each level's parts (several each), then each colour's
+       blocks (one each) */
+    for (int g = 0; ok && g < GETME_ORDER_LEVELS + ws->num_colours; g++) {
+        int level = g < GETME_ORDER_LEVELS;
+        if (!level && g - GETME_ORDER_LEVELS == ws->serial_colour)
+            continue;
+        for (int32_t n = 0; n < ws->nn; n++)
+            own[n] = -1;
+        int32_t k0 = level ? blk->part_ptr[g * np] : blk->col_ptr[g - GETME_ORDER_LEVELS];
+        int32_t k1 = level ? blk->part_ptr[(g + 1) * np]
+                           : blk->col_ptr[g - GETME_ORDER_LEVELS + 1];
+        int32_t p = 0;
+        for (int32_t k = k0; k < k1; k++) {
+            while (level && k >= blk->part_ptr[g * np + p + 1])
+                p++;
+            int32_t who = level ? p : k, b = blk->order[k];
+            for (int64_t j = blk->nptr[b]; j < blk->nptr[b + 1]; j++) {
+                int32_t n = blk->nodes[j];
+                ok &= own[n] == -1 || own[n] == who;
+                own[n] = who;
+            }
+        }
+    }
+    CHECK(ok);
+    free(own), free(seen);
+    return blk->part_ptr[GETME_ORDER_LEVELS * np];
+}
+
+/* A 24^3 Kuhn grid (162 blocks) for 1-4 threads: the order is race-free,
+   the parts take the blocks they should, and the Eq. 9 sums built in it
+   are the same integers for every thread count. */
+static void check_block_order(void)
+{
+    N = 24;
+    gen g = make("tet");
+    N = 5;
+    getme_mesh *mesh = to_mesh(&g);
+    int64_t *ref = NULL;
+    for (int nt = 1; nt <= 4; nt++) {
+        getme_ws ws;
+        getme_adj adj;
+        CHECK(getme__ws_build(&ws, mesh, 1, nt) == GETME_OK);
+        CHECK(getme__adj_build(&adj, &ws) == GETME_OK);
+        CHECK_EQ_INT(ws.num_blocks, 162);
+        int32_t in_parts = check_order(&adj.blk, &ws);
+        /* 1 thread: all in element order; more: the blocks on no part's
+           interface, over three levels (block_local.c); the grid is only
+           ~5 blocks wide, so the interfaces hold many of them */
+        static const int32_t expect[5] = {0, 162, 92, 42, 31};
+        CHECK_EQ_INT(in_parts, expect[nt]);
+        double *q = malloc((size_t)ws.ne * sizeof *q);
+        for (int32_t e = 0; e < ws.ne; e++)
+            q[e] = 0.05 + 0.9 * (double)((ws.elem_orig[e] * 7919) % 1000) / 1000.0;
+        getme__adj_sums_all(&adj, &ws, q);
+        if (!ref) {
+            ref = malloc((size_t)adj.num_edges * sizeof *ref);
+            memcpy(ref, adj.esum, (size_t)adj.num_edges * sizeof *ref);
+        } else { /* same numbering for every nt (node order is fixed) */
+            CHECK(memcmp(ref, adj.esum, (size_t)adj.num_edges * sizeof *ref) == 0);
+        }
+        free(q);
+        getme__adj_free(&adj);
+        getme__ws_free(&ws);
+    }
+    free(ref);
+    getme_mesh_free(mesh);
+    free_gen(&g);
+}
+
+/* GETMe adaptive on a 24^3 Kuhn grid distorted like the benchmark meshes
+   (getme_mesh_distort to q_mean 0.45), 1 and 2 threads: this
+   test is built with GETME_CHECK_SUMS, so every iteration compares the
+   Eq. 9 sums it keeps by differences (relaxation, update_after) with a
+   recomputation and fails with GETME_ERR_STATE if they differ.  The
+   q_mean stage's relaxation steps nodes back (num_relaxed > 0), so the
+   corrections after its first trial pass run (without them: status 5). */
+static int count_relaxed(const getme_progress *pr, void *data)
+{
+    if (pr->stage == GETME_STAGE_MEAN)
+        *(int64_t *)data += pr->num_relaxed;
+    return 0;
+}
+
+static void check_live_sums(void)
+{
+    N = 24;
+    gen g = make("tet");
+    N = 5;
+    double q_mean[3];
+    for (int nt = 1; nt <= 2; nt++) {
+        getme_mesh *mesh = to_mesh(&g);
+        CHECK(getme_mesh_fix_boundary(mesh, GETME_FIX_SKIN, NULL) == GETME_OK);
+        /* as the benchmark meshes: q_mean down to 0.45 */
+        CHECK(getme_mesh_distort(mesh, 1, 0.5, 0.45, 200) == GETME_OK);
+        getme_params p;
+        getme_params_init(&p);
+        p.num_threads = nt;
+        int64_t relaxed = 0;
+        p.progress = count_relaxed;
+        p.progress_data = &relaxed;
+        getme_result r;
+        CHECK_EQ_INT(getme_smooth(mesh, &p, &r), GETME_OK);
+        CHECK(relaxed > 0); /* the step corrections ran */
+        CHECK(r.iterations_mean >= 3 && r.iterations_min >= 1);
+        CHECK(r.q_mean > r.q_mean_initial);
+        q_mean[nt] = r.q_mean;
+        getme_mesh_free(mesh);
+    }
+    CHECK(memcmp(&q_mean[1], &q_mean[2], sizeof *q_mean) == 0);
+    free_gen(&g);
 }
 
 /* Build ws + adj for g with nt threads; check every regular element's
@@ -347,5 +479,7 @@ int main(void)
     for (size_t i = 0; i < sizeof kinds / sizeof *kinds; i++)
         check_conforming(kinds[i]);
     check_nonconforming();
+    check_block_order();
+    check_live_sums();
     return check_summary("test_adjacency");
 }
