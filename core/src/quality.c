@@ -103,25 +103,30 @@ static inline double cube_root(double x)
     return y + (x / (y * y) - y) * (1.0 / 3.0);
 }
 
-/* cube_root() of 8 values at once.  The same operations in the same order
-   per value, so the results are bit-identical to cube_root(); written as
-   loops over the 8 lanes so that the compiler keeps the Halley and Newton
-   steps (4 divisions each) in vector registers.  Only the initial guess's
-   division by 3 stays scalar (no 64-bit vector multiply-high). */
-static inline void cube_root8(const double *x, double *y)
+/* cube_root() of n <= 8 GETME_LANES values at once (x and y do not
+   overlap).  The same operations in the same order per value, so the
+   results are bit-identical to cube_root(); the Halley and Newton steps
+   are one loop over all the values, so every step is a vector instruction
+   and the n independent chains overlap instead of waiting on each other's
+   divisions.  Only the initial guess's division by 3 stays scalar (there
+   is no 64-bit vector multiply-high; an exact vector version through
+   32-bit multiplies measured no faster, bench/kernels.c). */
+static inline void cube_root_n(const double *restrict x, double *restrict y,
+                               int n)
 {
-    uint64_t bits[8];
-    double y3[8];
-    memcpy(bits, x, sizeof bits);
-    for (int i = 0; i < 8; i++)
+    uint64_t bits[8 * GETME_LANES];
+    memcpy(bits, x, sizeof(double) * (size_t)n);
+    for (int i = 0; i < n; i++)
         bits[i] = bits[i] / 3u + UINT64_C(0x2A9F7893782DA1CE);
-    memcpy(y, bits, sizeof bits);
-    for (int i = 0; i < 8; i++) {
-        y3[i] = y[i] * y[i] * y[i];
-        y[i] += y[i] * ((x[i] - y3[i]) / (2.0 * y3[i] + x[i]));
-        y3[i] = y[i] * y[i] * y[i];
-        y[i] += y[i] * ((x[i] - y3[i]) / (2.0 * y3[i] + x[i]));
-        y[i] = y[i] + (x[i] / (y[i] * y[i]) - y[i]) * (1.0 / 3.0);
+    memcpy(y, bits, sizeof(double) * (size_t)n);
+#pragma omp simd
+    for (int i = 0; i < n; i++) {
+        double yi = y[i], y3, xi = x[i];
+        y3 = yi * yi * yi;
+        yi += yi * ((xi - y3) / (2.0 * y3 + xi));
+        y3 = yi * yi * yi;
+        yi += yi * ((xi - y3) / (2.0 * y3 + xi));
+        y[i] = yi + (xi / (yi * yi) - yi) * (1.0 / 3.0);
     }
 }
 
@@ -169,31 +174,88 @@ double getme__quality_tet(const double *x)
 /* ---- hexahedron --------------------------------------------------------- */
 
 /* The paper's N^hex, zero-based; det = +1 on the unit cube in Gmsh order.
-   W = I: S_k = D_k.  The 8 corners go through one 8-lane cube root
-   (cube_root8), and their q_k are summed in corner order. */
+   W = I: S_k = D_k, the edges from node k to its three neighbours. */
 static const unsigned char hex_corners[8][4] = {
     {0, 3, 4, 1}, {1, 0, 5, 2}, {2, 1, 6, 3}, {3, 2, 7, 0},
     {4, 7, 5, 0}, {5, 4, 6, 1}, {6, 5, 7, 2}, {7, 6, 4, 3}};
 
+/*
+ * The corners' edge vectors are the 12 edges of the hex, each seen from
+ * both of its ends: corner k's edge to node j is +E or -E for the stored
+ * edge E = x[b] - x[a] between them, and x[j] - x[k] = -(x[k] - x[j])
+ * exactly.  So the 12 edges are subtracted once and squared once (|E|^2
+ * does not see the sign), and since negating an operand negates a
+ * correctly rounded product or sum exactly, det3(+-E1, +-E2, +-E3) is
+ * (the product of the signs) * det3(E1, E2, E3) to the bit, up to the sign
+ * of a zero det, which no caller can see (only det > 0 counts, and the
+ * cube root only of such a det).  For every corner of hex_corners:
+ * hex_corner_edges are the edges to its 3 neighbours in that order; the
+ * signs' product is -1 for the bottom corners 0-3, +1 for the top ones.
+ */
+static const unsigned char hex_edge_nodes[12][2] = {
+    {0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6},
+    {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
+static const unsigned char hex_corner_edges[8][3] = {
+    {3, 8, 0}, {0, 9, 1}, {1, 10, 2}, {2, 11, 3},
+    {7, 4, 8}, {4, 5, 9}, {5, 6, 10}, {6, 7, 11}};
+
+/* The mean ratio of L hexes whose coordinates are x[(3 i + d) L + l]
+   (node i, coordinate d, element l): L = 1 is one hex, L = GETME_LANES a
+   batch in lanes.  The same operations per corner as the textbook
+   kernel (edges, det3, sum of squared edge lengths, cube root, 3 c^2 /
+   frob2 summed in corner order); the 8 L determinants go through one
+   cube_root_n, so every step is a vector instruction over corners or
+   lanes and the Halley chains overlap. */
+static inline void quality_hex_n(const double *restrict x, double *restrict q,
+                                 const int L)
+{
+    double e[12][3][GETME_LANES], l2[12][GETME_LANES];
+    double det[8 * GETME_LANES], frob2[8 * GETME_LANES], c[8 * GETME_LANES];
+    for (int k = 0; k < 12; k++) {
+        int a = 3 * hex_edge_nodes[k][0], b = 3 * hex_edge_nodes[k][1];
+#pragma omp simd
+        for (int l = 0; l < L; l++) {
+            for (int d = 0; d < 3; d++)
+                e[k][d][l] = x[(b + d) * L + l] - x[(a + d) * L + l];
+            l2[k][l] = e[k][0][l] * e[k][0][l] + e[k][1][l] * e[k][1][l] +
+                       e[k][2][l] * e[k][2][l];
+        }
+    }
+    for (int k = 0; k < 8; k++) {
+        double(*e1)[GETME_LANES] = e[hex_corner_edges[k][0]];
+        double(*e2)[GETME_LANES] = e[hex_corner_edges[k][1]];
+        double(*e3)[GETME_LANES] = e[hex_corner_edges[k][2]];
+        double sign = k < 4 ? -1.0 : 1.0;
+#pragma omp simd
+        for (int l = 0; l < L; l++) {
+            double d3 = e1[0][l] * (e2[1][l] * e3[2][l] - e2[2][l] * e3[1][l]) +
+                        e1[1][l] * (e2[2][l] * e3[0][l] - e2[0][l] * e3[2][l]) +
+                        e1[2][l] * (e2[0][l] * e3[1][l] - e2[1][l] * e3[0][l]);
+            det[k * L + l] = sign * d3;
+            frob2[k * L + l] = l2[hex_corner_edges[k][0]][l] +
+                               l2[hex_corner_edges[k][1]][l] +
+                               l2[hex_corner_edges[k][2]][l];
+        }
+    }
+    cube_root_n(det, c, 8 * L);
+#pragma omp simd
+    for (int l = 0; l < L; l++) {
+        double s = 0.0;
+        int ok = 1;
+        for (int k = 0; k < 8; k++) {
+            double ck = c[k * L + l];
+            s += 3.0 * ck * ck / frob2[k * L + l];
+            ok &= det[k * L + l] > 0.0;
+        }
+        q[l] = valid_or_zero(ok, 0.125 * s);
+    }
+}
+
 double getme__quality_hex(const double *x)
 {
-    double det[8], frob2[8], c[8];
-    for (int k = 0; k < 8; k++) {
-        double e1[3], e2[3], e3[3];
-        edge(x, hex_corners[k][0], hex_corners[k][1], e1);
-        edge(x, hex_corners[k][0], hex_corners[k][2], e2);
-        edge(x, hex_corners[k][0], hex_corners[k][3], e3);
-        det[k] = det3(e1, e2, e3);
-        frob2[k] = dot3(e1, e1) + dot3(e2, e2) + dot3(e3, e3);
-    }
-    cube_root8(det, c);
-    double s = 0.0;
-    int ok = 1;
-    for (int k = 0; k < 8; k++) {
-        s += 3.0 * c[k] * c[k] / frob2[k];
-        ok &= det[k] > 0.0;
-    }
-    return valid_or_zero(ok, 0.125 * s);
+    double q;
+    quality_hex_n(x, &q, 1);
+    return q;
 }
 
 /* ---- GETME_LANES elements at once --------------------------------------- */
@@ -201,7 +263,7 @@ double getme__quality_hex(const double *x)
 /* getme__quality_tet and getme__quality_hex of GETME_LANES elements, x in
    lanes (x[3 i + d][l]: coordinate d of node i of element l).  The same
    operations in the same order per lane as the one-element kernels, and
-   cube_root8 is bit-identical to cube_root, so every lane's q is the same
+   cube_root_n is bit-identical to cube_root, so every lane's q is the same
    bits; written as loops over the lanes so that they become vector
    instructions (the relaxation evaluates every element this way). */
 static void quality_tet_lanes(const double (*x)[GETME_LANES], double *q)
@@ -223,7 +285,7 @@ static void quality_tet_lanes(const double (*x)[GETME_LANES], double *q)
         det[l] = GETME_SQRT2 * det3(e1, e2, e3);
         frob2[l] = dot3(e1, e1) + dot3(s2, s2) + dot3(s3, s3);
     }
-    cube_root8(det, c);
+    cube_root_n(det, c, L);
 #pragma omp simd
     for (int l = 0; l < L; l++)
         q[l] = valid_or_zero(det[l] > 0.0, 3.0 * c[l] * c[l] / frob2[l]);
@@ -231,36 +293,7 @@ static void quality_tet_lanes(const double (*x)[GETME_LANES], double *q)
 
 static void quality_hex_lanes(const double (*x)[GETME_LANES], double *q)
 {
-    enum { L = GETME_LANES };
-    double s[L];
-    int ok[L];
-    for (int l = 0; l < L; l++)
-        s[l] = 0.0, ok[l] = 1;
-    for (int k = 0; k < 8; k++) {
-        int a = 3 * hex_corners[k][0], b = 3 * hex_corners[k][1],
-            c1 = 3 * hex_corners[k][2], d1 = 3 * hex_corners[k][3];
-        double det[L], frob2[L], c[L];
-#pragma omp simd
-        for (int l = 0; l < L; l++) {
-            double e1[3], e2[3], e3[3];
-            for (int d = 0; d < 3; d++) {
-                e1[d] = x[b + d][l] - x[a + d][l];
-                e2[d] = x[c1 + d][l] - x[a + d][l];
-                e3[d] = x[d1 + d][l] - x[a + d][l];
-            }
-            det[l] = det3(e1, e2, e3);
-            frob2[l] = dot3(e1, e1) + dot3(e2, e2) + dot3(e3, e3);
-        }
-        cube_root8(det, c);
-#pragma omp simd
-        for (int l = 0; l < L; l++) {
-            s[l] += 3.0 * c[l] * c[l] / frob2[l];
-            ok[l] &= det[l] > 0.0;
-        }
-    }
-#pragma omp simd
-    for (int l = 0; l < L; l++)
-        q[l] = valid_or_zero(ok[l], 0.125 * s[l]);
+    quality_hex_n(&x[0][0], q, GETME_LANES);
 }
 
 int getme__quality_lanes(int type, const double (*x)[GETME_LANES], double *q)

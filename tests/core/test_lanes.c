@@ -7,6 +7,11 @@
  * build independent if that holds exactly, so the test compares bits, not
  * values within a tolerance.
  *
+ * The hex mean ratio is also compared with the textbook kernel below
+ * (corner by corner: its three edges, det, squared lengths, cube root),
+ * because the library's one-element and lane kernels share their edges
+ * and cube roots across corners and must still give its bits.
+ *
  * Built from the core's sources (not libgetme), because it checks private
  * functions.
  */
@@ -34,6 +39,47 @@ static int same_bits(double a, double b)
     return memcmp(&a, &b, sizeof a) == 0;
 }
 
+/* quality.c's cube root, step by step (the specification of its bits) */
+static double ref_cube_root(double x)
+{
+    uint64_t bits;
+    double y;
+    memcpy(&bits, &x, sizeof bits);
+    bits = bits / 3u + UINT64_C(0x2A9F7893782DA1CE);
+    memcpy(&y, &bits, sizeof y);
+    double y3 = y * y * y;
+    y += y * ((x - y3) / (2.0 * y3 + x));
+    y3 = y * y * y;
+    y += y * ((x - y3) / (2.0 * y3 + x));
+    return y + (x / (y * y) - y) * (1.0 / 3.0);
+}
+
+/* The hex mean ratio one corner at a time (paper's N^hex, W = I). */
+static double ref_quality_hex(const double *x)
+{
+    static const int corner[8][4] = {{0, 3, 4, 1}, {1, 0, 5, 2}, {2, 1, 6, 3},
+                                     {3, 2, 7, 0}, {4, 7, 5, 0}, {5, 4, 6, 1},
+                                     {6, 5, 7, 2}, {7, 6, 4, 3}};
+    double s = 0.0;
+    int ok = 1;
+    for (int k = 0; k < 8; k++) {
+        double e[3][3];
+        for (int j = 0; j < 3; j++)
+            for (int d = 0; d < 3; d++)
+                e[j][d] = x[3 * corner[k][j + 1] + d] - x[3 * corner[k][0] + d];
+        double det = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) +
+                     e[0][1] * (e[1][2] * e[2][0] - e[1][0] * e[2][2]) +
+                     e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
+        double frob2 = 0.0;
+        for (int j = 0; j < 3; j++)
+            frob2 += e[j][0] * e[j][0] + e[j][1] * e[j][1] + e[j][2] * e[j][2];
+        double c = ref_cube_root(det);
+        s += 3.0 * c * c / frob2;
+        ok &= det > 0.0;
+    }
+    return ok && 0.125 * s > 0.0 ? 0.125 * s : 0.0;
+}
+
 /* Element l of a batch of type t: kind 0 the regular element, 1 moved a
    little, 2 moved a lot (often inverted), 3 two nodes on top of each
    other (degenerate); scaled and shifted far from the origin. */
@@ -52,7 +98,7 @@ static void element(int t, int kind, double *x)
 
 static void check_type(int t)
 {
-    int nv = getme__nv[t], ok_q = 1, ok_t = 1;
+    int nv = getme__nv[t], ok_q = 1, ok_t = 1, ok_ref = 1;
     for (int batch = 0; batch < 2000; batch++) {
         double x[GETME_LANES][3 * GETME_MAX_NV], xl[3 * GETME_MAX_NV][GETME_LANES];
         double yl[3 * GETME_MAX_NV][GETME_LANES], ql[GETME_LANES];
@@ -69,6 +115,8 @@ static void check_type(int t)
         for (int l = 0; l < GETME_LANES; l++) {
             double y[3 * GETME_MAX_NV];
             ok_q &= same_bits(ql[l], getme__quality(t, x[l]));
+            if (t == GETME_HEX)
+                ok_ref &= same_bits(ql[l], ref_quality_hex(x[l]));
             getme__transform(t, x[l], 0.3, y);
             for (int i = 0; i < 3 * nv; i++)
                 ok_t &= same_bits(yl[i][l], y[i]);
@@ -76,6 +124,7 @@ static void check_type(int t)
     }
     CHECK(ok_q);
     CHECK(ok_t);
+    CHECK(ok_ref);
 }
 
 int main(void)
