@@ -271,20 +271,28 @@ static void quality_tet_lanes(const double (*x)[GETME_LANES], double *q)
 {
     enum { L = GETME_LANES };
     double det[L], frob2[L], c[L];
+    /* getme__quality_tet spelled out per coordinate: with small arrays
+       inside the lane loop gcc left it scalar */
 #pragma omp simd
     for (int l = 0; l < L; l++) {
-        double e1[3], e2[3], e3[3], s2[3], s3[3];
-        for (int d = 0; d < 3; d++) {
-            e1[d] = x[3 + d][l] - x[d][l];
-            e2[d] = x[6 + d][l] - x[d][l];
-            e3[d] = x[9 + d][l] - x[d][l];
-        }
-        for (int d = 0; d < 3; d++) {
-            s2[d] = (2.0 * e2[d] - e1[d]) * GETME_INV_SQRT3;
-            s3[d] = (3.0 * e3[d] - e1[d] - e2[d]) * GETME_INV_SQRT6;
-        }
-        det[l] = GETME_SQRT2 * det3(e1, e2, e3);
-        frob2[l] = dot3(e1, e1) + dot3(s2, s2) + dot3(s3, s3);
+        double e1x = x[3][l] - x[0][l], e1y = x[4][l] - x[1][l],
+               e1z = x[5][l] - x[2][l];
+        double e2x = x[6][l] - x[0][l], e2y = x[7][l] - x[1][l],
+               e2z = x[8][l] - x[2][l];
+        double e3x = x[9][l] - x[0][l], e3y = x[10][l] - x[1][l],
+               e3z = x[11][l] - x[2][l];
+        double s2x = (2.0 * e2x - e1x) * GETME_INV_SQRT3,
+               s2y = (2.0 * e2y - e1y) * GETME_INV_SQRT3,
+               s2z = (2.0 * e2z - e1z) * GETME_INV_SQRT3;
+        double s3x = (3.0 * e3x - e1x - e2x) * GETME_INV_SQRT6,
+               s3y = (3.0 * e3y - e1y - e2y) * GETME_INV_SQRT6,
+               s3z = (3.0 * e3z - e1z - e2z) * GETME_INV_SQRT6;
+        det[l] = GETME_SQRT2 * (e1x * (e2y * e3z - e2z * e3y) +
+                                e1y * (e2z * e3x - e2x * e3z) +
+                                e1z * (e2x * e3y - e2y * e3x));
+        frob2[l] = (e1x * e1x + e1y * e1y + e1z * e1z) +
+                   (s2x * s2x + s2y * s2y + s2z * s2z) +
+                   (s3x * s3x + s3y * s3y + s3z * s3z);
     }
     cube_root_n(det, c, L);
 #pragma omp simd
