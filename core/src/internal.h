@@ -105,6 +105,11 @@ void getme__transform_hex_lanes(const double (*x)[GETME_LANES], double sigma,
    lanes as above) into q; bit-identical per lane.  Returns 0 (nothing
    done) for a type without a lane kernel (only tets and hexes have one). */
 int getme__quality_lanes(int type, const double (*x)[GETME_LANES], double *q);
+/* getme__quality of n elements of type type stored one after the other
+   (x[3 nv e + 3 i + d]) into q[0..n): the lane kernels for full groups of
+   GETME_LANES tets or hexes (about 4x faster than one at a time,
+   bench/kernels.c), bit-identical to n calls of getme__quality. */
+void getme__qualities(int type, int32_t n, const double *x, double *q);
 void getme__transform_hex(const double *x, double sigma, double *out);
 void getme__transform_prism(const double *x, double sigma, double *out);
 void getme__transform_pyramid(const double *x, double sigma, double *out);

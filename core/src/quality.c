@@ -174,10 +174,9 @@ double getme__quality_tet(const double *x)
 /* ---- hexahedron --------------------------------------------------------- */
 
 /* The paper's N^hex, zero-based; det = +1 on the unit cube in Gmsh order.
-   W = I: S_k = D_k, the edges from node k to its three neighbours. */
-static const unsigned char hex_corners[8][4] = {
-    {0, 3, 4, 1}, {1, 0, 5, 2}, {2, 1, 6, 3}, {3, 2, 7, 0},
-    {4, 7, 5, 0}, {5, 4, 6, 1}, {6, 5, 7, 2}, {7, 6, 4, 3}};
+   W = I: S_k = D_k, the edges from node k to its three neighbours, in the
+   order (node; neighbours) = (0; 3 4 1) (1; 0 5 2) (2; 1 6 3) (3; 2 7 0)
+   (4; 7 5 0) (5; 4 6 1) (6; 5 7 2) (7; 6 4 3). */
 
 /*
  * The corners' edge vectors are the 12 edges of the hex, each seen from
@@ -188,8 +187,8 @@ static const unsigned char hex_corners[8][4] = {
  * correctly rounded product or sum exactly, det3(+-E1, +-E2, +-E3) is
  * (the product of the signs) * det3(E1, E2, E3) to the bit, up to the sign
  * of a zero det, which no caller can see (only det > 0 counts, and the
- * cube root only of such a det).  For every corner of hex_corners:
- * hex_corner_edges are the edges to its 3 neighbours in that order; the
+ * cube root only of such a det).  For every corner: hex_corner_edges are
+ * the edges to its 3 neighbours in N^hex's order; the
  * signs' product is -1 for the bottom corners 0-3, +1 for the top ones.
  */
 static const unsigned char hex_edge_nodes[12][2] = {
@@ -312,6 +311,26 @@ int getme__quality_lanes(int type, const double (*x)[GETME_LANES], double *q)
     case GETME_HEX: quality_hex_lanes(x, q); return 1;
     default: return 0;
     }
+}
+
+/* n elements of one type, one after the other (x[3 nv e + 3 i + d], the
+   layout getme__quality takes one element in), GETME_LANES at a time
+   through the lane kernels where the type has one: for callers that
+   gather elements themselves and evaluate many (statistics, set-up). */
+void getme__qualities(int type, int32_t n, const double *x, double *q)
+{
+    int nv = (unsigned)type < (unsigned)GETME_NUM_TYPES ? getme__nv[type] : 0;
+    int32_t e = 0;
+    if (type == GETME_TET || type == GETME_HEX)
+        for (; e + GETME_LANES <= n; e += GETME_LANES) {
+            double xl[3 * GETME_MAX_NV][GETME_LANES];
+            for (int l = 0; l < GETME_LANES; l++)
+                for (int i = 0; i < 3 * nv; i++)
+                    xl[i][l] = x[3 * nv * (e + l) + i];
+            getme__quality_lanes(type, (const double(*)[GETME_LANES])xl, q + e);
+        }
+    for (; e < n; e++)
+        q[e] = getme__quality(type, x + 3 * nv * e);
 }
 
 /* ---- prism -------------------------------------------------------------- */
@@ -457,6 +476,42 @@ static inline double corner_sj3(const double *x, int a, int b, int c, int d,
     return l > 0.0 && isfinite(s) ? s : -1.0;
 }
 
+/* corner_sj3 of the 8 hex corners (scale 1), min'd in corner order: the
+   12 edges subtracted and squared once (hex_corner_edges), each corner's
+   three edge vectors with their signs (negation is exact, so det keeps
+   the bits of the textbook corner, the sign of a zero included), then
+   the 8 square roots and divisions in one vector loop. */
+static double corner_sj_hex(const double *x)
+{
+    double e[12][3], l2[12], a[3][3][8], l[8], v[8];
+    for (int k = 0; k < 12; k++) {
+        edge(x, hex_edge_nodes[k][0], hex_edge_nodes[k][1], e[k]);
+        l2[k] = dot3(e[k], e[k]);
+    }
+    for (int k = 0; k < 8; k++) {
+        /* the first edge of a corner points into it, the second away,
+           the third away from a bottom corner and into a top one */
+        double sg[3] = {-1.0, 1.0, k < 4 ? 1.0 : -1.0};
+        for (int j = 0; j < 3; j++)
+            for (int d = 0; d < 3; d++)
+                a[j][d][k] = sg[j] * e[hex_corner_edges[k][j]][d];
+        l[k] = l2[hex_corner_edges[k][0]] * l2[hex_corner_edges[k][1]] *
+               l2[hex_corner_edges[k][2]];
+    }
+#pragma omp simd
+    for (int k = 0; k < 8; k++) {
+        double det = a[0][0][k] * (a[1][1][k] * a[2][2][k] - a[1][2][k] * a[2][1][k]) +
+                     a[0][1][k] * (a[1][2][k] * a[2][0][k] - a[1][0][k] * a[2][2][k]) +
+                     a[0][2][k] * (a[1][0][k] * a[2][1][k] - a[1][1][k] * a[2][0][k]);
+        double sj = 1.0 * det / sqrt(l[k]);
+        v[k] = l[k] > 0.0 && isfinite(sj) ? sj : -1.0;
+    }
+    double m = 1.0;
+    for (int k = 0; k < 8; k++)
+        m = fmin(m, v[k]);
+    return m;
+}
+
 static inline double corner_sj2(const double *x, int k, int next, int prev)
 {
     double l = len2_xy(x, k, next) * len2_xy(x, k, prev);
@@ -469,10 +524,7 @@ double getme__corner_sj(int type, const double *x)
     double m = 1.0;
     switch (type) {
     case GETME_HEX:
-        for (int k = 0; k < 8; k++)
-            m = fmin(m, corner_sj3(x, hex_corners[k][0], hex_corners[k][1],
-                                   hex_corners[k][2], hex_corners[k][3], 1.0));
-        return m;
+        return corner_sj_hex(x);
     case GETME_PRISM: {
         /* triangle corners span 60 degrees: 2/sqrt3 makes them 1 */
         static const unsigned char pc[6][4] = {{0, 1, 2, 3}, {1, 2, 0, 4},
