@@ -266,7 +266,8 @@ double getme__quality_hex(const double *x)
    cube_root_n is bit-identical to cube_root, so every lane's q is the same
    bits; written as loops over the lanes so that they become vector
    instructions (the relaxation evaluates every element this way). */
-static void quality_tet_lanes(const double (*x)[GETME_LANES], double *q)
+__attribute__((always_inline)) static inline void
+quality_tet_lanes(const double (*x)[GETME_LANES], double *q)
 {
     enum { L = GETME_LANES };
     double det[L], frob2[L], c[L];
@@ -299,11 +300,13 @@ static void quality_tet_lanes(const double (*x)[GETME_LANES], double *q)
         q[l] = valid_or_zero(det[l] > 0.0, 3.0 * c[l] * c[l] / frob2[l]);
 }
 
-static void quality_hex_lanes(const double (*x)[GETME_LANES], double *q)
+__attribute__((always_inline)) static inline void
+quality_hex_lanes(const double (*x)[GETME_LANES], double *q)
 {
     quality_hex_n(&x[0][0], q, GETME_LANES);
 }
 
+GETME_LANES_TARGETS
 int getme__quality_lanes(int type, const double (*x)[GETME_LANES], double *q)
 {
     switch (type) {

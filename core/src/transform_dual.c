@@ -182,6 +182,7 @@ void getme__transform_hex(const double *x, double sigma, double *out)
    moves.  The differences c_j - m of a node's face centroids are taken
    once each (dual_step takes each twice, as u of one triangle and v of
    the next: the same values). */
+GETME_LANES_TARGETS
 void getme__transform_hex_lanes(const double (*x)[GETME_LANES], double sigma,
                                 double (*out)[GETME_LANES])
 {
