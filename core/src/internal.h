@@ -78,6 +78,9 @@ static inline int getme__has_corners(int type)
            type == GETME_PYRAMID || type == GETME_QUAD;
 }
 
+/* quality.c's cube root of one value (the one-element kernels'), for the
+   tests that check the batched kernels against it */
+double getme__cube_root(double x);
 double getme__quality_tet(const double *x);
 double getme__quality_hex(const double *x);
 double getme__quality_prism(const double *x);

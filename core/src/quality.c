@@ -103,6 +103,11 @@ static inline double cube_root(double x)
     return y + (x / (y * y) - y) * (1.0 / 3.0);
 }
 
+double getme__cube_root(double x)
+{
+    return cube_root(x);
+}
+
 /* cube_root() of n <= 8 GETME_LANES values at once (x and y do not
    overlap).  The same operations in the same order per value, so the
    results are bit-identical to cube_root(); the Halley and Newton steps

@@ -191,7 +191,7 @@ void getme__transform_hex_lanes(const double (*x)[GETME_LANES], double sigma,
     double c[6][3][L], m[8][3][L], n[8][3][L], f[8][L], c0[3][L], sum_x[L];
     /* the input's half of the scaling first: its 12 square roots overlap
        the dual step's arithmetic */
-    getme__rescale3_lanes_x(x, 8, 12, t->edges, c0, sum_x);
+    getme__shape3_lanes(x, 8, 12, t->edges, c0, sum_x);
     for (int fc = 0; fc < 6; fc++)
         for (int d = 0; d < 3; d++) {
             const double *x0 = x[3 * t->face[fc][0] + d], *x1 = x[3 * t->face[fc][1] + d],

@@ -8,7 +8,8 @@
  * values within a tolerance.
  *
  * The hex mean ratio is also compared with the textbook kernel below
- * (corner by corner: its three edges, det, squared lengths, cube root),
+ * (corner by corner: its three edges, det, squared lengths, the one-value
+ * cube root),
  * because the library's one-element and lane kernels share their edges
  * and cube roots across corners and must still give its bits.
  *
@@ -40,21 +41,6 @@ static int same_bits(double a, double b)
     return memcmp(&a, &b, sizeof a) == 0;
 }
 
-/* quality.c's cube root, step by step (the specification of its bits) */
-static double ref_cube_root(double x)
-{
-    uint64_t bits;
-    double y;
-    memcpy(&bits, &x, sizeof bits);
-    bits = bits / 3u + UINT64_C(0x2A9F7893782DA1CE);
-    memcpy(&y, &bits, sizeof y);
-    double y3 = y * y * y;
-    y += y * ((x - y3) / (2.0 * y3 + x));
-    y3 = y * y * y;
-    y += y * ((x - y3) / (2.0 * y3 + x));
-    return y + (x / (y * y) - y) * (1.0 / 3.0);
-}
-
 /* The hex mean ratio one corner at a time (paper's N^hex, W = I). */
 static double ref_quality_hex(const double *x)
 {
@@ -74,7 +60,7 @@ static double ref_quality_hex(const double *x)
         double frob2 = 0.0;
         for (int j = 0; j < 3; j++)
             frob2 += e[j][0] * e[j][0] + e[j][1] * e[j][1] + e[j][2] * e[j][2];
-        double c = ref_cube_root(det);
+        double c = getme__cube_root(det);
         s += 3.0 * c * c / frob2;
         ok &= det > 0.0;
     }
