@@ -484,6 +484,14 @@ static inline double corner_sj3(const double *x, int a, int b, int c, int d,
     return l > 0.0 && isfinite(s) ? s : -1.0;
 }
 
+/* fmin(m, v) for numbers (never NaN, as the corner values are), without
+   the libm call gcc keeps for fmin: the smaller one, and fmin itself only
+   for equal values, where it picks between +0 and -0. */
+static inline double min_corner(double m, double v)
+{
+    return v < m ? v : v == m ? fmin(m, v) : m;
+}
+
 /* corner_sj3 of the 8 hex corners (scale 1), min'd in corner order: the
    12 edges subtracted and squared once (hex_corner_edges), each corner's
    three edge vectors with their signs (negation is exact, so det keeps
@@ -516,7 +524,7 @@ static double corner_sj_hex(const double *x)
     }
     double m = 1.0;
     for (int k = 0; k < 8; k++)
-        m = fmin(m, v[k]);
+        m = min_corner(m, v[k]);
     return m;
 }
 
@@ -539,7 +547,7 @@ double getme__corner_sj(int type, const double *x)
                                                {2, 0, 1, 5}, {3, 5, 4, 0},
                                                {4, 3, 5, 1}, {5, 4, 3, 2}};
         for (int k = 0; k < 6; k++)
-            m = fmin(m, corner_sj3(x, pc[k][0], pc[k][1], pc[k][2], pc[k][3],
+            m = min_corner(m, corner_sj3(x, pc[k][0], pc[k][1], pc[k][2], pc[k][3],
                                    2.0 * GETME_INV_SQRT3));
         return m;
     }
@@ -548,15 +556,15 @@ double getme__corner_sj(int type, const double *x)
         static const unsigned char yc[4][3] = {{0, 1, 3}, {1, 2, 0},
                                                {2, 3, 1}, {3, 0, 2}};
         for (int k = 0; k < 4; k++)
-            m = fmin(m, corner_sj3(x, yc[k][0], yc[k][1], yc[k][2], 4,
+            m = min_corner(m, corner_sj3(x, yc[k][0], yc[k][1], yc[k][2], 4,
                                    GETME_SQRT2));
         return m;
     }
     case GETME_QUAD:
-        m = fmin(m, corner_sj2(x, 0, 1, 3));
-        m = fmin(m, corner_sj2(x, 1, 2, 0));
-        m = fmin(m, corner_sj2(x, 2, 3, 1));
-        return fmin(m, corner_sj2(x, 3, 0, 2));
+        m = min_corner(m, corner_sj2(x, 0, 1, 3));
+        m = min_corner(m, corner_sj2(x, 1, 2, 0));
+        m = min_corner(m, corner_sj2(x, 2, 3, 1));
+        return min_corner(m, corner_sj2(x, 3, 0, 2));
     default:
         return 1.0; /* simplices: their mean ratio is their only corner */
     }
