@@ -211,8 +211,8 @@ static const unsigned char hex_corner_edges[8][3] = {
    cube_root_n, so every step is a vector instruction over corners or
    lanes and the Halley chains overlap.  always_inline: one copy per L (a
    shared copy with L unknown is not vectorised, measured 3x slower). */
-__attribute__((always_inline)) static inline void quality_hex_n(const double *restrict x, double *restrict q,
-                                 const int L)
+__attribute__((always_inline)) static inline void
+quality_hex_n(const double *restrict x, double *restrict q, const int L)
 {
     double e[12][3][GETME_LANES], l2[12][GETME_LANES];
     double det[8 * GETME_LANES], frob2[8 * GETME_LANES], c[8 * GETME_LANES];
