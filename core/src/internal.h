@@ -78,6 +78,9 @@ static inline int getme__has_corners(int type)
            type == GETME_PYRAMID || type == GETME_QUAD;
 }
 
+/* quality.c's cube root of one value (the one-element kernels'), for the
+   tests that check the batched kernels against it */
+double getme__cube_root(double x);
 double getme__quality_tet(const double *x);
 double getme__quality_hex(const double *x);
 double getme__quality_prism(const double *x);
@@ -94,6 +97,20 @@ void getme__transform_tet(const double *x, double sigma, double *out);
 /* Elements per batch of the lane kernels (*_lanes): 8 doubles, one
    AVX-512 register or two AVX2 ones. */
 #define GETME_LANES 8
+/* A build for any x86-64 CPU (GETME_NATIVE=OFF defines GETME_DISPATCH)
+   would run the lane kernels on SSE2, 2 doubles per instruction: they get
+   AVX2 and AVX-512 copies, chosen once at load time (ifunc).  Every copy
+   does the same IEEE operations (no fused multiply-add: -std=c11 means
+   -ffp-contract=off; vector square roots and divisions are correctly
+   rounded), so the bits do not depend on the copy (core_lanes runs the
+   machine's one against the one-element kernels).  Not in the native
+   build: there the kernels are inlined into their callers. */
+#if defined(GETME_DISPATCH) && defined(__x86_64__) && defined(__GNUC__) && \
+    !defined(__clang__)
+#define GETME_LANES_TARGETS __attribute__((target_clones("default", "avx2", "avx512f")))
+#else
+#define GETME_LANES_TARGETS
+#endif
 /* getme__transform_tet of GETME_LANES tets at once: x[3 i + d][l] is
    coordinate d of node i of tet l; out likewise.  Bit-identical per lane. */
 void getme__transform_tet_lanes(const double (*x)[GETME_LANES], double sigma,
@@ -105,6 +122,11 @@ void getme__transform_hex_lanes(const double (*x)[GETME_LANES], double sigma,
    lanes as above) into q; bit-identical per lane.  Returns 0 (nothing
    done) for a type without a lane kernel (only tets and hexes have one). */
 int getme__quality_lanes(int type, const double (*x)[GETME_LANES], double *q);
+/* getme__quality of n elements of type type stored one after the other
+   (x[3 nv e + 3 i + d]) into q[0..n): the lane kernels for full groups of
+   GETME_LANES tets or hexes (about 4x faster than one at a time,
+   bench/kernels.c), bit-identical to n calls of getme__quality. */
+void getme__qualities(int type, int32_t n, const double *x, double *q);
 void getme__transform_hex(const double *x, double sigma, double *out);
 void getme__transform_prism(const double *x, double sigma, double *out);
 void getme__transform_pyramid(const double *x, double sigma, double *out);

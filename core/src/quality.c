@@ -103,25 +103,35 @@ static inline double cube_root(double x)
     return y + (x / (y * y) - y) * (1.0 / 3.0);
 }
 
-/* cube_root() of 8 values at once.  The same operations in the same order
-   per value, so the results are bit-identical to cube_root(); written as
-   loops over the 8 lanes so that the compiler keeps the Halley and Newton
-   steps (4 divisions each) in vector registers.  Only the initial guess's
-   division by 3 stays scalar (no 64-bit vector multiply-high). */
-static inline void cube_root8(const double *x, double *y)
+double getme__cube_root(double x)
 {
-    uint64_t bits[8];
-    double y3[8];
-    memcpy(bits, x, sizeof bits);
-    for (int i = 0; i < 8; i++)
+    return cube_root(x);
+}
+
+/* cube_root() of n <= 8 GETME_LANES values at once (x and y do not
+   overlap).  The same operations in the same order per value, so the
+   results are bit-identical to cube_root(); the Halley and Newton steps
+   are one loop over all the values, so every step is a vector instruction
+   and the n independent chains overlap instead of waiting on each other's
+   divisions.  Only the initial guess's division by 3 stays scalar (there
+   is no 64-bit vector multiply-high; an exact vector version through
+   32-bit multiplies measured no faster, bench/kernels.c). */
+static inline void cube_root_n(const double *restrict x, double *restrict y,
+                               int n)
+{
+    uint64_t bits[8 * GETME_LANES];
+    memcpy(bits, x, sizeof(double) * (size_t)n);
+    for (int i = 0; i < n; i++)
         bits[i] = bits[i] / 3u + UINT64_C(0x2A9F7893782DA1CE);
-    memcpy(y, bits, sizeof bits);
-    for (int i = 0; i < 8; i++) {
-        y3[i] = y[i] * y[i] * y[i];
-        y[i] += y[i] * ((x[i] - y3[i]) / (2.0 * y3[i] + x[i]));
-        y3[i] = y[i] * y[i] * y[i];
-        y[i] += y[i] * ((x[i] - y3[i]) / (2.0 * y3[i] + x[i]));
-        y[i] = y[i] + (x[i] / (y[i] * y[i]) - y[i]) * (1.0 / 3.0);
+    memcpy(y, bits, sizeof(double) * (size_t)n);
+#pragma omp simd
+    for (int i = 0; i < n; i++) {
+        double yi = y[i], y3, xi = x[i];
+        y3 = yi * yi * yi;
+        yi += yi * ((xi - y3) / (2.0 * y3 + xi));
+        y3 = yi * yi * yi;
+        yi += yi * ((xi - y3) / (2.0 * y3 + xi));
+        y[i] = yi + (xi / (yi * yi) - yi) * (1.0 / 3.0);
     }
 }
 
@@ -169,31 +179,88 @@ double getme__quality_tet(const double *x)
 /* ---- hexahedron --------------------------------------------------------- */
 
 /* The paper's N^hex, zero-based; det = +1 on the unit cube in Gmsh order.
-   W = I: S_k = D_k.  The 8 corners go through one 8-lane cube root
-   (cube_root8), and their q_k are summed in corner order. */
-static const unsigned char hex_corners[8][4] = {
-    {0, 3, 4, 1}, {1, 0, 5, 2}, {2, 1, 6, 3}, {3, 2, 7, 0},
-    {4, 7, 5, 0}, {5, 4, 6, 1}, {6, 5, 7, 2}, {7, 6, 4, 3}};
+   W = I: S_k = D_k, the edges from node k to its three neighbours, in the
+   order (node; neighbours) = (0; 3 4 1) (1; 0 5 2) (2; 1 6 3) (3; 2 7 0)
+   (4; 7 5 0) (5; 4 6 1) (6; 5 7 2) (7; 6 4 3). */
+
+/*
+ * The corners' edge vectors are the 12 edges of the hex, each seen from
+ * both of its ends: corner k's edge to node j is +E or -E for the stored
+ * edge E = x[b] - x[a] between them, and x[j] - x[k] = -(x[k] - x[j])
+ * exactly.  So the 12 edges are subtracted once and squared once (|E|^2
+ * does not see the sign), and since negating an operand negates a
+ * correctly rounded product or sum exactly, det3(+-E1, +-E2, +-E3) is
+ * (the product of the signs) * det3(E1, E2, E3) to the bit, up to the sign
+ * of a zero det, which no caller can see (only det > 0 counts, and the
+ * cube root only of such a det).  For every corner: hex_corner_edges are
+ * the edges to its 3 neighbours in N^hex's order; the
+ * signs' product is -1 for the bottom corners 0-3, +1 for the top ones.
+ */
+static const unsigned char hex_edge_nodes[12][2] = {
+    {0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6},
+    {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
+static const unsigned char hex_corner_edges[8][3] = {
+    {3, 8, 0}, {0, 9, 1}, {1, 10, 2}, {2, 11, 3},
+    {7, 4, 8}, {4, 5, 9}, {5, 6, 10}, {6, 7, 11}};
+
+/* The mean ratio of L hexes whose coordinates are x[(3 i + d) L + l]
+   (node i, coordinate d, element l): L = 1 is one hex, L = GETME_LANES a
+   batch in lanes.  The same operations per corner as the textbook
+   kernel (edges, det3, sum of squared edge lengths, cube root, 3 c^2 /
+   frob2 summed in corner order); the 8 L determinants go through one
+   cube_root_n, so every step is a vector instruction over corners or
+   lanes and the Halley chains overlap.  always_inline: one copy per L (a
+   shared copy with L unknown is not vectorised, measured 3x slower). */
+__attribute__((always_inline)) static inline void
+quality_hex_n(const double *restrict x, double *restrict q, const int L)
+{
+    double e[12][3][GETME_LANES], l2[12][GETME_LANES];
+    double det[8 * GETME_LANES], frob2[8 * GETME_LANES], c[8 * GETME_LANES];
+    for (int k = 0; k < 12; k++) {
+        int a = 3 * hex_edge_nodes[k][0], b = 3 * hex_edge_nodes[k][1];
+#pragma omp simd
+        for (int l = 0; l < L; l++) {
+            for (int d = 0; d < 3; d++)
+                e[k][d][l] = x[(b + d) * L + l] - x[(a + d) * L + l];
+            l2[k][l] = e[k][0][l] * e[k][0][l] + e[k][1][l] * e[k][1][l] +
+                       e[k][2][l] * e[k][2][l];
+        }
+    }
+    for (int k = 0; k < 8; k++) {
+        double(*e1)[GETME_LANES] = e[hex_corner_edges[k][0]];
+        double(*e2)[GETME_LANES] = e[hex_corner_edges[k][1]];
+        double(*e3)[GETME_LANES] = e[hex_corner_edges[k][2]];
+        double sign = k < 4 ? -1.0 : 1.0;
+#pragma omp simd
+        for (int l = 0; l < L; l++) {
+            double d3 = e1[0][l] * (e2[1][l] * e3[2][l] - e2[2][l] * e3[1][l]) +
+                        e1[1][l] * (e2[2][l] * e3[0][l] - e2[0][l] * e3[2][l]) +
+                        e1[2][l] * (e2[0][l] * e3[1][l] - e2[1][l] * e3[0][l]);
+            det[k * L + l] = sign * d3;
+            frob2[k * L + l] = l2[hex_corner_edges[k][0]][l] +
+                               l2[hex_corner_edges[k][1]][l] +
+                               l2[hex_corner_edges[k][2]][l];
+        }
+    }
+    cube_root_n(det, c, 8 * L);
+#pragma omp simd
+    for (int l = 0; l < L; l++) {
+        double s = 0.0;
+        int ok = 1;
+        for (int k = 0; k < 8; k++) {
+            double ck = c[k * L + l];
+            s += 3.0 * ck * ck / frob2[k * L + l];
+            ok &= det[k * L + l] > 0.0;
+        }
+        q[l] = valid_or_zero(ok, 0.125 * s);
+    }
+}
 
 double getme__quality_hex(const double *x)
 {
-    double det[8], frob2[8], c[8];
-    for (int k = 0; k < 8; k++) {
-        double e1[3], e2[3], e3[3];
-        edge(x, hex_corners[k][0], hex_corners[k][1], e1);
-        edge(x, hex_corners[k][0], hex_corners[k][2], e2);
-        edge(x, hex_corners[k][0], hex_corners[k][3], e3);
-        det[k] = det3(e1, e2, e3);
-        frob2[k] = dot3(e1, e1) + dot3(e2, e2) + dot3(e3, e3);
-    }
-    cube_root8(det, c);
-    double s = 0.0;
-    int ok = 1;
-    for (int k = 0; k < 8; k++) {
-        s += 3.0 * c[k] * c[k] / frob2[k];
-        ok &= det[k] > 0.0;
-    }
-    return valid_or_zero(ok, 0.125 * s);
+    double q;
+    quality_hex_n(x, &q, 1);
+    return q;
 }
 
 /* ---- GETME_LANES elements at once --------------------------------------- */
@@ -201,68 +268,50 @@ double getme__quality_hex(const double *x)
 /* getme__quality_tet and getme__quality_hex of GETME_LANES elements, x in
    lanes (x[3 i + d][l]: coordinate d of node i of element l).  The same
    operations in the same order per lane as the one-element kernels, and
-   cube_root8 is bit-identical to cube_root, so every lane's q is the same
+   cube_root_n is bit-identical to cube_root, so every lane's q is the same
    bits; written as loops over the lanes so that they become vector
    instructions (the relaxation evaluates every element this way). */
-static void quality_tet_lanes(const double (*x)[GETME_LANES], double *q)
+__attribute__((always_inline)) static inline void
+quality_tet_lanes(const double (*x)[GETME_LANES], double *q)
 {
     enum { L = GETME_LANES };
     double det[L], frob2[L], c[L];
+    /* getme__quality_tet spelled out per coordinate: with small arrays
+       inside the lane loop gcc left it scalar */
 #pragma omp simd
     for (int l = 0; l < L; l++) {
-        double e1[3], e2[3], e3[3], s2[3], s3[3];
-        for (int d = 0; d < 3; d++) {
-            e1[d] = x[3 + d][l] - x[d][l];
-            e2[d] = x[6 + d][l] - x[d][l];
-            e3[d] = x[9 + d][l] - x[d][l];
-        }
-        for (int d = 0; d < 3; d++) {
-            s2[d] = (2.0 * e2[d] - e1[d]) * GETME_INV_SQRT3;
-            s3[d] = (3.0 * e3[d] - e1[d] - e2[d]) * GETME_INV_SQRT6;
-        }
-        det[l] = GETME_SQRT2 * det3(e1, e2, e3);
-        frob2[l] = dot3(e1, e1) + dot3(s2, s2) + dot3(s3, s3);
+        double e1x = x[3][l] - x[0][l], e1y = x[4][l] - x[1][l],
+               e1z = x[5][l] - x[2][l];
+        double e2x = x[6][l] - x[0][l], e2y = x[7][l] - x[1][l],
+               e2z = x[8][l] - x[2][l];
+        double e3x = x[9][l] - x[0][l], e3y = x[10][l] - x[1][l],
+               e3z = x[11][l] - x[2][l];
+        double s2x = (2.0 * e2x - e1x) * GETME_INV_SQRT3,
+               s2y = (2.0 * e2y - e1y) * GETME_INV_SQRT3,
+               s2z = (2.0 * e2z - e1z) * GETME_INV_SQRT3;
+        double s3x = (3.0 * e3x - e1x - e2x) * GETME_INV_SQRT6,
+               s3y = (3.0 * e3y - e1y - e2y) * GETME_INV_SQRT6,
+               s3z = (3.0 * e3z - e1z - e2z) * GETME_INV_SQRT6;
+        det[l] = GETME_SQRT2 * (e1x * (e2y * e3z - e2z * e3y) +
+                                e1y * (e2z * e3x - e2x * e3z) +
+                                e1z * (e2x * e3y - e2y * e3x));
+        frob2[l] = (e1x * e1x + e1y * e1y + e1z * e1z) +
+                   (s2x * s2x + s2y * s2y + s2z * s2z) +
+                   (s3x * s3x + s3y * s3y + s3z * s3z);
     }
-    cube_root8(det, c);
+    cube_root_n(det, c, L);
 #pragma omp simd
     for (int l = 0; l < L; l++)
         q[l] = valid_or_zero(det[l] > 0.0, 3.0 * c[l] * c[l] / frob2[l]);
 }
 
-static void quality_hex_lanes(const double (*x)[GETME_LANES], double *q)
+__attribute__((always_inline)) static inline void
+quality_hex_lanes(const double (*x)[GETME_LANES], double *q)
 {
-    enum { L = GETME_LANES };
-    double s[L];
-    int ok[L];
-    for (int l = 0; l < L; l++)
-        s[l] = 0.0, ok[l] = 1;
-    for (int k = 0; k < 8; k++) {
-        int a = 3 * hex_corners[k][0], b = 3 * hex_corners[k][1],
-            c1 = 3 * hex_corners[k][2], d1 = 3 * hex_corners[k][3];
-        double det[L], frob2[L], c[L];
-#pragma omp simd
-        for (int l = 0; l < L; l++) {
-            double e1[3], e2[3], e3[3];
-            for (int d = 0; d < 3; d++) {
-                e1[d] = x[b + d][l] - x[a + d][l];
-                e2[d] = x[c1 + d][l] - x[a + d][l];
-                e3[d] = x[d1 + d][l] - x[a + d][l];
-            }
-            det[l] = det3(e1, e2, e3);
-            frob2[l] = dot3(e1, e1) + dot3(e2, e2) + dot3(e3, e3);
-        }
-        cube_root8(det, c);
-#pragma omp simd
-        for (int l = 0; l < L; l++) {
-            s[l] += 3.0 * c[l] * c[l] / frob2[l];
-            ok[l] &= det[l] > 0.0;
-        }
-    }
-#pragma omp simd
-    for (int l = 0; l < L; l++)
-        q[l] = valid_or_zero(ok[l], 0.125 * s[l]);
+    quality_hex_n(&x[0][0], q, GETME_LANES);
 }
 
+GETME_LANES_TARGETS
 int getme__quality_lanes(int type, const double (*x)[GETME_LANES], double *q)
 {
     switch (type) {
@@ -270,6 +319,26 @@ int getme__quality_lanes(int type, const double (*x)[GETME_LANES], double *q)
     case GETME_HEX: quality_hex_lanes(x, q); return 1;
     default: return 0;
     }
+}
+
+/* n elements of one type, one after the other (x[3 nv e + 3 i + d], the
+   layout getme__quality takes one element in), GETME_LANES at a time
+   through the lane kernels where the type has one: for callers that
+   gather elements themselves and evaluate many (statistics, set-up). */
+void getme__qualities(int type, int32_t n, const double *x, double *q)
+{
+    int nv = (unsigned)type < (unsigned)GETME_NUM_TYPES ? getme__nv[type] : 0;
+    int32_t e = 0;
+    if (type == GETME_TET || type == GETME_HEX)
+        for (; e + GETME_LANES <= n; e += GETME_LANES) {
+            double xl[3 * GETME_MAX_NV][GETME_LANES];
+            for (int l = 0; l < GETME_LANES; l++)
+                for (int i = 0; i < 3 * nv; i++)
+                    xl[i][l] = x[3 * nv * (e + l) + i];
+            getme__quality_lanes(type, (const double(*)[GETME_LANES])xl, q + e);
+        }
+    for (; e < n; e++)
+        q[e] = getme__quality(type, x + 3 * nv * e);
 }
 
 /* ---- prism -------------------------------------------------------------- */
@@ -415,6 +484,50 @@ static inline double corner_sj3(const double *x, int a, int b, int c, int d,
     return l > 0.0 && isfinite(s) ? s : -1.0;
 }
 
+/* fmin(m, v) for numbers (never NaN, as the corner values are), without
+   the libm call gcc keeps for fmin: the smaller one, and fmin itself only
+   for equal values, where it picks between +0 and -0. */
+static inline double min_corner(double m, double v)
+{
+    return v < m ? v : v == m ? fmin(m, v) : m;
+}
+
+/* corner_sj3 of the 8 hex corners (scale 1), min'd in corner order: the
+   12 edges subtracted and squared once (hex_corner_edges), each corner's
+   three edge vectors with their signs (negation is exact, so det keeps
+   the bits of the textbook corner, the sign of a zero included), then
+   the 8 square roots and divisions in one vector loop. */
+static double corner_sj_hex(const double *x)
+{
+    double e[12][3], l2[12], a[3][3][8], l[8], v[8];
+    for (int k = 0; k < 12; k++) {
+        edge(x, hex_edge_nodes[k][0], hex_edge_nodes[k][1], e[k]);
+        l2[k] = dot3(e[k], e[k]);
+    }
+    for (int k = 0; k < 8; k++) {
+        /* the first edge of a corner points into it, the second away,
+           the third away from a bottom corner and into a top one */
+        double sg[3] = {-1.0, 1.0, k < 4 ? 1.0 : -1.0};
+        for (int j = 0; j < 3; j++)
+            for (int d = 0; d < 3; d++)
+                a[j][d][k] = sg[j] * e[hex_corner_edges[k][j]][d];
+        l[k] = l2[hex_corner_edges[k][0]] * l2[hex_corner_edges[k][1]] *
+               l2[hex_corner_edges[k][2]];
+    }
+#pragma omp simd
+    for (int k = 0; k < 8; k++) {
+        double det = a[0][0][k] * (a[1][1][k] * a[2][2][k] - a[1][2][k] * a[2][1][k]) +
+                     a[0][1][k] * (a[1][2][k] * a[2][0][k] - a[1][0][k] * a[2][2][k]) +
+                     a[0][2][k] * (a[1][0][k] * a[2][1][k] - a[1][1][k] * a[2][0][k]);
+        double sj = 1.0 * det / sqrt(l[k]);
+        v[k] = l[k] > 0.0 && isfinite(sj) ? sj : -1.0;
+    }
+    double m = 1.0;
+    for (int k = 0; k < 8; k++)
+        m = min_corner(m, v[k]);
+    return m;
+}
+
 static inline double corner_sj2(const double *x, int k, int next, int prev)
 {
     double l = len2_xy(x, k, next) * len2_xy(x, k, prev);
@@ -427,17 +540,14 @@ double getme__corner_sj(int type, const double *x)
     double m = 1.0;
     switch (type) {
     case GETME_HEX:
-        for (int k = 0; k < 8; k++)
-            m = fmin(m, corner_sj3(x, hex_corners[k][0], hex_corners[k][1],
-                                   hex_corners[k][2], hex_corners[k][3], 1.0));
-        return m;
+        return corner_sj_hex(x);
     case GETME_PRISM: {
         /* triangle corners span 60 degrees: 2/sqrt3 makes them 1 */
         static const unsigned char pc[6][4] = {{0, 1, 2, 3}, {1, 2, 0, 4},
                                                {2, 0, 1, 5}, {3, 5, 4, 0},
                                                {4, 3, 5, 1}, {5, 4, 3, 2}};
         for (int k = 0; k < 6; k++)
-            m = fmin(m, corner_sj3(x, pc[k][0], pc[k][1], pc[k][2], pc[k][3],
+            m = min_corner(m, corner_sj3(x, pc[k][0], pc[k][1], pc[k][2], pc[k][3],
                                    2.0 * GETME_INV_SQRT3));
         return m;
     }
@@ -446,15 +556,15 @@ double getme__corner_sj(int type, const double *x)
         static const unsigned char yc[4][3] = {{0, 1, 3}, {1, 2, 0},
                                                {2, 3, 1}, {3, 0, 2}};
         for (int k = 0; k < 4; k++)
-            m = fmin(m, corner_sj3(x, yc[k][0], yc[k][1], yc[k][2], 4,
+            m = min_corner(m, corner_sj3(x, yc[k][0], yc[k][1], yc[k][2], 4,
                                    GETME_SQRT2));
         return m;
     }
     case GETME_QUAD:
-        m = fmin(m, corner_sj2(x, 0, 1, 3));
-        m = fmin(m, corner_sj2(x, 1, 2, 0));
-        m = fmin(m, corner_sj2(x, 2, 3, 1));
-        return fmin(m, corner_sj2(x, 3, 0, 2));
+        m = min_corner(m, corner_sj2(x, 0, 1, 3));
+        m = min_corner(m, corner_sj2(x, 1, 2, 0));
+        m = min_corner(m, corner_sj2(x, 2, 3, 1));
+        return min_corner(m, corner_sj2(x, 3, 0, 2));
     default:
         return 1.0; /* simplices: their mean ratio is their only corner */
     }

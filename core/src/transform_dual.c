@@ -174,71 +174,75 @@ void getme__transform_hex(const double *x, double sigma, double *out)
 
 /* getme__transform_hex of GETME_LANES hexes at once (internal.h): the
    same operations in the same order per lane as dual_step and
-   getme__rescale3, as loops over the lanes (vector instructions), so
-   every lane's result is bit-identical to the one-element kernel's. */
+   getme__rescale3, so every lane's result is bit-identical to the
+   one-element kernel's.  Written in phases over all 8 nodes, each a loop
+   over the lanes (vector instructions): the 24 divisions by 3 of the
+   means side by side, then the 8 nodes' square roots and divisions side
+   by side (8 independent chains instead of one per node), then the
+   moves.  The differences c_j - m of a node's face centroids are taken
+   once each (dual_step takes each twice, as u of one triangle and v of
+   the next: the same values). */
+GETME_LANES_TARGETS
 void getme__transform_hex_lanes(const double (*x)[GETME_LANES], double sigma,
                                 double (*out)[GETME_LANES])
 {
     enum { L = GETME_LANES };
     const dual_topology *t = &hex_topo;
-    double c[6][3][L];
-    for (int f = 0; f < 6; f++)
+    double c[6][3][L], m[8][3][L], n[8][3][L], f[8][L], c0[3][L], sum_x[L];
+    /* the input's half of the scaling first: its 12 square roots overlap
+       the dual step's arithmetic */
+    getme__shape3_lanes(x, 8, 12, t->edges, c0, sum_x);
+    for (int fc = 0; fc < 6; fc++)
         for (int d = 0; d < 3; d++) {
-            double s[L];
+            const double *x0 = x[3 * t->face[fc][0] + d], *x1 = x[3 * t->face[fc][1] + d],
+                         *x2 = x[3 * t->face[fc][2] + d], *x3 = x[3 * t->face[fc][3] + d];
 #pragma omp simd
             for (int l = 0; l < L; l++)
-                s[l] = 0.0;
-            for (int j = 0; j < 4; j++) {
-                const double *xj = x[3 * t->face[f][j] + d];
-#pragma omp simd
-                for (int l = 0; l < L; l++)
-                    s[l] += xj[l];
-            }
+                c[fc][d][l] = (0.0 + x0[l] + x1[l] + x2[l] + x3[l]) / 4;
+        }
+    for (int i = 0; i < 8; i++)
+        for (int d = 0; d < 3; d++) {
+            const double *c0 = c[t->around[i][0]][d], *c1 = c[t->around[i][1]][d],
+                         *c2 = c[t->around[i][2]][d];
 #pragma omp simd
             for (int l = 0; l < L; l++)
-                c[f][d][l] = s[l] / 4;
+                m[i][d][l] = (0.0 + c0[l] + c1[l] + c2[l]) / 3;
         }
     for (int i = 0; i < 8; i++) {
-        double m[3][L], n[3][L];
-        for (int d = 0; d < 3; d++) {
-#pragma omp simd
-            for (int l = 0; l < L; l++)
-                m[d][l] = n[d][l] = 0.0;
-            for (int j = 0; j < 3; j++) {
-                const double *cj = c[t->around[i][j]][d];
-#pragma omp simd
-                for (int l = 0; l < L; l++)
-                    m[d][l] += cj[l];
-            }
-#pragma omp simd
-            for (int l = 0; l < L; l++)
-                m[d][l] /= 3;
-        }
-        for (int j = 0; j < 3; j++) {
-            double(*a)[L] = c[t->around[i][j]];
-            double(*b)[L] = c[t->around[i][(j + 1) % 3]];
-#pragma omp simd
-            for (int l = 0; l < L; l++) {
-                double u0 = a[0][l] - m[0][l], u1 = a[1][l] - m[1][l],
-                       u2 = a[2][l] - m[2][l];
-                double v0 = b[0][l] - m[0][l], v1 = b[1][l] - m[1][l],
-                       v2 = b[2][l] - m[2][l];
-                n[0][l] += 0.5 * (u1 * v2 - u2 * v1);
-                n[1][l] += 0.5 * (u2 * v0 - u0 * v2);
-                n[2][l] += 0.5 * (u0 * v1 - u1 * v0);
-            }
-        }
+        double(*a)[L] = c[t->around[i][0]], (*b)[L] = c[t->around[i][1]],
+        (*e)[L] = c[t->around[i][2]];
 #pragma omp simd
         for (int l = 0; l < L; l++) {
-            double nn = n[0][l] * n[0][l] + n[1][l] * n[1][l] + n[2][l] * n[2][l];
-            /* = sigma * getme__inv_sqrt_norm(n) */
-            double f = sigma * (1.0 / sqrt(sqrt(getme__at_least(nn, DBL_MIN))));
-            out[3 * i][l] = m[0][l] + f * n[0][l];
-            out[3 * i + 1][l] = m[1][l] + f * n[1][l];
-            out[3 * i + 2][l] = m[2][l] + f * n[2][l];
+            double ax = a[0][l] - m[i][0][l], ay = a[1][l] - m[i][1][l],
+                   az = a[2][l] - m[i][2][l];
+            double bx = b[0][l] - m[i][0][l], by = b[1][l] - m[i][1][l],
+                   bz = b[2][l] - m[i][2][l];
+            double ex = e[0][l] - m[i][0][l], ey = e[1][l] - m[i][1][l],
+                   ez = e[2][l] - m[i][2][l];
+            /* the triangles (a, b), (b, e), (e, a) in dual_step's order */
+            double n0 = 0.0 + 0.5 * (ay * bz - az * by);
+            double n1 = 0.0 + 0.5 * (az * bx - ax * bz);
+            double n2 = 0.0 + 0.5 * (ax * by - ay * bx);
+            n0 += 0.5 * (by * ez - bz * ey);
+            n1 += 0.5 * (bz * ex - bx * ez);
+            n2 += 0.5 * (bx * ey - by * ex);
+            n0 += 0.5 * (ey * az - ez * ay);
+            n1 += 0.5 * (ez * ax - ex * az);
+            n2 += 0.5 * (ex * ay - ey * ax);
+            n[i][0][l] = n0, n[i][1][l] = n1, n[i][2][l] = n2;
+            f[i][l] = n0 * n0 + n1 * n1 + n2 * n2;
         }
     }
-    getme__rescale3_lanes(out, x, 8, 12, t->edges);
+    for (int i = 0; i < 8; i++)
+#pragma omp simd
+        for (int l = 0; l < L; l++) /* = sigma * getme__inv_sqrt_norm(n) */
+            f[i][l] = sigma * (1.0 / sqrt(sqrt(getme__at_least(f[i][l], DBL_MIN))));
+    for (int i = 0; i < 8; i++)
+        for (int d = 0; d < 3; d++)
+#pragma omp simd
+            for (int l = 0; l < L; l++)
+                out[3 * i + d][l] = m[i][d][l] + f[i][l] * n[i][d][l];
+    getme__rescale3_lanes_out(out, 8, 12, t->edges, (const double(*)[L])c0, sum_x);
 }
 
 /* ---- prism -------------------------------------------------------------- */

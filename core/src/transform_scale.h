@@ -82,6 +82,43 @@ static inline void getme__rescale3(double *out, const double *x, int nv,
             out[3 * i + d] = c0[d] + f * (out[3 * i + d] - c[d]);
 }
 
+/* Centroid c and edge-length sum of GETME_LANES elements p in lanes, in
+   node and edge order (getme__rescale3's sums); each edge's square root
+   in the loop that squares it. */
+static inline void getme__shape3_lanes(const double (*p)[GETME_LANES], int nv, int ne,
+                                       const unsigned char (*edges)[2],
+                                       double (*c)[GETME_LANES], double *sum)
+{
+    double len[12][GETME_LANES];
+    for (int d = 0; d < 3; d++)
+        for (int l = 0; l < GETME_LANES; l++)
+            c[d][l] = 0.0;
+    for (int i = 0; i < nv; i++)
+        for (int d = 0; d < 3; d++)
+#pragma omp simd
+            for (int l = 0; l < GETME_LANES; l++)
+                c[d][l] += p[3 * i + d][l];
+    for (int d = 0; d < 3; d++)
+#pragma omp simd
+        for (int l = 0; l < GETME_LANES; l++)
+            c[d][l] /= nv;
+    for (int k = 0; k < ne; k++) {
+        const double *pa = p[3 * edges[k][0]], *pb = p[3 * edges[k][1]];
+#pragma omp simd
+        for (int l = 0; l < GETME_LANES; l++) {
+            double dx = pb[l] - pa[l], dy = pb[GETME_LANES + l] - pa[GETME_LANES + l],
+                   dz = pb[2 * GETME_LANES + l] - pa[2 * GETME_LANES + l];
+            len[k][l] = sqrt(dx * dx + dy * dy + dz * dz);
+        }
+    }
+    for (int l = 0; l < GETME_LANES; l++)
+        sum[l] = 0.0;
+    for (int k = 0; k < ne; k++)
+#pragma omp simd
+        for (int l = 0; l < GETME_LANES; l++)
+            sum[l] += len[k][l];
+}
+
 /*
  * getme__rescale3 for GETME_LANES elements at once, in lanes: out[3 i + d]
  * and x[3 i + d] hold coordinate d of node i of every lane's element.  The
@@ -89,59 +126,18 @@ static inline void getme__rescale3(double *out, const double *x, int nv,
  * node and edge order, the same divisions and square roots, no fused
  * multiply-adds under -std=c11), so every lane's result is bit-identical
  * to the one-element kernel's; written as loops over the lanes so that
- * they become vector instructions.
+ * they become vector instructions.  getme__rescale3_lanes_out takes the
+ * input's half (getme__shape3_lanes of x: centroid c0 and edge-length sum
+ * sum_x) from the caller, which can compute it before its own work so that
+ * those square roots overlap that work.
  */
-static inline void getme__rescale3_lanes(double (*out)[GETME_LANES],
-                                         const double (*x)[GETME_LANES],
-                                         int nv, int ne,
-                                         const unsigned char (*edges)[2])
+static inline void getme__rescale3_lanes_out(double (*out)[GETME_LANES], int nv,
+                                             int ne, const unsigned char (*edges)[2],
+                                             const double (*c0)[GETME_LANES],
+                                             const double *sum_x)
 {
-    double c[3][GETME_LANES], c0[3][GETME_LANES];
-    double sum_x[GETME_LANES], sum_out[GETME_LANES], f[GETME_LANES];
-    for (int d = 0; d < 3; d++)
-        for (int l = 0; l < GETME_LANES; l++)
-            c[d][l] = c0[d][l] = 0.0;
-    for (int i = 0; i < nv; i++)
-        for (int d = 0; d < 3; d++)
-#pragma omp simd
-            for (int l = 0; l < GETME_LANES; l++) {
-                c[d][l] += out[3 * i + d][l];
-                c0[d][l] += x[3 * i + d][l];
-            }
-    for (int d = 0; d < 3; d++)
-#pragma omp simd
-        for (int l = 0; l < GETME_LANES; l++) {
-            c[d][l] /= nv;
-            c0[d][l] /= nv;
-        }
-    double len[2][12][GETME_LANES]; /* squared, then plain edge lengths */
-    for (int k = 0; k < ne; k++) {
-        const double *xa = x[3 * edges[k][0]], *xb = x[3 * edges[k][1]];
-        const double *oa = out[3 * edges[k][0]], *ob = out[3 * edges[k][1]];
-#pragma omp simd
-        for (int l = 0; l < GETME_LANES; l++) {
-            double dx = xb[l] - xa[l], dy = xb[GETME_LANES + l] - xa[GETME_LANES + l],
-                   dz = xb[2 * GETME_LANES + l] - xa[2 * GETME_LANES + l];
-            double ex = ob[l] - oa[l], ey = ob[GETME_LANES + l] - oa[GETME_LANES + l],
-                   ez = ob[2 * GETME_LANES + l] - oa[2 * GETME_LANES + l];
-            len[0][k][l] = dx * dx + dy * dy + dz * dz;
-            len[1][k][l] = ex * ex + ey * ey + ez * ez;
-        }
-    }
-    for (int k = 0; k < ne; k++)
-#pragma omp simd
-        for (int l = 0; l < GETME_LANES; l++) {
-            len[0][k][l] = sqrt(len[0][k][l]);
-            len[1][k][l] = sqrt(len[1][k][l]);
-        }
-    for (int l = 0; l < GETME_LANES; l++)
-        sum_x[l] = sum_out[l] = 0.0;
-    for (int k = 0; k < ne; k++)
-#pragma omp simd
-        for (int l = 0; l < GETME_LANES; l++) {
-            sum_x[l] += len[0][k][l];
-            sum_out[l] += len[1][k][l];
-        }
+    double c[3][GETME_LANES], sum_out[GETME_LANES], f[GETME_LANES];
+    getme__shape3_lanes((const double(*)[GETME_LANES])out, nv, ne, edges, c, sum_out);
 #pragma omp simd
     for (int l = 0; l < GETME_LANES; l++)
         f[l] = sum_x[l] / getme__at_least(sum_out[l], DBL_MIN);
@@ -150,6 +146,17 @@ static inline void getme__rescale3_lanes(double (*out)[GETME_LANES],
 #pragma omp simd
             for (int l = 0; l < GETME_LANES; l++)
                 out[3 * i + d][l] = c0[d][l] + f[l] * (out[3 * i + d][l] - c[d][l]);
+}
+
+static inline void getme__rescale3_lanes(double (*out)[GETME_LANES],
+                                         const double (*x)[GETME_LANES],
+                                         int nv, int ne,
+                                         const unsigned char (*edges)[2])
+{
+    double c0[3][GETME_LANES], sum_x[GETME_LANES];
+    getme__shape3_lanes(x, nv, ne, edges, c0, sum_x);
+    getme__rescale3_lanes_out(out, nv, ne, edges, (const double(*)[GETME_LANES])c0,
+                              sum_x);
 }
 
 /* The same for a planar polygon of n nodes: perimeter and centroid in xy;

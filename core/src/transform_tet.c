@@ -52,6 +52,7 @@ void getme__transform_tet(const double *x, double sigma, double *out)
 
 /* The same operations as getme__transform_tet, in the same order per
    lane, as loops over GETME_LANES tets (vector instructions). */
+GETME_LANES_TARGETS
 void getme__transform_tet_lanes(const double (*x)[GETME_LANES], double sigma,
                                 double (*out)[GETME_LANES])
 {

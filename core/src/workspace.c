@@ -547,11 +547,28 @@ void getme__ws_store(getme_ws *ws, getme_mesh *mesh)
     getme__ho_store(ws, mesh);
 }
 
+/* GETME_LANES elements at a time through getme__qualities (the lane
+   kernels, about 4x faster for hexes) where a group is of one type and the
+   mesh is linear; getme__ws_quality one by one otherwise.  The same bits
+   either way. */
 void getme__ws_qualities(const getme_ws *ws, double *q)
 {
+    int32_t ngroups = (ws->ne + GETME_LANES - 1) / GETME_LANES;
 #pragma omp parallel for schedule(static) num_threads(ws->nt)
-    for (int32_t e = 0; e < ws->ne; e++)
-        q[e] = getme__ws_quality(ws, ws->x, e);
+    for (int32_t j = 0; j < ngroups; j++) {
+        int32_t e0 = j * GETME_LANES, e1 = e0 + GETME_LANES;
+        int t = getme__ws_type(ws, e0);
+        if (!ws->ho && e1 <= ws->tstart[t + 1]) {
+            double x[GETME_LANES * 3 * GETME_MAX_NV];
+            int nv = getme__nv[t];
+            for (int l = 0; l < GETME_LANES; l++)
+                getme__ws_gather(ws, ws->x, t, e0 + l, x + 3 * nv * l);
+            getme__qualities(t, GETME_LANES, x, q + e0);
+        } else {
+            for (int32_t e = e0; e < e1 && e < ws->ne; e++)
+                q[e] = getme__ws_quality(ws, ws->x, e);
+        }
+    }
 }
 
 /* Exact fixed-point sum (exact.h): the same bits for any thread count and

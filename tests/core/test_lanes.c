@@ -7,12 +7,19 @@
  * build independent if that holds exactly, so the test compares bits, not
  * values within a tolerance.
  *
+ * The hex mean ratio is also compared with the textbook kernel below
+ * (corner by corner: its three edges, det, squared lengths, the one-value
+ * cube root),
+ * because the library's one-element and lane kernels share their edges
+ * and cube roots across corners and must still give its bits.
+ *
  * Built from the core's sources (not libgetme), because it checks private
  * functions.
  */
 #include "check.h"
 #include "internal.h"
 
+#include <math.h>
 #include <stdint.h>
 #include <string.h>
 
@@ -34,6 +41,58 @@ static int same_bits(double a, double b)
     return memcmp(&a, &b, sizeof a) == 0;
 }
 
+/* The hex mean ratio one corner at a time (paper's N^hex, W = I). */
+static double ref_quality_hex(const double *x)
+{
+    static const int corner[8][4] = {{0, 3, 4, 1}, {1, 0, 5, 2}, {2, 1, 6, 3},
+                                     {3, 2, 7, 0}, {4, 7, 5, 0}, {5, 4, 6, 1},
+                                     {6, 5, 7, 2}, {7, 6, 4, 3}};
+    double s = 0.0;
+    int ok = 1;
+    for (int k = 0; k < 8; k++) {
+        double e[3][3];
+        for (int j = 0; j < 3; j++)
+            for (int d = 0; d < 3; d++)
+                e[j][d] = x[3 * corner[k][j + 1] + d] - x[3 * corner[k][0] + d];
+        double det = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) +
+                     e[0][1] * (e[1][2] * e[2][0] - e[1][0] * e[2][2]) +
+                     e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
+        double frob2 = 0.0;
+        for (int j = 0; j < 3; j++)
+            frob2 += e[j][0] * e[j][0] + e[j][1] * e[j][1] + e[j][2] * e[j][2];
+        double c = getme__cube_root(det);
+        s += 3.0 * c * c / frob2;
+        ok &= det > 0.0;
+    }
+    return ok && 0.125 * s > 0.0 ? 0.125 * s : 0.0;
+}
+
+/* The worst corner's scaled Jacobian of a hex, one corner at a time:
+   det / sqrt(|e1|^2 |e2|^2 |e3|^2), -1 for a zero edge or a non-finite
+   value, min'd with fmin from 1 in corner order. */
+static double ref_corner_sj_hex(const double *x)
+{
+    static const int corner[8][4] = {{0, 3, 4, 1}, {1, 0, 5, 2}, {2, 1, 6, 3},
+                                     {3, 2, 7, 0}, {4, 7, 5, 0}, {5, 4, 6, 1},
+                                     {6, 5, 7, 2}, {7, 6, 4, 3}};
+    double m = 1.0;
+    for (int k = 0; k < 8; k++) {
+        double e[3][3], len2[3];
+        for (int j = 0; j < 3; j++) {
+            for (int d = 0; d < 3; d++)
+                e[j][d] = x[3 * corner[k][j + 1] + d] - x[3 * corner[k][0] + d];
+            len2[j] = e[j][0] * e[j][0] + e[j][1] * e[j][1] + e[j][2] * e[j][2];
+        }
+        double det = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) +
+                     e[0][1] * (e[1][2] * e[2][0] - e[1][0] * e[2][2]) +
+                     e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
+        double l = len2[0] * len2[1] * len2[2];
+        double s = det / sqrt(l);
+        m = fmin(m, l > 0.0 && isfinite(s) ? s : -1.0);
+    }
+    return m;
+}
+
 /* Element l of a batch of type t: kind 0 the regular element, 1 moved a
    little, 2 moved a lot (often inverted), 3 two nodes on top of each
    other (degenerate); scaled and shifted far from the origin. */
@@ -52,7 +111,7 @@ static void element(int t, int kind, double *x)
 
 static void check_type(int t)
 {
-    int nv = getme__nv[t], ok_q = 1, ok_t = 1;
+    int nv = getme__nv[t], ok_q = 1, ok_t = 1, ok_ref = 1;
     for (int batch = 0; batch < 2000; batch++) {
         double x[GETME_LANES][3 * GETME_MAX_NV], xl[3 * GETME_MAX_NV][GETME_LANES];
         double yl[3 * GETME_MAX_NV][GETME_LANES], ql[GETME_LANES];
@@ -69,6 +128,9 @@ static void check_type(int t)
         for (int l = 0; l < GETME_LANES; l++) {
             double y[3 * GETME_MAX_NV];
             ok_q &= same_bits(ql[l], getme__quality(t, x[l]));
+            if (t == GETME_HEX)
+                ok_ref &= same_bits(ql[l], ref_quality_hex(x[l])) &
+                          same_bits(getme__corner_sj(t, x[l]), ref_corner_sj_hex(x[l]));
             getme__transform(t, x[l], 0.3, y);
             for (int i = 0; i < 3 * nv; i++)
                 ok_t &= same_bits(yl[i][l], y[i]);
@@ -76,10 +138,37 @@ static void check_type(int t)
     }
     CHECK(ok_q);
     CHECK(ok_t);
+    CHECK(ok_ref);
+    if (t == GETME_HEX) { /* flat hex: every det is a zero, of either sign */
+        double x[3 * GETME_MAX_NV];
+        for (int i = 0; i < 3 * nv; i++)
+            x[i] = i % 3 == 2 ? 0.0 : regular[t][i] - 0.5;
+        CHECK(same_bits(getme__corner_sj(t, x), ref_corner_sj_hex(x)));
+        CHECK(same_bits(getme__quality(t, x), ref_quality_hex(x)));
+        CHECK(getme__quality(t, x) == 0.0);
+    }
+}
+
+/* getme__qualities (the batch entry point): 2 full groups of lanes and 3
+   more elements, against one getme__quality call each, for every type */
+static void check_qualities(int t)
+{
+    int nv = getme__nv[t], ok = 1;
+    double xs[19][3 * GETME_MAX_NV], flat[19 * 3 * GETME_MAX_NV], qs[19];
+    for (int e = 0; e < 19; e++) {
+        element(t, e % 4, xs[e]);
+        memcpy(flat + 3 * nv * e, xs[e], sizeof(double) * 3 * (size_t)nv);
+    }
+    getme__qualities(t, 19, flat, qs);
+    for (int e = 0; e < 19; e++)
+        ok &= same_bits(qs[e], getme__quality(t, xs[e]));
+    CHECK(ok);
 }
 
 int main(void)
 {
+    for (int t = 0; t < GETME_NUM_TYPES; t++)
+        check_qualities(t);
     check_type(GETME_TET);
     check_type(GETME_HEX);
     double xl[3 * GETME_MAX_NV][GETME_LANES] = {{0.0}}, q[GETME_LANES];

@@ -1,0 +1,16 @@
+#!/bin/sh
+# Build and run bench/kernels.c (the per-element kernels alone, one
+# thread) with libgetme's own compile flags (core/CMakeLists.txt):
+#     bench/kernels.sh [evaluations per kernel]
+# SRC=other checkout measures another tree's kernels with the same driver.
+set -e
+here=$(cd "$(dirname "$0")/.." && pwd)
+src=${SRC:-$here}
+out=${OUT:-/tmp/getme-kernels-$$}
+gcc -std=c11 -O3 -fno-math-errno ${MARCH--march=native} -fopenmp -Wall -Wextra \
+    -I"$src/core/include" -I"$src/core/src" "$here/bench/kernels.c" \
+    "$src/core/src/quality.c" "$src/core/src/transform.c" \
+    "$src/core/src/transform_tet.c" "$src/core/src/transform_dual.c" \
+    "$src/core/src/transform_polygon.c" -lm -o "$out"
+OMP_NUM_THREADS=1 taskset -c "${CPU:-0}" "$out" "$@"
+rm -f "$out"
