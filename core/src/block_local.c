@@ -30,6 +30,16 @@ void getme__blocks_free(getme_blocks *blk)
     memset(blk, 0, sizeof *blk);
 }
 
+void getme__blocks_free_local(getme_blocks *blk)
+{
+    free(blk->nptr);
+    free(blk->nodes);
+    free(blk->lconn);
+    blk->nptr = NULL;
+    blk->nodes = NULL;
+    blk->lconn = NULL;
+}
+
 /* Block b's distinct nodes: with list == NULL only counted; else listed
    into list and each element node's local index written to lconn. */
 static int32_t block_nodes(const getme_ws *ws, int32_t b, int32_t *mark,

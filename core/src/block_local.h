@@ -75,6 +75,11 @@ typedef struct getme_blocks {
    GETME_ERR_NOMEM. */
 getme_status getme__blocks_build(getme_blocks *blk, const getme_ws *ws);
 void getme__blocks_free(getme_blocks *blk);
+/* Free only the blocks' node lists and local connectivity (nptr, nodes,
+   lconn: ~10 B per tet, ~18 B per hex), which only the q_mean stage's
+   block kernel reads; the visiting order and the scratch stay for the
+   sweeps of the q*_min stage (getme__blocks_run). */
+void getme__blocks_free_local(getme_blocks *blk);
 
 /* f(ctx, b) for every block b of ws, in blk's race-free order, on
    ws->nt threads (blocks running at the same time share no node).  Returns

@@ -866,9 +866,10 @@ getme_status getme__adaptive(getme_run *run)
             best_min = q_min; /* the end of stage 1 is the first candidate */
             getme__best_take(&best, ws);
             /* Only the q_mean stage's scatter_all uses the block kernel's
-               local connectivity: freed before the q*_min stage's lists
-               grow (10 B per tet, 18 B per hex less at the peak). */
-            getme__blocks_free(&run->adj->blk);
+               node lists and local connectivity: freed before the q*_min
+               stage's lists grow (10 B per tet, 18 B per hex less at the
+               peak); the blocks' order stays for the later sweeps. */
+            getme__blocks_free_local(&run->adj->blk);
         }
         if (state == MIN_RUNNING) {
             if (!(q_min > prev_min + p->min_tol))
