@@ -230,6 +230,7 @@ static ranked *pass_list(const getme_run *run, double bound, int32_t *count)
 {
     const getme_ws *ws = run->ws;
     int32_t n = 0;
+#pragma omp parallel for schedule(static) num_threads(ws->nt) reduction(+ : n)
     for (int32_t e = 0; e < ws->ne; e++)
         n += ws->free_elem[e] && run->q[e] <= bound;
     ranked *r = malloc((size_t)(n ? n : 1) * sizeof *r);
