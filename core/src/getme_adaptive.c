@@ -718,10 +718,13 @@ double getme__threshold(getme_run *run, double fraction, int32_t min_count)
     if (n == 0)
         return 0.0;
     int64_t k = getme__quantile_pos(n, fraction, min_count);
-    /* the histogram, then one per thread */
-    int64_t *hist = malloc((size_t)(ws->nt + 1) * 65536 * sizeof *hist);
-    if (getme__dist_any(run, hist == NULL)) { /* all stop, not only this one */
+    /* the histogram (dist/test_fail_alloc.c fails this malloc by its
+       size), and one per thread */
+    int64_t *hist = malloc(65536 * sizeof *hist);
+    int64_t *part = malloc((size_t)ws->nt * 65536 * sizeof *part);
+    if (getme__dist_any(run, !hist || !part)) { /* all stop, not only this one */
         free(hist);
+        free(part);
         return -1.0;
     }
     uint64_t prefix = 0, mask = 0;
@@ -730,7 +733,7 @@ double getme__threshold(getme_run *run, double fraction, int32_t min_count)
        levels pin all 64 bits, so no process needs the candidates. */
     int last = run->comm ? 0 : 32;
     for (int shift = 48; shift >= last; shift -= 16) {
-        threshold_hist(run, shift, mask, prefix, hist, hist + 65536);
+        threshold_hist(run, shift, mask, prefix, hist, part);
         getme__dist_sum_i64(run, hist, 65536);
         int64_t below = 0;
         int bin = 0;
@@ -742,6 +745,7 @@ double getme__threshold(getme_run *run, double fraction, int32_t min_count)
         mask |= (uint64_t)0xffff << shift;
     }
     free(hist);
+    free(part);
     if (run->comm) {
         double qt;
         memcpy(&qt, &prefix, sizeof qt);
