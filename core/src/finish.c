@@ -50,6 +50,99 @@ static int cmp_ranked(const void *a, const void *b)
     return (x->e > y->e) - (x->e < y->e);
 }
 
+/*
+ * A memo of failed single-node climbs.  A climb that keeps no step leaves
+ * everything as it was (trial moves are undone bit for bit), and whether
+ * it keeps one depends only on the coordinates of the nodes of the node's
+ * star, on the patch's loss, and on its budget through -min(loss * gain,
+ * budget) (patch.c, trial): with the same loss, no node of the star moved
+ * since, and either a budget no larger than then or every trial's
+ * loss * gain below the budget then (the budget did not matter), the same
+ * climb fails again, so it is skipped.  Later passes and the second sweep
+ * of the next pass revisit many unchanged stars; the moves made, and so
+ * the output, are exactly those without the memo.
+ */
+typedef struct fail_record {
+    uint32_t stamp; /* moves kept before the failure */
+    double loss, budget, allowed_max;
+} fail_record;
+
+typedef struct climb_memo {
+    uint32_t stamp;      /* moves kept so far */
+    uint32_t *moved;     /* per node: stamp of its last kept move, 0: none */
+    uint32_t *record;    /* per node: 1 + its record's index, 0: none */
+    fail_record *rec;
+    uint32_t num_rec, cap_rec;
+} climb_memo;
+
+static void memo_free(climb_memo *m)
+{
+    free(m->moved);
+    free(m->record);
+    free(m->rec);
+}
+
+/* The memo for ws's nodes; 0, or -1 without memory (then none is used). */
+static int memo_init(climb_memo *m, const getme_ws *ws)
+{
+    memset(m, 0, sizeof *m);
+    m->moved = calloc((size_t)ws->nn + 1, sizeof *m->moved);
+    m->record = calloc((size_t)ws->nn + 1, sizeof *m->record);
+    if (!m->moved || !m->record) {
+        memo_free(m);
+        return -1;
+    }
+    return 0;
+}
+
+static void memo_moved(climb_memo *m, const int32_t *mv, int k)
+{
+    if (!m)
+        return;
+    m->stamp++;
+    for (int j = 0; j < k; j++)
+        m->moved[mv[j]] = m->stamp;
+}
+
+static void memo_failed(climb_memo *m, const getme_patch *p, int32_t node)
+{
+    if (!m)
+        return;
+    if (!m->record[node]) {
+        if (m->num_rec == m->cap_rec) {
+            uint32_t cap = m->cap_rec ? 2 * m->cap_rec : 1024;
+            fail_record *r = realloc(m->rec, cap * sizeof *r);
+            if (!r)
+                return; /* not remembered: it is climbed again */
+            m->rec = r, m->cap_rec = cap;
+        }
+        m->record[node] = ++m->num_rec;
+    }
+    m->rec[m->record[node] - 1] =
+        (fail_record){m->stamp, p->loss, p->budget, p->allowed_max};
+}
+
+/* 1 if climbing node alone is known to keep no step (see above). */
+static int memo_fails(const climb_memo *m, const getme_ws *ws,
+                      const getme_patch *p, int32_t node)
+{
+    if (!m || !m->record[node])
+        return 0;
+    const fail_record *r = &m->rec[m->record[node] - 1];
+    if (r->loss != p->loss ||
+        !(p->budget <= r->budget || r->allowed_max <= r->budget))
+        return 0;
+    for (int64_t s = ws->star_ptr[node]; s < ws->star_ptr[node + 1]; s++) {
+        int32_t e = ws->star[s];
+        int t = getme__ws_type(ws, e);
+        const int32_t *c = getme__ws_nodes(ws, t, e);
+        for (int i = 0; i < getme__nv[t]; i++)
+            if (m->moved[c[i]] > r->stamp)
+                return 0;
+    }
+    return 1;
+}
+
 /* Put the elements around the k nodes mv into the patch (each once). */
 static getme_status fill(getme_run *run, getme_patch *p, const int32_t *mv,
                          int k)
@@ -80,8 +173,9 @@ static void store(getme_run *run, const getme_patch *p)
         run->q[p->id[i]] = p->q[i];
 }
 
-/* Work on element e. */
-static getme_status improve(getme_run *run, getme_patch *p, int32_t e)
+/* Work on element e (memo: failed climbs, or NULL). */
+static getme_status improve(getme_run *run, getme_patch *p, climb_memo *memo,
+                            int32_t e)
 {
     const getme_ws *ws = run->ws;
     int t = getme__ws_type(ws, e);
@@ -94,10 +188,17 @@ static getme_status improve(getme_run *run, getme_patch *p, int32_t e)
     double q0 = run->q[e];
     getme_status st;
     for (int j = 0; j < k; j++) {
+        if (memo_fails(memo, ws, p, mv[j]))
+            continue;
         if ((st = fill(run, p, &mv[j], 1)) != GETME_OK)
             return st;
-        if (getme__patch_climb(p, &mv[j], 1, 8, 1))
+        p->allowed_max = -INFINITY;
+        if (getme__patch_climb(p, &mv[j], 1, 8, 1)) {
             store(run, p);
+            memo_moved(memo, &mv[j], 1);
+        } else {
+            memo_failed(memo, p, mv[j]);
+        }
     }
     if (k >= 2 && !(run->q[e] > q0)) {
         if ((st = fill(run, p, mv, k)) != GETME_OK)
@@ -113,8 +214,10 @@ static getme_status improve(getme_run *run, getme_patch *p, int32_t e)
             }
         int moved = getme__patch_toward(p, mv, k, tg);
         moved += getme__patch_climb(p, mv, k, 4, 1);
-        if (moved)
+        if (moved) {
             store(run, p);
+            memo_moved(memo, mv, k);
+        }
     }
     return GETME_OK;
 }
@@ -257,6 +360,11 @@ getme_status getme__finish(getme_run *run)
     p.ws = ws;
     p.guard = run->guard;
     p.floor = run->corner_floor;
+    /* no memo for second-order elements: their validity also reads the
+       mid-edge nodes */
+    climb_memo memo_store, *memo = NULL;
+    if (!ws->ho && memo_init(&memo_store, ws) == 0)
+        memo = &memo_store;
     double q_mean, q_min;
     getme__finish_summary(run, &q_mean, &q_min, NULL);
     getme_status st = GETME_OK;
@@ -288,7 +396,7 @@ getme_status getme__finish(getme_run *run)
             p.loss = sweep ? GETME_PATCH_LOSS : 0.0;
             for (int32_t i = 0; i < n && st == GETME_OK; i++)
                 if (run->q[list[i].e] <= bound)
-                    st = improve(run, &p, list[i].e);
+                    st = improve(run, &p, memo, list[i].e);
         }
         /* Raised over the pass, whichever sweep did it (the list keeps
            each element's quality at the pass's start). */
@@ -310,5 +418,7 @@ getme_status getme__finish(getme_run *run)
             break;
     }
     getme__patch_free(&p);
+    if (memo)
+        memo_free(memo);
     return st;
 }

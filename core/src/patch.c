@@ -190,6 +190,7 @@ static int trial(getme_patch *p, double cur)
     }
     double change = sum_new - sum_old, allowed = (m - cur) * p->loss;
     p->change = change;
+    p->allowed_max = allowed > p->allowed_max ? allowed : p->allowed_max;
     return change >= -(allowed < p->budget ? allowed : p->budget);
 }
 
