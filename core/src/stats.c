@@ -112,7 +112,6 @@ static void merge(partial *to, const partial *p)
 static void block_stats(const getme_mesh *mesh, const getme_block *bl,
                         const double *q, partial *part, int nt, partial *all)
 {
-    int nv = getme__nv[bl->type];
     for (int k = 0; k < nt; k++)
         partial_init(&part[k]);
 #pragma omp parallel num_threads(nt)
@@ -121,13 +120,9 @@ static void block_stats(const getme_mesh *mesh, const getme_block *bl,
         partial_init(&p);
         /* static: thread k's elements come before thread k + 1's */
 #pragma omp for schedule(static)
-        for (int32_t e = 0; e < bl->count; e++) {
-            const int32_t *c = bl->conn + (int64_t)e * nv;
-            int has_free = 0;
-            for (int i = 0; i < nv; i++)
-                has_free |= !mesh->fixed[c[i]];
-            add_value(&p, q[bl->first + e], has_free, bl->first + e);
-        }
+        for (int32_t e = 0; e < bl->count; e++)
+            add_value(&p, q[bl->first + e], getme__local_has_free(mesh, bl, e),
+                      bl->first + e);
         part[omp_get_thread_num()] = p;
     }
     for (int k = 0; k < nt; k++)

@@ -188,7 +188,6 @@ static getme_status worst_sweep(const getme_mesh *mesh, const double *q,
     }
     for (int b = 0; b < mesh->num_blocks; b++) {
         const getme_block *bl = &mesh->blocks[b];
-        int nv = getme__nv[bl->type];
         for (int k = 0; k < nt; k++)
             cnt[k] = 0;
 #pragma omp parallel num_threads(nt)
@@ -197,11 +196,7 @@ static getme_status worst_sweep(const getme_mesh *mesh, const double *q,
             getme_worst_element *w = part + (int64_t)k * max;
 #pragma omp for schedule(static)
             for (int32_t e = 0; e < bl->count; e++) {
-                const int32_t *c = bl->conn + (int64_t)e * nv;
-                int free_node = 0;
-                for (int i = 0; i < nv; i++)
-                    free_node |= !mesh->fixed[c[i]];
-                if (!free_only || free_node)
+                if (!free_only || getme__local_has_free(mesh, bl, e))
                     keep_worst(w, &cnt[k], max, q[bl->first + e],
                                bl->first + e);
             }
