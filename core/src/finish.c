@@ -50,6 +50,155 @@ static int cmp_ranked(const void *a, const void *b)
     return (x->e > y->e) - (x->e < y->e);
 }
 
+/*
+ * A memo of failed single-node climbs.  A climb that keeps no step leaves
+ * everything as it was (trial moves are undone bit for bit), and whether
+ * it keeps one depends only on the coordinates of the nodes of the node's
+ * star, on the patch's loss, and on its budget through -min(loss * gain,
+ * budget) (patch.c, trial): with the same loss, no node of the star moved
+ * since, and either a budget no larger than then or every trial's
+ * loss * gain below the budget then (the budget did not matter), the same
+ * climb fails again, so it is skipped.  Later passes and the second sweep
+ * of the next pass revisit many unchanged stars; the moves made, and so
+ * the output, are exactly those without the memo.
+ */
+typedef struct fail_record {
+    uint32_t stamp; /* moves kept before the failure */
+    double loss, budget, allowed_max;
+} fail_record;
+
+/* A node's entry: only nodes that moved or failed have one, a few per
+   listed element, so an open-addressing table instead of arrays over all
+   nodes (the step runs when the mesh's memory is at its peak). */
+typedef struct memo_slot {
+    int32_t node;   /* -1: empty */
+    uint32_t moved; /* stamp of its last kept move, 0: none */
+    uint32_t rec;   /* 1 + its failure's index in rec, 0: none */
+} memo_slot;
+
+typedef struct climb_memo {
+    uint32_t stamp; /* moves kept so far */
+    memo_slot *slot;
+    uint32_t cap, used; /* cap a power of two, used <= cap / 2 */
+    fail_record *rec;
+    uint32_t num_rec, cap_rec;
+} climb_memo;
+
+static void memo_free(climb_memo *m)
+{
+    free(m->slot);
+    free(m->rec);
+}
+
+static int memo_alloc(climb_memo *m, uint32_t cap)
+{
+    m->slot = malloc((size_t)cap * sizeof *m->slot);
+    if (!m->slot)
+        return -1;
+    for (uint32_t i = 0; i < cap; i++)
+        m->slot[i] = (memo_slot){-1, 0, 0};
+    m->cap = cap, m->used = 0;
+    return 0;
+}
+
+/* 0, or -1 without memory (then no memo is used). */
+static int memo_init(climb_memo *m)
+{
+    memset(m, 0, sizeof *m);
+    return memo_alloc(m, 4096);
+}
+
+/* The entry of node, created if add (NULL if absent, or no memory). */
+static memo_slot *memo_at(climb_memo *m, int32_t node, int add)
+{
+    uint32_t mask = m->cap - 1, i = ((uint32_t)node * 2654435761u) & mask;
+    while (m->slot[i].node >= 0 && m->slot[i].node != node)
+        i = (i + 1) & mask;
+    if (m->slot[i].node == node || !add)
+        return m->slot[i].node == node ? &m->slot[i] : NULL;
+    if (2 * (m->used + 1) > m->cap) { /* grow: rehash into twice the room */
+        climb_memo old = *m;
+        if (memo_alloc(m, 2 * old.cap) != 0) {
+            *m = old;
+            return NULL;
+        }
+        for (uint32_t k = 0; k < old.cap; k++)
+            if (old.slot[k].node >= 0)
+                *memo_at(m, old.slot[k].node, 1) = old.slot[k];
+        free(old.slot);
+        return memo_at(m, node, 1);
+    }
+    m->used++;
+    m->slot[i] = (memo_slot){node, 0, 0};
+    return &m->slot[i];
+}
+
+/* A kept move of the k nodes mv; 0, or -1 without memory (then the memo
+   must no longer be used: it would miss this move). */
+static int memo_moved(climb_memo *m, const int32_t *mv, int k)
+{
+    m->stamp++;
+    for (int j = 0; j < k; j++) {
+        memo_slot *s = memo_at(m, mv[j], 1);
+        if (!s)
+            return -1;
+        s->moved = m->stamp;
+    }
+    return 0;
+}
+
+static void memo_failed(climb_memo *m, const getme_patch *p, int32_t node)
+{
+    memo_slot *s = memo_at(m, node, 1);
+    if (!s)
+        return; /* not remembered: it is climbed again */
+    if (!s->rec) {
+        if (m->num_rec == m->cap_rec) {
+            uint32_t cap = m->cap_rec ? 2 * m->cap_rec : 1024;
+            fail_record *r = realloc(m->rec, cap * sizeof *r);
+            if (!r)
+                return;
+            m->rec = r, m->cap_rec = cap;
+        }
+        s->rec = ++m->num_rec;
+    }
+    m->rec[s->rec - 1] =
+        (fail_record){m->stamp, p->loss, p->budget, p->allowed_max};
+}
+
+/* 1 if climbing node alone is known to keep no step (see above). */
+static int memo_fails(climb_memo *m, const getme_ws *ws, const getme_patch *p,
+                      int32_t node)
+{
+    const memo_slot *s = m ? memo_at(m, node, 0) : NULL;
+    if (!s || !s->rec)
+        return 0;
+    const fail_record *r = &m->rec[s->rec - 1];
+    if (r->loss != p->loss ||
+        !(p->budget <= r->budget || r->allowed_max <= r->budget))
+        return 0;
+    for (int64_t j = ws->star_ptr[node]; j < ws->star_ptr[node + 1]; j++) {
+        int32_t e = ws->star[j];
+        int t = getme__ws_type(ws, e);
+        const int32_t *c = getme__ws_nodes(ws, t, e);
+        for (int i = 0; i < getme__nv[t]; i++) {
+            const memo_slot *o = memo_at(m, c[i], 0);
+            if (o && o->moved > r->stamp)
+                return 0;
+        }
+    }
+    return 1;
+}
+
+/* Drop the memo (for good) if c: it missed a move. */
+static void forget_if(climb_memo **memo, int c)
+{
+    if (c) {
+        memo_free(*memo);
+        *memo = NULL;
+    }
+}
+
 /* Put the elements around the k nodes mv into the patch (each once). */
 static getme_status fill(getme_run *run, getme_patch *p, const int32_t *mv,
                          int k)
@@ -80,8 +229,9 @@ static void store(getme_run *run, const getme_patch *p)
         run->q[p->id[i]] = p->q[i];
 }
 
-/* Work on element e. */
-static getme_status improve(getme_run *run, getme_patch *p, int32_t e)
+/* Work on element e (*memo: failed climbs, or NULL). */
+static getme_status improve(getme_run *run, getme_patch *p,
+                            climb_memo **memo, int32_t e)
 {
     const getme_ws *ws = run->ws;
     int t = getme__ws_type(ws, e);
@@ -94,10 +244,17 @@ static getme_status improve(getme_run *run, getme_patch *p, int32_t e)
     double q0 = run->q[e];
     getme_status st;
     for (int j = 0; j < k; j++) {
+        if (memo_fails(*memo, ws, p, mv[j]))
+            continue;
         if ((st = fill(run, p, &mv[j], 1)) != GETME_OK)
             return st;
-        if (getme__patch_climb(p, &mv[j], 1, 8, 1))
+        p->allowed_max = -INFINITY;
+        if (getme__patch_climb(p, &mv[j], 1, 8, 1)) {
             store(run, p);
+            forget_if(memo, *memo && memo_moved(*memo, &mv[j], 1) != 0);
+        } else if (*memo) {
+            memo_failed(*memo, p, mv[j]);
+        }
     }
     if (k >= 2 && !(run->q[e] > q0)) {
         if ((st = fill(run, p, mv, k)) != GETME_OK)
@@ -113,8 +270,10 @@ static getme_status improve(getme_run *run, getme_patch *p, int32_t e)
             }
         int moved = getme__patch_toward(p, mv, k, tg);
         moved += getme__patch_climb(p, mv, k, 4, 1);
-        if (moved)
+        if (moved) {
             store(run, p);
+            forget_if(memo, *memo && memo_moved(*memo, mv, k) != 0);
+        }
     }
     return GETME_OK;
 }
@@ -230,6 +389,7 @@ static ranked *pass_list(const getme_run *run, double bound, int32_t *count)
 {
     const getme_ws *ws = run->ws;
     int32_t n = 0;
+#pragma omp parallel for schedule(static) num_threads(ws->nt) reduction(+ : n)
     for (int32_t e = 0; e < ws->ne; e++)
         n += ws->free_elem[e] && run->q[e] <= bound;
     ranked *r = malloc((size_t)(n ? n : 1) * sizeof *r);
@@ -256,6 +416,11 @@ getme_status getme__finish(getme_run *run)
     p.ws = ws;
     p.guard = run->guard;
     p.floor = run->corner_floor;
+    /* no memo for second-order elements: their validity also reads the
+       mid-edge nodes */
+    climb_memo memo_store, *memo = NULL;
+    if (!ws->ho && memo_init(&memo_store) == 0)
+        memo = &memo_store;
     double q_mean, q_min;
     getme__finish_summary(run, &q_mean, &q_min, NULL);
     getme_status st = GETME_OK;
@@ -287,7 +452,7 @@ getme_status getme__finish(getme_run *run)
             p.loss = sweep ? GETME_PATCH_LOSS : 0.0;
             for (int32_t i = 0; i < n && st == GETME_OK; i++)
                 if (run->q[list[i].e] <= bound)
-                    st = improve(run, &p, list[i].e);
+                    st = improve(run, &p, &memo, list[i].e);
         }
         /* Raised over the pass, whichever sweep did it (the list keeps
            each element's quality at the pass's start). */
@@ -309,5 +474,7 @@ getme_status getme__finish(getme_run *run)
             break;
     }
     getme__patch_free(&p);
+    if (memo)
+        memo_free(memo);
     return st;
 }

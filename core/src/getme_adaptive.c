@@ -423,6 +423,7 @@ static getme_status start_tlist(getme_run *run, double qt)
 {
     const getme_ws *ws = run->ws;
     int32_t n = 0;
+#pragma omp parallel for schedule(static) num_threads(ws->nt) reduction(+ : n)
     for (int32_t e = 0; e < ws->ne; e++) {
         run->tflag[e] =
             ws->free_elem[e] && getme__owned(run, e) && run->q[e] <= qt;
@@ -667,6 +668,36 @@ static inline uint64_t bits_of(double v)
     return b;
 }
 
+/* The histogram pass of getme__threshold at bits shift..shift + 15 of the
+   free elements whose bits under mask are prefix, into hist: one
+   histogram per thread (part, zeroed, 65536 counts per thread), added bin
+   by bin; integer counts, so the same for any thread count. */
+static void threshold_hist(const getme_run *run, int shift, uint64_t mask,
+                           uint64_t prefix, int64_t *hist, int64_t *part)
+{
+    const getme_ws *ws = run->ws;
+    int nt = ws->nt;
+    memset(part, 0, (size_t)nt * 65536 * sizeof *part);
+#pragma omp parallel num_threads(nt)
+    {
+        int64_t *h = part + (int64_t)omp_get_thread_num() * 65536;
+#pragma omp for schedule(static)
+        for (int32_t e = 0; e < ws->ne; e++) {
+            uint64_t b = bits_of(run->q[e]);
+            if (ws->free_elem[e] && getme__owned(run, e) &&
+                (b & mask) == prefix)
+                h[(b >> shift) & 0xffff]++;
+        }
+#pragma omp for schedule(static)
+        for (int32_t bin = 0; bin < 65536; bin++) {
+            int64_t c = 0;
+            for (int k = 0; k < nt; k++)
+                c += part[(int64_t)k * 65536 + bin];
+            hist[bin] = c;
+        }
+    }
+}
+
 /* DetermineTransformationThreshold: the quality at position
    fraction * n (at least min_count - 1) of the sorted qualities of the
    elements with a free node
@@ -688,9 +719,13 @@ double getme__threshold(getme_run *run, double fraction, int32_t min_count)
     if (n == 0)
         return 0.0;
     int64_t k = getme__quantile_pos(n, fraction, min_count);
+    /* the histogram (dist/test_fail_alloc.c fails this malloc by its
+       size), and one per thread */
     int64_t *hist = malloc(65536 * sizeof *hist);
-    if (getme__dist_any(run, hist == NULL)) { /* all stop, not only this one */
+    int64_t *part = malloc((size_t)ws->nt * 65536 * sizeof *part);
+    if (getme__dist_any(run, !hist || !part)) { /* all stop, not only this one */
         free(hist);
+        free(part);
         return -1.0;
     }
     uint64_t prefix = 0, mask = 0;
@@ -699,13 +734,7 @@ double getme__threshold(getme_run *run, double fraction, int32_t min_count)
        levels pin all 64 bits, so no process needs the candidates. */
     int last = run->comm ? 0 : 32;
     for (int shift = 48; shift >= last; shift -= 16) {
-        memset(hist, 0, 65536 * sizeof *hist);
-        for (int32_t e = 0; e < ws->ne; e++) {
-            uint64_t b = bits_of(run->q[e]);
-            if (ws->free_elem[e] && getme__owned(run, e) &&
-                (b & mask) == prefix)
-                hist[(b >> shift) & 0xffff]++;
-        }
+        threshold_hist(run, shift, mask, prefix, hist, part);
         getme__dist_sum_i64(run, hist, 65536);
         int64_t below = 0;
         int bin = 0;
@@ -717,6 +746,7 @@ double getme__threshold(getme_run *run, double fraction, int32_t min_count)
         mask |= (uint64_t)0xffff << shift;
     }
     free(hist);
+    free(part);
     if (run->comm) {
         double qt;
         memcpy(&qt, &prefix, sizeof qt);
@@ -895,7 +925,13 @@ getme_status getme__adaptive(getme_run *run)
                 st = GETME_ERR_NOMEM;
                 break;
             }
-            getme__adj_sums_all(run->adj, ws, run->q);
+            /* The Eq. 9 sums: the q_mean stage leaves them behind its last
+               iteration's qualities; after a q*_min iteration they are
+               current (update_after keeps them exactly, exact.h), so a
+               later cycle needs no recomputation.  Distributed: always
+               (each process's sums of the nodes it shares). */
+            if (!have_cycle || run->comm)
+                getme__adj_sums_all(run->adj, ws, run->q);
             have_cycle = 1;
             res->cycles_min++;
         }

@@ -195,6 +195,18 @@ static inline void getme__gather_local(const getme_mesh *mesh,
     }
 }
 
+/* 1 if element e of block bl has a node that is not fixed. */
+static inline int getme__local_has_free(const getme_mesh *mesh,
+                                        const getme_block *bl, int32_t e)
+{
+    int nv = getme__nv[bl->type];
+    const int32_t *c = bl->conn + (int64_t)e * nv;
+    int f = 0;
+    for (int i = 0; i < nv; i++)
+        f |= !mesh->fixed[c[i]];
+    return f;
+}
+
 /* How many elements ahead the caller-order sweeps (statistics, measures)
    prefetch the nodes: the caller's element order can be unrelated to its
    node order, so each gather is a handful of independent cache misses,

@@ -3,9 +3,12 @@
  * measures for analysts", docs/quality.md): dihedral angles, the Verdict /
  * CUBIT scaled Jacobian, Gmsh's gamma and SICN, and their mesh statistics.
  *
- * These are reporting kernels, not the smoother's hot path: clarity over
- * speed (libm's sqrt, atan2), but still pure functions of the element's
- * coordinates, so the mesh statistics can evaluate them from any thread.
+ * Pure functions of the element's coordinates, so the mesh statistics can
+ * evaluate them from any thread.  The getme command measures every mesh
+ * before and after smoothing, so getme_mesh_measure_all runs the 3-D types
+ * eight elements at a time in vector lanes with the same kernels (every
+ * value the same bits as the one-element functions give), and reduces
+ * each measure's statistics in element order.
  */
 #include "internal.h"
 
@@ -18,6 +21,54 @@
 #define M_SQRT3_ 1.73205080756887729353
 #define M_PI_ 3.14159265358979323846
 #define RAD2DEG (180.0 / M_PI_)
+
+/* The kernels on 3-vectors below are shared by the one-element functions
+   and the lane loops of getme_mesh_measure_all (further down): inlined
+   there, on scalars rather than arrays, and with their divisions made
+   unconditional (by 1 where the result is the fallback), the compiler
+   turns those loops into vector instructions.  Either way every value is
+   the same bits. */
+#if defined(__GNUC__)
+#define KERNEL static inline __attribute__((always_inline))
+#else
+#define KERNEL static inline
+#endif
+
+typedef struct v3 {
+    double x, y, z;
+} v3;
+
+KERNEL v3 v3_sub(v3 a, v3 b) { return (v3){a.x - b.x, a.y - b.y, a.z - b.z}; }
+
+KERNEL double v3_dot(v3 a, v3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+
+KERNEL v3 v3_cross(v3 a, v3 b)
+{
+    return (v3){a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z,
+                a.x * b.y - a.y * b.x};
+}
+
+KERNEL double v3_norm(v3 a) { return sqrt(v3_dot(a, a)); }
+
+/* node i of one element's coordinates */
+KERNEL v3 v3_at(const double *x, int i)
+{
+    return (v3){x[3 * i], x[3 * i + 1], x[3 * i + 2]};
+}
+
+/* q / d, or z where d is not > 0 (the division done either way) */
+KERNEL double div_or(double q, double d, double z)
+{
+    double r = q / (d > 0.0 ? d : 1.0);
+    return d > 0.0 ? r : z;
+}
+
+/* det of the three unit vectors a / |a|, ...; 0 if one has length 0. */
+KERNEL double unit_det3(v3 a, v3 b, v3 c)
+{
+    double l = v3_norm(a) * v3_norm(b) * v3_norm(c);
+    return div_or(v3_dot(a, v3_cross(b, c)), l, 0.0);
+}
 
 /* ---- corners ------------------------------------------------------------ */
 
@@ -32,6 +83,12 @@ static const int8_t prism_corner[6][4] = {
     {3, 5, 4, 0}, {4, 3, 5, 1}, {5, 4, 3, 2}};
 static const int8_t pyramid_corner[4][4] = {
     {0, 1, 3, 4}, {1, 2, 0, 4}, {2, 3, 1, 4}, {3, 0, 2, 4}};
+/* Verdict's scaled Jacobian of a hex also checks the centre: the
+   principal axes, each the sum of the four parallel edges {from, to}. */
+static const int8_t hex_axis[3][4][2] = {
+    {{0, 1}, {3, 2}, {4, 5}, {7, 6}},
+    {{0, 3}, {1, 2}, {4, 7}, {5, 6}},
+    {{0, 4}, {1, 5}, {2, 6}, {3, 7}}};
 
 static void vsub(const double *x, int a, int b, double e[3])
 {
@@ -70,8 +127,7 @@ static void corner_edges(const double *x, const int8_t c[4], double e[3][3])
 /* det of the three unit edge vectors; 0 if an edge has length 0. */
 static double unit_det(double e[3][3])
 {
-    double l = vnorm(e[0]) * vnorm(e[1]) * vnorm(e[2]);
-    return l > 0.0 ? vdet(e[0], e[1], e[2]) / l : 0.0;
+    return unit_det3(v3_at(e[0], 0), v3_at(e[1], 0), v3_at(e[2], 0));
 }
 
 /* 2-D: the edges x[b] - x[a] in the xy plane and their cross / dot. */
@@ -147,6 +203,20 @@ static void dihedral_ends_of(int type, dihedral_ends *d)
     }
 }
 
+/* The dihedral end a-b seen from a, p and q a's neighbours in its two
+   faces: u, v the components of p - a and q - a normal to the edge, and
+   the cosine of their angle (1 when u or v vanishes). */
+KERNEL double end_uv(v3 a, v3 b, v3 p, v3 q, v3 *u, v3 *v)
+{
+    v3 e = v3_sub(b, a), dp = v3_sub(p, a), dq = v3_sub(q, a);
+    double ee = v3_dot(e, e), inv = div_or(1.0, ee, 0.0);
+    double pe = v3_dot(dp, e) * inv, qe = v3_dot(dq, e) * inv;
+    *u = (v3){dp.x - pe * e.x, dp.y - pe * e.y, dp.z - pe * e.z};
+    *v = (v3){dq.x - qe * e.x, dq.y - qe * e.y, dq.z - qe * e.z};
+    double den = sqrt(v3_dot(*u, *u) * v3_dot(*v, *v));
+    return div_or(v3_dot(*u, *v), den, 1.0);
+}
+
 /* atan2(|u x v|, u . v): the angle between u and v in [0, pi] */
 static double angle_between(const double u[3], const double v[3])
 {
@@ -169,18 +239,10 @@ static void dihedral3(const dihedral_ends *d, const double *x, double *lo,
     double umin[3] = {0}, vmin[3] = {0}, umax[3] = {0}, vmax[3] = {0};
     for (int k = 0; k < d->n; k++) {
         const int8_t *end = d->end[k];
-        double e[3], dp[3], dq[3], u[3], v[3];
-        vsub(x, end[0], end[1], e);
-        vsub(x, end[0], end[2], dp);
-        vsub(x, end[0], end[3], dq);
-        double ee = vdot(e, e), inv = ee > 0.0 ? 1.0 / ee : 0.0;
-        double pe = vdot(dp, e) * inv, qe = vdot(dq, e) * inv;
-        for (int c = 0; c < 3; c++) {
-            u[c] = dp[c] - pe * e[c];
-            v[c] = dq[c] - qe * e[c];
-        }
-        double den = sqrt(vdot(u, u) * vdot(v, v));
-        double cs = den > 0.0 ? vdot(u, v) / den : 1.0;
+        v3 uu, vv;
+        double cs = end_uv(v3_at(x, end[0]), v3_at(x, end[1]),
+                           v3_at(x, end[2]), v3_at(x, end[3]), &uu, &vv);
+        double u[3] = {uu.x, uu.y, uu.z}, v[3] = {vv.x, vv.y, vv.z};
         if (cs > cmax) { /* smallest angle so far */
             cmax = cs;
             memcpy(umax, u, sizeof u);
@@ -258,17 +320,11 @@ static double scaled_jacobian(int type, const double *x)
         return m > 0.0 ? M_SQRT2_ * vdet(e[0], e[1], e[2]) / m : 0.0;
     }
     case GETME_HEX: {
-        /* Verdict also checks the centre: the principal axes, each the sum
-           of the four parallel edges */
-        static const int8_t axis[3][4][2] = {
-            {{0, 1}, {3, 2}, {4, 5}, {7, 6}},
-            {{0, 3}, {1, 2}, {4, 7}, {5, 6}},
-            {{0, 4}, {1, 5}, {2, 6}, {3, 7}}};
         double p[3][3] = {{0}};
         for (int d = 0; d < 3; d++)
             for (int i = 0; i < 4; i++) {
                 double e[3];
-                vsub(x, axis[d][i][0], axis[d][i][1], e);
+                vsub(x, hex_axis[d][i][0], hex_axis[d][i][1], e);
                 for (int c = 0; c < 3; c++)
                     p[d][c] += e[c];
             }
@@ -299,25 +355,23 @@ static double scaled_jacobian(int type, const double *x)
 /* 3 r / R of a tet: with the edges a, b, c from node 0, V = |det| / 6,
    r = 3 V / (sum of face areas), R = |a^2 (b x c) + b^2 (c x a) +
    c^2 (a x b)| / (2 |det|), so 3 r / R = 3 det^2 / (areas * |N|). */
+KERNEL double gamma_tet4(v3 p0, v3 p1, v3 p2, v3 p3)
+{
+    v3 a = v3_sub(p1, p0), b = v3_sub(p2, p0), c = v3_sub(p3, p0);
+    v3 bc = v3_cross(b, c), ca = v3_cross(c, a), ab = v3_cross(a, b);
+    v3 fg = v3_cross(v3_sub(p2, p1), v3_sub(p3, p1));
+    double det = v3_dot(a, bc);
+    double areas =
+        0.5 * (v3_norm(bc) + v3_norm(ca) + v3_norm(ab) + v3_norm(fg));
+    double la = v3_dot(a, a), lb = v3_dot(b, b), lc = v3_dot(c, c);
+    v3 n = {la * bc.x + lb * ca.x + lc * ab.x, la * bc.y + lb * ca.y + lc * ab.y,
+            la * bc.z + lb * ca.z + lc * ab.z};
+    return div_or(3.0 * det * det, areas * v3_norm(n), 0.0);
+}
+
 static double gamma_tet(const double *x)
 {
-    double a[3], b[3], c[3], bc[3], ca[3], ab[3], f[3], g[3], fg[3], n[3];
-    vsub(x, 0, 1, a);
-    vsub(x, 0, 2, b);
-    vsub(x, 0, 3, c);
-    vcross(b, c, bc);
-    vcross(c, a, ca);
-    vcross(a, b, ab);
-    vsub(x, 1, 2, f);
-    vsub(x, 1, 3, g);
-    vcross(f, g, fg);
-    double det = vdot(a, bc);
-    double areas = 0.5 * (vnorm(bc) + vnorm(ca) + vnorm(ab) + vnorm(fg));
-    double la = vdot(a, a), lb = vdot(b, b), lc = vdot(c, c);
-    for (int k = 0; k < 3; k++)
-        n[k] = la * bc[k] + lb * ca[k] + lc * ab[k];
-    double den = areas * vnorm(n);
-    return den > 0.0 ? 3.0 * det * det / den : 0.0;
+    return gamma_tet4(v3_at(x, 0), v3_at(x, 1), v3_at(x, 2), v3_at(x, 3));
 }
 
 /* 2 r / R of a triangle = 16 A^2 / (perimeter * product of the edges) */
@@ -359,49 +413,51 @@ static double gamma_prism(const double *x)
 
 /* ---- Gmsh's SICN -------------------------------------------------------- */
 
-/* 3 det S / (|S|_F |cof S|_F) for the columns s of S; 0 if degenerate. */
-static double icn3(double s[3][3])
+/* 3 det S / (|S|_F |cof S|_F) for S = D W^-1, D the corner's edges
+   e0, e1, e2 and W that of quality.c; 0 if degenerate. */
+KERNEL double icn3(int type, v3 e0, v3 e1, v3 e2)
 {
-    double c0[3], c1[3], c2[3];
-    vcross(s[1], s[2], c0);
-    vcross(s[2], s[0], c1);
-    vcross(s[0], s[1], c2);
-    double f = vdot(s[0], s[0]) + vdot(s[1], s[1]) + vdot(s[2], s[2]);
-    double g = vdot(c0, c0) + vdot(c1, c1) + vdot(c2, c2);
-    double den = sqrt(f * g);
-    return den > 0.0 ? 3.0 * vdot(s[0], c0) / den : 0.0;
+    v3 s1 = e1, s2 = e2;
+    if (type == GETME_TET || type == GETME_PRISM)
+        s1 = (v3){(2.0 * e1.x - e0.x) / M_SQRT3_, (2.0 * e1.y - e0.y) / M_SQRT3_,
+                  (2.0 * e1.z - e0.z) / M_SQRT3_};
+    if (type == GETME_TET) {
+        const double k = M_SQRT2_ * M_SQRT3_;
+        s2 = (v3){(3.0 * e2.x - e0.x - e1.x) / k, (3.0 * e2.y - e0.y - e1.y) / k,
+                  (3.0 * e2.z - e0.z - e1.z) / k};
+    } else if (type == GETME_PYRAMID) {
+        s2 = (v3){M_SQRT2_ * (e2.x - 0.5 * (e0.x + e1.x)),
+                  M_SQRT2_ * (e2.y - 0.5 * (e0.y + e1.y)),
+                  M_SQRT2_ * (e2.z - 0.5 * (e0.z + e1.z))};
+    }
+    v3 c0 = v3_cross(s1, s2), c1 = v3_cross(s2, e0), c2 = v3_cross(e0, s1);
+    double f = v3_dot(e0, e0) + v3_dot(s1, s1) + v3_dot(s2, s2);
+    double g = v3_dot(c0, c0) + v3_dot(c1, c1) + v3_dot(c2, c2);
+    return div_or(3.0 * v3_dot(e0, c0), sqrt(f * g), 0.0);
 }
 
-/* Map corner edges to S = D W^-1 (the W of quality.c). */
-static void to_regular(int type, double e[3][3])
+static const int8_t tet_corner[1][4] = {{0, 1, 2, 3}};
+
+/* The corners of a 3-D type and their number. */
+static const int8_t (*corners_of(int type, int *n))[4]
 {
-    for (int c = 0; c < 3; c++) {
-        double e1 = e[0][c], e2 = e[1][c], e3 = e[2][c];
-        if (type == GETME_TET) {
-            e[1][c] = (2.0 * e2 - e1) / M_SQRT3_;
-            e[2][c] = (3.0 * e3 - e1 - e2) / (M_SQRT2_ * M_SQRT3_);
-        } else if (type == GETME_PRISM) {
-            e[1][c] = (2.0 * e2 - e1) / M_SQRT3_;
-        } else if (type == GETME_PYRAMID) {
-            e[2][c] = M_SQRT2_ * (e3 - 0.5 * (e1 + e2));
-        }
-    }
+    *n = type == GETME_TET ? 1 : type == GETME_HEX ? 8 : type == GETME_PRISM ? 6 : 4;
+    return type == GETME_TET     ? tet_corner
+           : type == GETME_HEX   ? hex_corner
+           : type == GETME_PRISM ? prism_corner
+                                 : pyramid_corner;
 }
 
 static double sicn3(int type, const double *x)
 {
-    static const int8_t tet_corner[1][4] = {{0, 1, 2, 3}};
-    const int8_t(*corner)[4] = type == GETME_TET     ? tet_corner
-                               : type == GETME_HEX   ? hex_corner
-                               : type == GETME_PRISM ? prism_corner
-                                                     : pyramid_corner;
-    int n = type == GETME_TET ? 1 : type == GETME_HEX ? 8 : type == GETME_PRISM ? 6 : 4;
+    int n;
+    const int8_t(*corner)[4] = corners_of(type, &n);
     double m = INFINITY;
     for (int k = 0; k < n; k++) {
-        double e[3][3];
-        corner_edges(x, corner[k], e);
-        to_regular(type, e);
-        m = fmin(m, icn3(e));
+        v3 o = v3_at(x, corner[k][0]);
+        m = fmin(m, icn3(type, v3_sub(v3_at(x, corner[k][1]), o),
+                         v3_sub(v3_at(x, corner[k][2]), o),
+                         v3_sub(v3_at(x, corner[k][3]), o)));
     }
     return m;
 }
@@ -631,6 +687,248 @@ getme_status getme_mesh_measure_stats(getme_mesh *mesh, int type,
     return GETME_OK;
 }
 
+/* ---- GETME_LANES 3-D elements at once ---------------------------------- */
+
+/*
+ * getme_mesh_measure_all evaluates the 3-D types GETME_LANES elements at a
+ * time, x in lanes (x[3 i + d][l]: coordinate d of node i of element l),
+ * with the kernels the one-element functions use, in the same order, so
+ * every value is the same bits (no fused multiply-adds: -std=c11); the
+ * loops over the lanes become vector instructions, square roots and
+ * divisions included, and the mean ratio goes through quality.c's lane
+ * kernel.  The dihedral ends are ranked by their cosines in the lanes;
+ * only the two extreme ends of each element get atan2.
+ */
+enum { L = GETME_LANES };
+
+/* node i of lane l */
+KERNEL v3 v3_lane(const double (*x)[L], int i, int l)
+{
+    return (v3){x[3 * i][l], x[3 * i + 1][l], x[3 * i + 2][l]};
+}
+
+/* fmin and fmax (glibc's: minsd / maxsd when ordered, including which
+   zero they give for +0 and -0) for an a that is not NaN, as selects that
+   vectorise. */
+KERNEL double min_nn(double a, double b)
+{
+    return b != b ? a : (a < b ? a : b);
+}
+
+KERNEL double max_nn(double a, double b)
+{
+    return b != b ? a : (a > b ? a : b);
+}
+
+/* end_uv of end k of lane l */
+KERNEL double end_lane(const dihedral_ends *d, const double (*x)[L], int k,
+                       int l, v3 *u, v3 *v)
+{
+    const int8_t *e = d->end[k];
+    return end_uv(v3_lane(x, e[0], l), v3_lane(x, e[1], l),
+                  v3_lane(x, e[2], l), v3_lane(x, e[3], l), u, v);
+}
+
+/* dihedral3 of the lanes, in degrees as measure() gives them. */
+static void dihedral_lanes(const dihedral_ends *d, const double (*x)[L],
+                           double *lo, double *hi)
+{
+    double cmin[L], cmax[L];
+    int kmin[L], kmax[L];
+    for (int l = 0; l < L; l++)
+        cmin[l] = INFINITY, cmax[l] = -INFINITY, kmin[l] = kmax[l] = -1;
+    for (int k = 0; k < d->n; k++) {
+#pragma omp simd
+        for (int l = 0; l < L; l++) {
+            v3 u, v;
+            double cs = end_lane(d, x, k, l, &u, &v);
+            int up = cs > cmax[l], down = cs < cmin[l];
+            cmax[l] = up ? cs : cmax[l];
+            kmax[l] = up ? k : kmax[l];
+            cmin[l] = down ? cs : cmin[l];
+            kmin[l] = down ? k : kmin[l];
+        }
+    }
+    for (int l = 0; l < L; l++) {
+        /* no end ranked (NaN cosines): u = v = 0, as dihedral3 has it */
+        v3 u = {0, 0, 0}, v = {0, 0, 0};
+        if (kmax[l] >= 0)
+            end_lane(d, x, kmax[l], l, &u, &v);
+        lo[l] = angle_between((double[3]){u.x, u.y, u.z},
+                              (double[3]){v.x, v.y, v.z}) * RAD2DEG;
+        u = v = (v3){0, 0, 0};
+        if (kmin[l] >= 0)
+            end_lane(d, x, kmin[l], l, &u, &v);
+        hi[l] = angle_between((double[3]){u.x, u.y, u.z},
+                              (double[3]){v.x, v.y, v.z}) * RAD2DEG;
+    }
+}
+
+/* unit_det of corner c of the lanes into u */
+static void corner_det_lanes(const double (*x)[L], const int8_t *c, double *u)
+{
+#pragma omp simd
+    for (int l = 0; l < L; l++) {
+        v3 o = v3_lane(x, c[0], l);
+        u[l] = unit_det3(v3_sub(v3_lane(x, c[1], l), o),
+                         v3_sub(v3_lane(x, c[2], l), o),
+                         v3_sub(v3_lane(x, c[3], l), o));
+    }
+}
+
+/* scaled_jacobian of tets: max_length_product and the corner at node 0. */
+static void sj_tet_lanes(const double (*x)[L], double *sj)
+{
+    const getme_edge_table *et = &getme__edges[GETME_TET];
+    double prod[4][L];
+    for (int i = 0; i < 4; i++)
+        for (int l = 0; l < L; l++)
+            prod[i][l] = 1.0;
+    for (int k = 0; k < et->num_edges; k++) {
+        int a = et->node[k][0], b = et->node[k][1];
+#pragma omp simd
+        for (int l = 0; l < L; l++) {
+            double len = v3_norm(v3_sub(v3_lane(x, b, l), v3_lane(x, a, l)));
+            prod[a][l] *= len;
+            prod[b][l] *= len;
+        }
+    }
+#pragma omp simd
+    for (int l = 0; l < L; l++) {
+        double m = 0.0;
+        for (int i = 0; i < 4; i++)
+            m = max_nn(m, prod[i][l]);
+        v3 o = v3_lane(x, 0, l), e0 = v3_sub(v3_lane(x, 1, l), o),
+           e1 = v3_sub(v3_lane(x, 2, l), o), e2 = v3_sub(v3_lane(x, 3, l), o);
+        sj[l] = div_or(M_SQRT2_ * v3_dot(e0, v3_cross(e1, e2)), m, 0.0);
+    }
+}
+
+/* unit_det of the principal axes of hexes (scaled_jacobian's centre). */
+static void hex_axes_lanes(const double (*x)[L], double *u)
+{
+#pragma omp simd
+    for (int l = 0; l < L; l++) {
+        v3 p[3];
+        for (int d = 0; d < 3; d++) {
+            p[d] = (v3){0, 0, 0};
+            for (int i = 0; i < 4; i++) {
+                v3 e = v3_sub(v3_lane(x, hex_axis[d][i][1], l),
+                              v3_lane(x, hex_axis[d][i][0], l));
+                p[d] = (v3){p[d].x + e.x, p[d].y + e.y, p[d].z + e.z};
+            }
+        }
+        u[l] = unit_det3(p[0], p[1], p[2]);
+    }
+}
+
+/* One corner of sicn3 in the lanes, into their minimum out; inlined with
+   a constant type, so icn3's choice of W is made at compile time. */
+KERNEL void sicn_corner_lanes(int type, const double (*x)[L],
+                              const int8_t *c, double *out)
+{
+#pragma omp simd
+    for (int l = 0; l < L; l++) {
+        v3 o = v3_lane(x, c[0], l);
+        out[l] = min_nn(out[l], icn3(type, v3_sub(v3_lane(x, c[1], l), o),
+                                     v3_sub(v3_lane(x, c[2], l), o),
+                                     v3_sub(v3_lane(x, c[3], l), o)));
+    }
+}
+
+static void sicn_lanes(int type, const double (*x)[L], double *out)
+{
+    int n;
+    const int8_t(*corner)[4] = corners_of(type, &n);
+    for (int l = 0; l < L; l++)
+        out[l] = INFINITY;
+    for (int k = 0; k < n; k++)
+        switch (type) {
+        case GETME_TET: sicn_corner_lanes(GETME_TET, x, corner[k], out); break;
+        case GETME_HEX: sicn_corner_lanes(GETME_HEX, x, corner[k], out); break;
+        case GETME_PRISM: sicn_corner_lanes(GETME_PRISM, x, corner[k], out); break;
+        default: sicn_corner_lanes(GETME_PYRAMID, x, corner[k], out); break;
+        }
+}
+
+/* Every measure of the GETME_LANES 3-D elements of type t in x into
+   v[l * GETME_NUM_MEASURES + m] (NaN where not defined for the type). */
+static void measures3_lanes(int t, const dihedral_ends *de,
+                            const double (*x)[L], double *v)
+{
+    double q[L], lo[L], hi[L], sj[L], g[L], s[L], cu[8][L];
+    if (!getme__quality_lanes(t, x, q))
+        for (int l = 0; l < L; l++) {
+            double xl[3 * GETME_MAX_NV];
+            for (int i = 0; i < 3 * getme__nv[t]; i++)
+                xl[i] = x[i][l];
+            q[l] = getme__quality(t, xl);
+        }
+    dihedral_lanes(de, x, lo, hi);
+    int n;
+    const int8_t(*corner)[4] = corners_of(t, &n);
+    if (t != GETME_TET)
+        for (int k = 0; k < n; k++)
+            corner_det_lanes(x, corner[k], cu[k]);
+    for (int l = 0; l < L; l++)
+        g[l] = NAN;
+    if (t == GETME_TET) {
+        sj_tet_lanes(x, sj);
+#pragma omp simd
+        for (int l = 0; l < L; l++)
+            g[l] = gamma_tet4(v3_lane(x, 0, l), v3_lane(x, 1, l),
+                              v3_lane(x, 2, l), v3_lane(x, 3, l));
+    } else {
+        double ax[L];
+        if (t == GETME_HEX)
+            hex_axes_lanes(x, ax);
+        for (int l = 0; l < L; l++) {
+            double m = INFINITY, ma = INFINITY;
+            for (int k = 0; k < n; k++) {
+                m = min_nn(m, cu[k][l]);
+                ma = min_nn(ma, fabs(cu[k][l]));
+            }
+            sj[l] = t == GETME_HEX     ? min_nn(m, ax[l])
+                    : t == GETME_PRISM ? 2.0 / M_SQRT3_ * m
+                                       : min_nn(1.0, M_SQRT2_ * m);
+            if (t == GETME_PRISM)
+                g[l] = 2.0 / M_SQRT3_ * ma;
+        }
+    }
+    sicn_lanes(t, x, s);
+    for (int l = 0; l < L; l++) {
+        double *o = v + l * GETME_NUM_MEASURES;
+        o[GETME_MEASURE_MEAN_RATIO] = q[l];
+        o[GETME_MEASURE_MIN_DIHEDRAL] = lo[l];
+        o[GETME_MEASURE_MAX_DIHEDRAL] = hi[l];
+        o[GETME_MEASURE_SCALED_JACOBIAN] = sj[l];
+        o[GETME_MEASURE_GAMMA] = g[l];
+        o[GETME_MEASURE_SICN] = s[l];
+    }
+}
+
+/* Gather the n <= GETME_LANES elements from e of block bl into lanes
+   (unused lanes repeat the last one) and measure them into v. */
+static void measure_group(const getme_mesh *mesh, const getme_block *bl,
+                          int32_t e, int32_t n, double ysign,
+                          const dihedral_ends *de, double *v)
+{
+    double x[3 * GETME_MAX_NV][L], xe[3 * GETME_MAX_NV];
+    int nv = getme__nv[bl->type];
+    for (int l = 0; l < L; l++) {
+        getme__gather_local(mesh, bl, e + (l < n ? l : n - 1), ysign, xe);
+        for (int i = 0; i < 3 * nv; i++)
+            x[i][l] = xe[i];
+    }
+    if (n == L) {
+        measures3_lanes(bl->type, de, (const double(*)[L])x, v);
+        return;
+    }
+    double w[L * GETME_NUM_MEASURES];
+    measures3_lanes(bl->type, de, (const double(*)[L])x, w);
+    memcpy(v, w, (size_t)n * GETME_NUM_MEASURES * sizeof *v);
+}
+
 /* Elements per tile of getme_mesh_measure_all: the tile's values of every
    measure (6 doubles per element, 1.5 MiB) are computed in parallel, then
    reduced serially in element order. */
@@ -691,19 +989,34 @@ getme_status getme_mesh_measure_all(getme_mesh *mesh,
         for (int32_t e0 = 0; e0 < bl->count; e0 += MEASURE_TILE) {
             int32_t n = bl->count - e0 < MEASURE_TILE ? bl->count - e0
                                                        : MEASURE_TILE;
+            if (getme_type_dim((getme_elem_type)t) == 3) {
 #pragma omp parallel for schedule(static)
-            for (int32_t i = 0; i < n; i++) {
-                getme__prefetch_local(mesh, bl, e0 + i + GETME_PREFETCH_AHEAD);
-                element_measures(mesh, bl, e0 + i, ysign, &de, defined,
-                                 v + (int64_t)i * GETME_NUM_MEASURES);
+                for (int32_t i = 0; i < n; i += L) {
+                    for (int32_t k = 0; k < L; k++)
+                        getme__prefetch_local(mesh, bl, e0 + i + L + k);
+                    measure_group(mesh, bl, e0 + i, n - i < L ? n - i : L,
+                                  ysign, &de,
+                                  v + (int64_t)i * GETME_NUM_MEASURES);
+                }
+            } else {
+#pragma omp parallel for schedule(static)
+                for (int32_t i = 0; i < n; i++) {
+                    getme__prefetch_local(mesh, bl,
+                                          e0 + i + GETME_PREFETCH_AHEAD);
+                    element_measures(mesh, bl, e0 + i, ysign, &de, defined,
+                                     v + (int64_t)i * GETME_NUM_MEASURES);
+                }
             }
+            /* Each measure's statistics are reduced in element order by
+               one thread: the same sums as a serial sweep. */
             getme_measure_stats *s = stats + t * GETME_NUM_MEASURES;
-            for (int32_t i = 0; i < n; i++) {
-                const double *vi = v + (int64_t)i * GETME_NUM_MEASURES;
-                for (int m = 0; m < GETME_NUM_MEASURES; m++)
-                    if (!isnan(vi[m]))
-                        add_stat(&s[m], vi[m], bl->first + e0 + i, &sum[t][m]);
-            }
+#pragma omp parallel for schedule(static, 1)
+            for (int m = 0; m < GETME_NUM_MEASURES; m++)
+                for (int32_t i = 0; i < n; i++) {
+                    double vi = v[(int64_t)i * GETME_NUM_MEASURES + m];
+                    if (!isnan(vi))
+                        add_stat(&s[m], vi, bl->first + e0 + i, &sum[t][m]);
+                }
         }
     }
     for (int t = 0; t < GETME_NUM_TYPES; t++)

@@ -57,35 +57,99 @@ getme_status getme__patch_add(getme_patch *p, int type, const int32_t *conn,
     return GETME_OK;
 }
 
-/* Quality of patch element i at p->x; its worst corner into *sj when the
-   corner guard applies to its type. */
-static double elem_q(const getme_patch *p, int32_t i, double *sj)
+/* Coordinates of patch element i at p->x, one node after the other. */
+static void elem_x(const getme_patch *p, int32_t i, double *x)
 {
-    double x[3 * GETME_MAX_NV];
-    int t = p->type[i];
     const int32_t *c = p->conn[i];
-    for (int j = 0; j < getme__nv[t]; j++) {
+    for (int j = 0; j < getme__nv[p->type[i]]; j++) {
         const double *s = p->x + 3 * (int64_t)c[j];
         x[3 * j] = s[0];
         x[3 * j + 1] = p->mirror ? -s[1] : s[1];
         x[3 * j + 2] = s[2];
     }
+}
+
+/* What elem_q adds to the mean ratio q of patch element i at coordinates
+   x: its worst corner into *sj when the corner guard applies to its type,
+   and 0 for a second-order element invalid at a node. */
+static double elem_finish(const getme_patch *p, int32_t i, const double *x,
+                          double q, double *sj)
+{
+    int t = p->type[i];
     if (p->guard && getme__has_corners(t))
         *sj = getme__corner_sj(t, x);
-    double q = getme__quality(t, x);
     if (q > 0.0 && p->ws && p->ws->ho && !getme__ho_valid(p->ws, p->x, p->id[i]))
         return 0.0; /* second order: det J > 0 at every node */
     return q;
 }
 
+/* Quality of patch element i at p->x; its worst corner into *sj when the
+   corner guard applies to its type. */
+static double elem_q(const getme_patch *p, int32_t i, double *sj)
+{
+    double x[3 * GETME_MAX_NV];
+    elem_x(p, i, x);
+    return elem_finish(p, i, x, getme__quality(p->type[i], x), sj);
+}
+
+/* The mean ratios of the n <= GETME_LANES patch elements from i0 into q
+   by one lane kernel (quality.c: the same bits as getme__quality, several
+   times faster; trials evaluate every patch element, which is most of the
+   finishing step's time).  Returns 0, and computes nothing, when they are
+   not all of one type that has a lane kernel. */
+static int lanes_q(const getme_patch *p, int32_t i0, int32_t n, double *q)
+{
+    int t = p->type[i0];
+    for (int32_t l = 1; l < n; l++)
+        if (p->type[i0 + l] != t)
+            return 0;
+    if (t != GETME_TET && t != GETME_HEX)
+        return 0;
+    double x[3 * GETME_MAX_NV][GETME_LANES];
+    for (int32_t l = 0; l < GETME_LANES; l++) {
+        /* unused lanes repeat the last element: finite, and ignored */
+        const int32_t *c = p->conn[i0 + (l < n ? l : n - 1)];
+        for (int j = 0; j < getme__nv[t]; j++) {
+            const double *s = p->x + 3 * (int64_t)c[j];
+            x[3 * j][l] = s[0];
+            x[3 * j + 1][l] = p->mirror ? -s[1] : s[1];
+            x[3 * j + 2][l] = s[2];
+        }
+    }
+    return getme__quality_lanes(t, (const double(*)[GETME_LANES])x, q);
+}
+
+/* elem_q of the n <= GETME_LANES patch elements from i0 into q (and into
+   sj where elem_q sets it). */
+static void group_q(const getme_patch *p, int32_t i0, int32_t n, double *q,
+                    double *sj)
+{
+    double ql[GETME_LANES], x[3 * GETME_MAX_NV];
+    int lanes = lanes_q(p, i0, n, ql);
+    for (int32_t l = 0; l < n; l++) {
+        if (!lanes) {
+            q[l] = elem_q(p, i0 + l, &sj[l]);
+            continue;
+        }
+        int t = p->type[i0 + l];
+        int more = (p->guard && getme__has_corners(t)) || (p->ws && p->ws->ho);
+        if (more)
+            elem_x(p, i0 + l, x);
+        q[l] = more ? elem_finish(p, i0 + l, x, ql[l], &sj[l]) : ql[l];
+    }
+}
+
 double getme__patch_eval(getme_patch *p)
 {
     double m = INFINITY;
-    for (int32_t i = 0; i < p->n; i++) {
+    for (int32_t i = 0; i < p->n; i++)
         p->sj[i] = 1.0;
-        p->q[i] = elem_q(p, i, &p->sj[i]);
-        m = fmin(m, p->q[i]);
+    for (int32_t i0 = 0; i0 < p->n; i0 += GETME_LANES) {
+        int32_t n = p->n - i0 < GETME_LANES ? p->n - i0 : GETME_LANES;
+        group_q(p, i0, n, p->q + i0, p->sj + i0);
     }
+    for (int32_t i = 0; i < p->n; i++)
+        m = fmin(m, p->q[i]);
     return m;
 }
 
@@ -105,20 +169,28 @@ double getme__patch_eval(getme_patch *p)
 static int trial(getme_patch *p, double cur)
 {
     double m = INFINITY, sum_new = 0.0, sum_old = 0.0;
-    for (int32_t i = 0; i < p->n; i++) {
-        double sj = 1.0;
-        double q = elem_q(p, i, &sj);
-        if (!(q > cur))
-            return 0;
-        if (sj < p->sj[i] && sj < p->floor && p->guard)
-            return 0;
-        p->qt[i] = q;
-        m = fmin(m, q);
-        sum_new += q;
-        sum_old += p->q[i];
+    for (int32_t i0 = 0; i0 < p->n; i0 += GETME_LANES) {
+        int32_t n = p->n - i0 < GETME_LANES ? p->n - i0 : GETME_LANES;
+        double qg[GETME_LANES], sj[GETME_LANES];
+        for (int32_t l = 0; l < n; l++)
+            sj[l] = 1.0;
+        group_q(p, i0, n, qg, sj);
+        for (int32_t l = 0; l < n; l++) {
+            int32_t i = i0 + l;
+            double q = qg[l];
+            if (!(q > cur))
+                return 0;
+            if (sj[l] < p->sj[i] && sj[l] < p->floor && p->guard)
+                return 0;
+            p->qt[i] = q;
+            m = fmin(m, q);
+            sum_new += q;
+            sum_old += p->q[i];
+        }
     }
     double change = sum_new - sum_old, allowed = (m - cur) * p->loss;
     p->change = change;
+    p->allowed_max = allowed > p->allowed_max ? allowed : p->allowed_max;
     return change >= -(allowed < p->budget ? allowed : p->budget);
 }
 

@@ -41,6 +41,9 @@ typedef struct getme_patch {
                         kept moves gained so far, less what they spent (0
                         at the start: q_mean never ends lower)            */
     double change;   /* scratch: the last trial's change of the total    */
+    double allowed_max; /* the largest loss * gain of a trial that got as
+                        far as the total's test (the caller resets it);
+                        the finishing step's memo of failed climbs uses it */
     /* the elements (filled by the caller with getme__patch_add) */
     int32_t n, cap;
     int8_t *type;

@@ -16,6 +16,7 @@
 #include "patch.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -55,45 +56,74 @@ static void keep_worst(getme_worst_element *w, int32_t *n, int32_t max,
     w[i].element = e;
 }
 
+/* The elements of block bl with a marked node, in element order, at
+   list + at (count them first with list = NULL); each thread takes a
+   contiguous range (off[k]: thread k's first position, counted by the
+   first call).  Returns how many. */
+static int32_t marked(const getme_block *bl, const uint8_t *mark,
+                      int32_t *list, int32_t *off, int nt)
+{
+    int nv = getme__nv[bl->type];
+#pragma omp parallel num_threads(nt)
+    {
+        int k = omp_get_thread_num();
+        int32_t at = list ? off[k] : 0;
+#pragma omp for schedule(static)
+        for (int32_t e = 0; e < bl->count; e++) {
+            const int32_t *c = bl->conn + (int64_t)e * nv;
+            int hit = 0;
+            for (int i = 0; i < nv; i++)
+                hit |= mark[c[i]];
+            if (hit && list)
+                list[at] = bl->first + e;
+            at += hit;
+        }
+        if (!list)
+            off[k + 1] = at;
+    }
+    if (list)
+        return off[nt];
+    off[0] = 0;
+    for (int k = 0; k < nt; k++)
+        off[k + 1] += off[k];
+    return off[nt];
+}
+
 /* The elements around the free nodes of the n reported elements, found in
-   one scan of the mesh (the mesh has no node stars), into *cand. */
+   one parallel scan of the mesh (the mesh has no node stars), in element
+   order, into *cand. */
 static getme_status candidates(const getme_mesh *mesh,
                                const getme_worst_element *w, int32_t n,
                                int32_t **cand, int32_t *num)
 {
+    int nt = omp_get_max_threads();
     uint8_t *mark = calloc((size_t)mesh->num_nodes, 1);
-    if (!mark)
-        return GETME_ERR_NOMEM;
-    for (int32_t i = 0; i < n; i++) {
+    int32_t *off = calloc((size_t)nt + 1, sizeof *off);
+    int32_t *list = malloc(sizeof *list), m = 0;
+    for (int32_t i = 0; mark && i < n; i++) {
         int t;
         const int32_t *c = nodes_of(mesh, w[i].element, &t);
         for (int j = 0; j < getme__nv[t]; j++)
             mark[c[j]] = !mesh->fixed[c[j]];
     }
-    int32_t m = 0, cap = 256;
-    int32_t *list = malloc((size_t)cap * sizeof *list);
-    for (int b = 0; b < mesh->num_blocks && list; b++) {
+    for (int b = 0; b < mesh->num_blocks && mark && off && list; b++) {
         const getme_block *bl = &mesh->blocks[b];
-        int nv = getme__nv[bl->type];
-        for (int32_t e = 0; e < bl->count && list; e++) {
-            const int32_t *c = bl->conn + (int64_t)e * nv;
-            int hit = 0;
-            for (int i = 0; i < nv; i++)
-                hit |= mark[c[i]];
-            if (!hit)
-                continue;
-            if (m == cap) {
-                int32_t *grown = realloc(list, 2 * (size_t)cap * sizeof *list);
-                if (!grown)
-                    free(list);
-                list = grown, cap *= 2;
-                if (!list)
-                    break;
-            }
-            list[m++] = bl->first + e;
+        int32_t add = marked(bl, mark, NULL, off, nt);
+        int32_t *grown = realloc(list, ((size_t)m + add + 1) * sizeof *list);
+        if (!grown) {
+            free(list);
+            list = NULL;
+            break;
         }
+        list = grown;
+        m += marked(bl, mark, list + m, off, nt);
+    }
+    if (!mark || !off) {
+        free(list);
+        list = NULL;
     }
     free(mark);
+    free(off);
     *cand = list, *num = m;
     return list ? GETME_OK : GETME_ERR_NOMEM;
 }
@@ -138,15 +168,47 @@ static int can_improve(const getme_mesh *mesh, getme_patch *p,
     return 0;
 }
 
-/* Has element e a free node? */
-static int has_free(const getme_mesh *mesh, int32_t e)
+/* The max worst elements (only those with a free node if free_only) of
+   qualities q into out, *n of them, ascending, ties by index.  Each thread
+   keeps the worst of its contiguous range of a block; fed into one list in
+   thread order, they give what one serial sweep gives, since keep_worst
+   keeps the smallest (quality, arrival) pairs and equal qualities arrive
+   in index order either way. */
+static getme_status worst_sweep(const getme_mesh *mesh, const double *q,
+                                int free_only, int32_t max,
+                                getme_worst_element *out, int32_t *n)
 {
-    int t;
-    const int32_t *c = nodes_of(mesh, e, &t);
-    for (int j = 0; j < getme__nv[t]; j++)
-        if (!mesh->fixed[c[j]])
-            return 1;
-    return 0;
+    int nt = omp_get_max_threads();
+    getme_worst_element *part = malloc((size_t)nt * max * sizeof *part);
+    int32_t *cnt = malloc((size_t)nt * sizeof *cnt);
+    if (!part || !cnt) {
+        free(part);
+        free(cnt);
+        return GETME_ERR_NOMEM;
+    }
+    for (int b = 0; b < mesh->num_blocks; b++) {
+        const getme_block *bl = &mesh->blocks[b];
+        for (int k = 0; k < nt; k++)
+            cnt[k] = 0;
+#pragma omp parallel num_threads(nt)
+        {
+            int k = omp_get_thread_num();
+            getme_worst_element *w = part + (int64_t)k * max;
+#pragma omp for schedule(static)
+            for (int32_t e = 0; e < bl->count; e++) {
+                if (!free_only || getme__local_has_free(mesh, bl, e))
+                    keep_worst(w, &cnt[k], max, q[bl->first + e],
+                               bl->first + e);
+            }
+        }
+        for (int k = 0; k < nt; k++)
+            for (int32_t i = 0; i < cnt[k]; i++)
+                keep_worst(out, n, max, part[(int64_t)k * max + i].quality,
+                           part[(int64_t)k * max + i].element);
+    }
+    free(part);
+    free(cnt);
+    return GETME_OK;
 }
 
 getme_status getme_mesh_worst_elements(getme_mesh *mesh, int32_t max_count,
@@ -164,9 +226,11 @@ getme_status getme_mesh_worst_elements(getme_mesh *mesh, int32_t max_count,
         return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
     getme_mesh_element_qualities(mesh, q);
     int32_t n = 0;
-    for (int32_t e = 0; e < mesh->num_elements; e++)
-        if (!(flags & GETME_WORST_FREE_ONLY) || has_free(mesh, e))
-            keep_worst(out, &n, max_count, q[e], e);
+    if (worst_sweep(mesh, q, flags & GETME_WORST_FREE_ONLY, max_count, out,
+                    &n) != GETME_OK) {
+        free(q);
+        return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
+    }
     free(q);
 
     getme_patch p;
