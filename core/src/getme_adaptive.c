@@ -925,12 +925,13 @@ getme_status getme__adaptive(getme_run *run)
                 st = GETME_ERR_NOMEM;
                 break;
             }
-            /* The Eq. 9 sums: the q_mean stage leaves them behind its last
-               iteration's qualities; after a q*_min iteration they are
-               current (update_after keeps them exactly, exact.h), so a
-               later cycle needs no recomputation.  Distributed: always
-               (each process's sums of the nodes it shares). */
-            if (!have_cycle || run->comm)
+            /* The Eq. 9 sums are current: the q_mean stage's relaxation
+               (relax.c) and update_after keep them at run->q exactly
+               (exact.h; GETME_CHECK_SUMS builds check it every
+               iteration), so a cycle needs no recomputation.
+               Distributed: always (each process's sums of the nodes it
+               shares). */
+            if (run->comm)
                 getme__adj_sums_all(run->adj, ws, run->q);
             have_cycle = 1;
             res->cycles_min++;
