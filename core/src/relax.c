@@ -74,11 +74,43 @@ static inline void set_q(getme_run *run, int t, int32_t e, double v)
     run->q[e] = v;
 }
 
+/* trial_quality of the n <= GETME_LANES elements elems[0..n) into run->q
+   (set_q), their mean ratios in one lane kernel (quality.c) when they are
+   all of type t and t has one: the same bits, several times faster.  A
+   short batch repeats its first element in the unused lanes. */
+__attribute__((always_inline)) /* t is a constant in trial_block's copies */
+static inline void trial_batch(int t, getme_run *run, const int32_t *elems,
+                               int32_t n)
+{
+    const getme_ws *ws = run->ws;
+    double x[3 * GETME_MAX_NV][GETME_LANES], q[GETME_LANES];
+    int same = 1; /* the list need not be sorted (q*_min stage) */
+    for (int32_t l = 0; l < n; l++)
+        same &= elems[l] >= ws->tstart[t] && elems[l] < ws->tstart[t + 1];
+    if (same) {
+        for (int l = 0; l < GETME_LANES; l++) {
+            const int32_t *c = getme__ws_nodes(ws, t, elems[l < n ? l : 0]);
+            for (int i = 0; i < getme__nv[t]; i++)
+                for (int d = 0; d < 3; d++)
+                    x[3 * i + d][l] = run->xnew[3 * (int64_t)c[i] + d];
+        }
+        if (getme__quality_lanes(t, (const double(*)[GETME_LANES])x, q)) {
+            for (int32_t l = 0; l < n; l++)
+                set_q(run, t, elems[l], trial_check(run, elems[l], t, q[l]));
+            return;
+        }
+    }
+    for (int32_t l = 0; l < n; l++) {
+        int32_t e = elems[l];
+        set_q(run, getme__ws_type(ws, e), e, trial_quality(run, e));
+    }
+}
+
 /* The q_mean stage's first trial-quality pass over block b (its elements
    all of type t, a constant in each copy, GETME_FOR_TYPE): every free
-   element's quality at xnew, GETME_LANES at a time in the lane kernel, and
-   its S_v / S_e updated (set_q).  Blocks that run at the same time share
-   no node, hence no edge (block_local.h), so the sums need no atomics. */
+   element's quality at xnew, and its S_v / S_e updated (set_q).  Blocks
+   that run at the same time share no node, hence no edge
+   (block_local.h), so the sums need no atomics. */
 __attribute__((always_inline)) /* one copy per type: t is a constant */
 static inline void trial_block(int t, getme_run *run, int32_t b)
 {
@@ -88,23 +120,8 @@ static inline void trial_block(int t, getme_run *run, int32_t b)
     for (int32_t e = ws->block_start[b]; e < ws->block_start[b + 1]; e++)
         if (ws->free_elem[e])
             list[n++] = e;
-    int nv = getme__nv[t];
-    for (int32_t j = 0; j < n; j += GETME_LANES) {
-        double x[3 * GETME_MAX_NV][GETME_LANES], q[GETME_LANES];
-        for (int l = 0; l < GETME_LANES; l++) {
-            /* a short last batch repeats its first element */
-            const int32_t *c = getme__ws_nodes(ws, t, list[j + l < n ? j + l : j]);
-            for (int i = 0; i < nv; i++)
-                for (int d = 0; d < 3; d++)
-                    x[3 * i + d][l] = run->xnew[3 * (int64_t)c[i] + d];
-        }
-        int lanes = getme__quality_lanes(t, (const double(*)[GETME_LANES])x, q);
-        for (int l = 0; l < GETME_LANES && j + l < n; l++) {
-            int32_t e = list[j + l];
-            set_q(run, t, e,
-                  lanes ? trial_check(run, e, t, q[l]) : trial_quality(run, e));
-        }
-    }
+    for (int32_t j = 0; j < n; j += GETME_LANES)
+        trial_batch(t, run, list + j, n - j < GETME_LANES ? n - j : GETME_LANES);
 }
 
 static int64_t trial_block_any(void *ctx, int32_t b)
@@ -113,35 +130,6 @@ static int64_t trial_block_any(void *ctx, int32_t b)
     GETME_FOR_TYPE(getme__ws_type(run->ws, run->ws->block_start[b]),
                    trial_block, run, b);
     return 0;
-}
-
-/* trial_quality of the elements elems[k0..k0 + GETME_LANES) into run->q,
-   their mean ratios in one lane kernel (quality.c) when they are all of
-   one type that has one: the same bits, several times faster. */
-static void trial_qualities_lanes(getme_run *run, const int32_t *elems,
-                                  int32_t k0)
-{
-    const getme_ws *ws = run->ws;
-    int t = getme__ws_type(ws, elems[k0]);
-    double x[3 * GETME_MAX_NV][GETME_LANES], q[GETME_LANES];
-    int same = 1; /* the list need not be sorted (q*_min stage) */
-    for (int l = 1; l < GETME_LANES; l++)
-        same &= elems[k0 + l] >= ws->tstart[t] && elems[k0 + l] < ws->tstart[t + 1];
-    if (same) {
-        for (int l = 0; l < GETME_LANES; l++) {
-            const int32_t *c = getme__ws_nodes(ws, t, elems[k0 + l]);
-            for (int i = 0; i < getme__nv[t]; i++)
-                for (int d = 0; d < 3; d++)
-                    x[3 * i + d][l] = run->xnew[3 * (int64_t)c[i] + d];
-        }
-        if (getme__quality_lanes(t, (const double(*)[GETME_LANES])x, q)) {
-            for (int l = 0; l < GETME_LANES; l++)
-                run->q[elems[k0 + l]] = trial_check(run, elems[k0 + l], t, q[l]);
-            return;
-        }
-    }
-    for (int l = 0; l < GETME_LANES; l++)
-        run->q[elems[k0 + l]] = trial_quality(run, elems[k0 + l]);
 }
 
 /* How many elements of the list are invalid at xnew (parallel count). */
@@ -328,7 +316,8 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
         int32_t nbatch = ne / GETME_LANES;
 #pragma omp parallel for schedule(static) num_threads(nt) if (ne > GETME_PAR_MIN)
         for (int32_t j = 0; j < nbatch; j++)
-            trial_qualities_lanes(run, elems, j * GETME_LANES);
+            trial_batch(getme__ws_type(ws, elems[j * GETME_LANES]), run,
+                        elems + j * GETME_LANES, GETME_LANES);
         for (int32_t k = nbatch * GETME_LANES; k < ne; k++)
             q[elems[k]] = trial_quality(run, elems[k]);
     }
