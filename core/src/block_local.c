@@ -111,24 +111,13 @@ static int interior(const getme_blocks *blk, const int32_t *part, int32_t b,
     return 1;
 }
 
-typedef struct block_key {
-    double key;
-    int32_t b;
-} block_key;
-
-static int cmp_key(const void *pa, const void *pb)
-{
-    const block_key *a = pa, *b = pb;
-    return a->key < b->key ? -1 : a->key > b->key ? 1 : (a->b > b->b) - (a->b < b->b);
-}
-
 /* Deal the blocks cur[0..n) into np parts by position along the axis
    where they spread most (a block's position: its first node's): the
    blocks left after a level lie along the parts' interfaces, so this cuts
    across them, and the next level finds most of them interior. */
 static void deal_across(const getme_blocks *blk, const getme_ws *ws,
                         const int32_t *cur, int32_t n, int np, int32_t *bpart,
-                        block_key *keys)
+                        getme_ranked *keys)
 {
     double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
     for (int32_t k = 0; k < n; k++)
@@ -142,12 +131,12 @@ static void deal_across(const getme_blocks *blk, const getme_ws *ws,
         if (hi[d] - lo[d] > hi[a] - lo[a])
             a = d;
     for (int32_t k = 0; k < n; k++) {
-        keys[k].b = cur[k];
-        keys[k].key = ws->x[3 * (int64_t)blk->nodes[blk->nptr[cur[k]]] + a];
+        keys[k].e = cur[k];
+        keys[k].q = ws->x[3 * (int64_t)blk->nodes[blk->nptr[cur[k]]] + a];
     }
-    qsort(keys, (size_t)n, sizeof *keys, cmp_key);
+    qsort(keys, (size_t)n, sizeof *keys, getme__cmp_ranked);
     for (int32_t k = 0; k < n; k++)
-        bpart[keys[k].b] = (int32_t)((int64_t)k * np / n);
+        bpart[keys[k].e] = (int32_t)((int64_t)k * np / n);
 }
 
 /* The visiting order (block_local.h), from the blocks' node lists; part[]
@@ -166,7 +155,7 @@ static getme_status build_order(getme_blocks *blk, const getme_ws *ws,
                            sizeof *blk->part_ptr);
     blk->col_ptr = calloc((size_t)ws->num_colours + 1, sizeof *blk->col_ptr);
     int32_t *cur = malloc(nbs * sizeof *cur), *bpart = malloc(nbs * sizeof *bpart);
-    block_key *keys = malloc(nbs * sizeof *keys);
+    getme_ranked *keys = malloc(nbs * sizeof *keys);
     uint8_t *left = malloc(nbs);
     getme_status st = GETME_ERR_NOMEM;
     if (!blk->order || !blk->part_ptr || !blk->col_ptr || !cur || !bpart ||

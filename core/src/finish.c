@@ -37,19 +37,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct ranked {
-    double q;
-    int32_t e;
-} ranked;
-
-static int cmp_ranked(const void *a, const void *b)
-{
-    const ranked *x = a, *y = b;
-    if (x->q != y->q)
-        return x->q < y->q ? -1 : 1;
-    return (x->e > y->e) - (x->e < y->e);
-}
-
 /*
  * A memo of failed single-node climbs.  A climb that keeps no step leaves
  * everything as it was (trial moves are undone bit for bit), and whether
@@ -319,7 +306,7 @@ static double sub_bound(const getme_run *run, double fraction,
 
 /* On a sub-mesh: 1 if every free node of every listed element has its
    whole star inside (improve() moves them and fills their stars). */
-static int stars_inside(const getme_run *run, const ranked *r, int32_t n)
+static int stars_inside(const getme_run *run, const getme_ranked *r, int32_t n)
 {
     const getme_ws *ws = run->ws;
     for (int32_t i = 0; i < n; i++) {
@@ -385,21 +372,22 @@ static int report(getme_run *run, int pass, double q_min, double q_mean,
 }
 
 /* The pass's elements: free ones with q <= bound, worst first. */
-static ranked *pass_list(const getme_run *run, double bound, int32_t *count)
+static getme_ranked *pass_list(const getme_run *run, double bound,
+                               int32_t *count)
 {
     const getme_ws *ws = run->ws;
     int32_t n = 0;
 #pragma omp parallel for schedule(static) num_threads(ws->nt) reduction(+ : n)
     for (int32_t e = 0; e < ws->ne; e++)
         n += ws->free_elem[e] && run->q[e] <= bound;
-    ranked *r = malloc((size_t)(n ? n : 1) * sizeof *r);
+    getme_ranked *r = malloc((size_t)(n ? n : 1) * sizeof *r);
     if (!r)
         return NULL;
     n = 0;
     for (int32_t e = 0; e < ws->ne; e++)
         if (ws->free_elem[e] && run->q[e] <= bound)
             r[n].q = run->q[e], r[n++].e = e;
-    qsort(r, (size_t)n, sizeof *r, cmp_ranked);
+    qsort(r, (size_t)n, sizeof *r, getme__cmp_ranked);
     *count = n;
     return r;
 }
@@ -435,7 +423,7 @@ getme_status getme__finish(getme_run *run)
             break;
         }
         int32_t n, raised = 0;
-        ranked *list = bound < 0.0 ? NULL : pass_list(run, bound, &n);
+        getme_ranked *list = bound < 0.0 ? NULL : pass_list(run, bound, &n);
         if (!list) {
             st = GETME_ERR_NOMEM;
             break;

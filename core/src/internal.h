@@ -70,6 +70,23 @@ double getme__quality(int type, const double *x);
    ratio already measures their only corner. */
 double getme__corner_sj(int type, const double *x);
 
+/* A value and the element (or block) it belongs to.  getme__cmp_ranked
+   sorts by value, ties by index: a total order, so qsort gives the same
+   list whatever it does with equal keys (values are finite: qualities,
+   coordinates). */
+typedef struct getme_ranked {
+    double q;
+    int32_t e;
+} getme_ranked;
+
+static inline int getme__cmp_ranked(const void *a, const void *b)
+{
+    const getme_ranked *x = a, *y = b;
+    if (x->q != y->q)
+        return x->q < y->q ? -1 : 1;
+    return (x->e > y->e) - (x->e < y->e);
+}
+
 /* Types whose mean ratio averages several corners, so that one corner can
    collapse while q stays fair: the corner guard applies to them. */
 static inline int getme__has_corners(int type)

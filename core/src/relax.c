@@ -121,7 +121,8 @@ static inline void trial_block(int t, getme_run *run, int32_t b)
         if (ws->free_elem[e])
             list[n++] = e;
     for (int32_t j = 0; j < n; j += GETME_LANES)
-        trial_batch(t, run, list + j, n - j < GETME_LANES ? n - j : GETME_LANES);
+        trial_batch(t, run, list + j,
+                    n - j < GETME_LANES ? n - j : GETME_LANES);
 }
 
 static int64_t trial_block_any(void *ctx, int32_t b)
