@@ -280,8 +280,10 @@ static int32_t scatter_all(getme_run *run)
     return (int32_t)(r & 0xffffffff);
 }
 
-/* The q_mean stage's I_T (every free node in use) and element list (every
-   free element): the same in every iteration, so built once. */
+/* The q_mean stage's I_T (every free node in use): the same in every
+   iteration, so built once.  Its element list, every free element, is
+   implicit (relax.c): run->elems stays untouched, so not resident, until
+   the q*_min stage. */
 static void lists_all(getme_run *run)
 {
     const getme_ws *ws = run->ws;
@@ -290,11 +292,7 @@ static void lists_all(getme_run *run)
         if (!ws->fixed[i] && ws->star_ptr[i + 1] > ws->star_ptr[i])
             run->nodes[m++] = i;
     run->num_nodes = m;
-    m = 0;
-    for (int32_t e = 0; e < ws->ne; e++)
-        if (ws->free_elem[e])
-            run->elems[m++] = e;
-    run->num_elems = m;
+    run->num_elems = (int32_t)ws->num_free_elem;
 }
 
 /* q*_min stage: only the elements in run->tlist (q <= q_t) are transformed,

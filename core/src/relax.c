@@ -13,21 +13,45 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Eq. 10 for node i with table entry rho.  rho = 0 and rho = 1 are taken
-   literally so that a reset node gets its old coordinates bit for bit. */
+/* Where node i's trial coordinates are: after its p-hat
+   (GETME_TRIAL_OFF, smooth_internal.h) if it moves (in_t), else its
+   coordinates.  A select, not a branch: in the q_mean stage only the
+   boundary's nodes stay. */
+static inline const void *trial_at(const getme_run *run, int32_t i)
+{
+    const unsigned char *slot = run->phat + i * run->phat_step + GETME_TRIAL_OFF;
+    const void *x = run->ws->x + 3 * (int64_t)i;
+    return run->in_t[i] ? (const void *)slot : x;
+}
+
+/* The coordinates of element e's nodes (type t) at the trial positions. */
+static inline void trial_gather(const getme_run *run, int t, int32_t e,
+                                double *x)
+{
+    const int32_t *c = getme__ws_nodes(run->ws, t, e);
+    for (int i = 0; i < getme__nv[t]; i++)
+        memcpy(x + 3 * i, trial_at(run, c[i]), 3 * sizeof *x);
+}
+
+/* Eq. 10 for node i (in I_T) with table entry rho, into its trial
+   coordinates.  rho = 0 and rho = 1 are taken literally so that a reset
+   node gets its old coordinates bit for bit. */
 static inline void place(getme_run *run, int32_t i, double rho)
 {
     const double *x = run->ws->x + 3 * (int64_t)i;
-    double ph[3];
-    memcpy(ph, run->phat + i * run->phat_step, sizeof ph);
-    double *xn = run->xnew + 3 * (int64_t)i;
+    unsigned char *slot = run->phat + i * run->phat_step;
+    double ph[3], xn[3];
+    memcpy(ph, slot, sizeof ph);
     for (int d = 0; d < 3; d++)
         xn[d] = rho == 0.0 ? x[d]
               : rho == 1.0 ? ph[d]
                            : (1.0 - rho) * x[d] + rho * ph[d];
+    memcpy(slot + GETME_TRIAL_OFF, xn, sizeof xn);
+    if (run->xnew) /* second order */
+        memcpy(run->xnew + 3 * (int64_t)i, xn, sizeof xn);
 }
 
-/* Quality of element e (type t) at the trial coordinates xnew, given its
+/* Quality of element e (type t) at the trial coordinates, given its
    mean ratio q there: 0 if it is invalid there or if the corner guard
    rejects it: its worst corner fell below both its old value (at ws->x)
    and the floor.  An element at its old shape is never rejected, so the
@@ -42,7 +66,7 @@ static inline double trial_check(const getme_run *run, int32_t e, int t,
         q >= run->guard_skip_q[t])
         return q;
     double x[3 * GETME_MAX_NV];
-    getme__ws_gather(ws, run->xnew, t, e, x);
+    trial_gather(run, t, e, x);
     double sj = getme__corner_sj(t, x);
     if (sj >= run->corner_floor)
         return q;
@@ -54,7 +78,7 @@ static inline double trial_quality(const getme_run *run, int32_t e)
 {
     double x[3 * GETME_MAX_NV];
     int t = getme__ws_type(run->ws, e);
-    getme__ws_gather(run->ws, run->xnew, t, e, x);
+    trial_gather(run, t, e, x);
     return trial_check(run, e, t, getme__quality(t, x));
 }
 
@@ -90,9 +114,12 @@ static inline void trial_batch(int t, getme_run *run, const int32_t *elems,
     if (same) {
         for (int l = 0; l < GETME_LANES; l++) {
             const int32_t *c = getme__ws_nodes(ws, t, elems[l < n ? l : 0]);
-            for (int i = 0; i < getme__nv[t]; i++)
+            for (int i = 0; i < getme__nv[t]; i++) {
+                double p[3];
+                memcpy(p, trial_at(run, c[i]), sizeof p);
                 for (int d = 0; d < 3; d++)
-                    x[3 * i + d][l] = run->xnew[3 * (int64_t)c[i] + d];
+                    x[3 * i + d][l] = p[d];
+            }
         }
         if (getme__quality_lanes(t, (const double(*)[GETME_LANES])x, q)) {
             for (int32_t l = 0; l < n; l++)
@@ -108,7 +135,7 @@ static inline void trial_batch(int t, getme_run *run, const int32_t *elems,
 
 /* The q_mean stage's first trial-quality pass over block b (its elements
    all of type t, a constant in each copy, GETME_FOR_TYPE): every free
-   element's quality at xnew, and its S_v / S_e updated (set_q).  Blocks
+   element's quality at the trial coordinates, and its S_v / S_e updated (set_q).  Blocks
    that run at the same time share no node, hence no edge
    (block_local.h), so the sums need no atomics. */
 __attribute__((always_inline)) /* one copy per type: t is a constant */
@@ -133,24 +160,46 @@ static int64_t trial_block_any(void *ctx, int32_t b)
     return 0;
 }
 
-/* How many elements of the list are invalid at xnew (parallel count). */
+/* The relaxation's element list: run->elems, or in the q_mean stage
+   (run->live) every free element in ascending order, which run->elems
+   then does not hold (4 B per element less at stage 1's peak).  Element
+   k of the list, for k < list_len(run): */
+static inline int32_t list_len(const getme_run *run)
+{
+    return run->live ? run->ws->ne : run->num_elems;
+}
+
+/* -1 for an index of the implicit list that is not a free element. */
+static inline int32_t list_elem(const getme_run *run, int32_t k)
+{
+    if (!run->live)
+        return run->elems[k];
+    return run->ws->free_elem[k] ? k : -1;
+}
+
+/* Element e of the list is invalid at the trial coordinates. */
+static inline int is_invalid(const getme_run *run, int32_t e)
+{
+    return e >= 0 && !(run->q[e] > 0.0);
+}
+
+/* How many elements of the list are invalid at the trial coordinates
+   (parallel count). */
 static int32_t count_invalid(const getme_run *run)
 {
-    const double *q = run->q;
-    const int32_t *elems = run->elems;
-    int32_t n = run->num_elems, bad = 0;
+    int32_t n = list_len(run), bad = 0;
 #pragma omp parallel for schedule(static) num_threads(run->ws->nt) \
     reduction(+ : bad) if (n > GETME_PAR_MIN)
     for (int32_t k = 0; k < n; k++)
-        bad += !(q[elems[k]] > 0.0);
+        bad += is_invalid(run, list_elem(run, k));
     return bad;
 }
 
-/* The invalid elements of the list (q <= 0 at xnew), in list order, into
-   *bad (grown as needed; *cap its room).  Returns how many, or -1 if out of
-   memory.  Few elements are invalid, so after this one scan each step of
-   the table re-checks only them and the stars it touched, instead of
-   counting over the whole list again. */
+/* The invalid elements of the list (q <= 0 at the trial coordinates), in
+   list order, into *bad (grown as needed; *cap its room).  Returns how
+   many, or -1 if out of memory.  Few elements are invalid, so after this
+   one scan each step of the table re-checks only them and the stars it
+   touched, instead of counting over the whole list again. */
 static int32_t list_invalid(const getme_run *run, int32_t **bad, int64_t *cap)
 {
     int32_t n = count_invalid(run), m = 0;
@@ -161,9 +210,11 @@ static int32_t list_invalid(const getme_run *run, int32_t **bad, int64_t *cap)
         *bad = p;
         *cap = 2 * (int64_t)n;
     }
-    for (int32_t k = 0; m < n && k < run->num_elems; k++)
-        if (!(run->q[run->elems[k]] > 0.0))
-            (*bad)[m++] = run->elems[k];
+    for (int32_t k = 0; m < n && k < list_len(run); k++) {
+        int32_t e = list_elem(run, k);
+        if (is_invalid(run, e))
+            (*bad)[m++] = e;
+    }
     return m;
 }
 
@@ -188,17 +239,20 @@ static int keep_if_invalid(getme_run *run, int32_t e, int32_t **bad,
     return 0;
 }
 
-/* The moving nodes of the invalid elements among bad[0..nbad) that can
-   still step down the table, each once, into run->list (serial: few elements
-   are invalid, and the list order must not depend on the thread count). */
+/* The moving nodes of the invalid elements among bad[0..nbad) (NULL: the
+   whole element list, list_elem) that can still step down the table, each
+   once, into run->list (serial: few elements are invalid, and the list
+   order must not depend on the thread count). */
 static int32_t nodes_to_step(getme_run *run, int nR, const int32_t *bad,
                              int32_t nbad)
 {
     const getme_ws *ws = run->ws;
     int32_t m = 0;
+    if (!bad)
+        nbad = list_len(run);
     for (int32_t k = 0; k < nbad; k++) {
-        int32_t e = bad[k];
-        if (run->q[e] > 0.0)
+        int32_t e = bad ? bad[k] : list_elem(run, k);
+        if (!is_invalid(run, e))
             continue; /* the whole element list was passed (no memory) */
         int t = getme__ws_type(ws, e);
         const int32_t *c = getme__ws_nodes(ws, t, e);
@@ -241,7 +295,7 @@ static void step_nodes(getme_run *run, const double *R, int32_t m)
 static void steps_dist(getme_run *run, const double *R, int nR)
 {
     while (getme__dist_any(run, count_invalid(run) > 0)) {
-        nodes_to_step(run, nR, run->elems, run->num_elems);
+        nodes_to_step(run, nR, NULL, 0);
         int32_t m = getme__dist_step_list(run, nR);
         if (!getme__dist_any(run, m > 0))
             break; /* unreachable for a valid input, see getme__relax */
@@ -264,8 +318,7 @@ static void steps_local(getme_run *run, const double *R, int nR)
         /* Out of memory for the lists: the whole list is the candidate
            set (slower, same result). */
         int32_t m = nbad > 0 ? nodes_to_step(run, nR, bad, nbad)
-                             : nodes_to_step(run, nR, run->elems,
-                                             run->num_elems);
+                             : nodes_to_step(run, nR, NULL, 0);
         if (m == 0)
             break; /* unreachable for a valid input, see above */
         step_nodes(run, R, m);
@@ -311,7 +364,7 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
         run->ridx[nodes[k]] = 0;
         place(run, nodes[k], R[0]);
     }
-    if (run->live) { /* the q_mean stage: run->elems is every free element */
+    if (run->live) { /* the q_mean stage: the list is every free element */
         getme__blocks_run(&run->adj->blk, ws, trial_block_any, run);
     } else {
         int32_t nbatch = ne / GETME_LANES;
@@ -338,9 +391,7 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
     reduction(+ : relaxed) if (nn > GETME_PAR_MIN)
     for (int32_t k = 0; k < nn; k++) {
         int32_t i = nodes[k];
-        double *x = ws->x + 3 * (int64_t)i;
-        const double *xn = run->xnew + 3 * (int64_t)i;
-        x[0] = xn[0], x[1] = xn[1], x[2] = xn[2];
+        memcpy(ws->x + 3 * (int64_t)i, trial_at(run, i), 3 * sizeof(double));
         relaxed += run->ridx[i] > 0;
     }
     return relaxed;
