@@ -13,64 +13,71 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Where node i's trial coordinates are: after its p-hat
-   (GETME_TRIAL_OFF, smooth_internal.h) if it moves (in_t), else its
-   coordinates.  A select, not a branch: in the q_mean stage only the
-   boundary's nodes stay. */
-static inline const void *trial_at(const getme_run *run, int32_t i)
+/* During the relaxation ws->x holds the trial coordinates, and a node
+   that moves (I_T, in_t) keeps its old coordinates after its p-hat
+   (GETME_XOLD_OFF, smooth_internal.h): the trial qualities gather from
+   the dense coordinate array, the step that ends the relaxation has
+   nothing to copy, and no trial array is needed (24 B per node). */
+static inline unsigned char *old_slot(const getme_run *run, int32_t i)
 {
-    const unsigned char *slot = run->phat + i * run->phat_step + GETME_TRIAL_OFF;
-    const void *x = run->ws->x + 3 * (int64_t)i;
-    return run->in_t[i] ? (const void *)slot : x;
+    return run->phat + i * run->phat_step + GETME_XOLD_OFF;
 }
 
-/* The coordinates of element e's nodes (type t) at the trial positions. */
-static inline void trial_gather(const getme_run *run, int t, int32_t e,
-                                double *x)
+/* Eq. 10 for node i (in I_T) with table entry rho and old coordinates
+   x, into ws->x.  rho = 0 and rho = 1 are taken literally so that a
+   reset node gets its old coordinates bit for bit. */
+static inline void place_from(getme_run *run, int32_t i, double rho,
+                              const double x[3])
 {
-    const int32_t *c = getme__ws_nodes(run->ws, t, e);
-    for (int i = 0; i < getme__nv[t]; i++)
-        memcpy(x + 3 * i, trial_at(run, c[i]), 3 * sizeof *x);
-}
-
-/* Eq. 10 for node i (in I_T) with table entry rho, into its trial
-   coordinates.  rho = 0 and rho = 1 are taken literally so that a reset
-   node gets its old coordinates bit for bit. */
-static inline void place(getme_run *run, int32_t i, double rho)
-{
-    const double *x = run->ws->x + 3 * (int64_t)i;
-    unsigned char *slot = run->phat + i * run->phat_step;
     double ph[3], xn[3];
-    memcpy(ph, slot, sizeof ph);
+    memcpy(ph, run->phat + i * run->phat_step, sizeof ph);
     for (int d = 0; d < 3; d++)
         xn[d] = rho == 0.0 ? x[d]
               : rho == 1.0 ? ph[d]
                            : (1.0 - rho) * x[d] + rho * ph[d];
-    memcpy(slot + GETME_TRIAL_OFF, xn, sizeof xn);
-    if (run->xnew) /* second order */
-        memcpy(run->xnew + 3 * (int64_t)i, xn, sizeof xn);
+    memcpy(run->ws->x + 3 * (int64_t)i, xn, sizeof xn);
 }
 
-/* Quality of element e (type t) at the trial coordinates, given its
-   mean ratio q there: 0 if it is invalid there or if the corner guard
-   rejects it: its worst corner fell below both its old value (at ws->x)
-   and the floor.  An element at its old shape is never rejected, so the
+/* The first placement of node i: its coordinates saved as the old ones. */
+static inline void place_first(getme_run *run, int32_t i, double rho)
+{
+    double x[3];
+    memcpy(x, run->ws->x + 3 * (int64_t)i, sizeof x);
+    memcpy(old_slot(run, i), x, sizeof x);
+    place_from(run, i, rho, x);
+}
+
+/* A later placement of node i, from its saved old coordinates. */
+static inline void place(getme_run *run, int32_t i, double rho)
+{
+    double x[3];
+    memcpy(x, old_slot(run, i), sizeof x);
+    place_from(run, i, rho, x);
+}
+
+/* Quality of element e (type t) at the trial coordinates (ws->x), given
+   its mean ratio q there: 0 if it is invalid there or if the corner guard
+   rejects it: its worst corner fell below both its old value and the
+   floor.  An element at its old shape is never rejected, so the
    relaxation's reset argument holds. */
 static inline double trial_check(const getme_run *run, int32_t e, int t,
                                  double q)
 {
     const getme_ws *ws = run->ws;
-    if (q > 0.0 && ws->ho && !getme__ho_valid(ws, run->xnew, e))
+    if (q > 0.0 && ws->ho && !getme__ho_valid(ws, ws->x, e))
         return 0.0; /* second order: det J > 0 at every node */
     if (!run->guard || !getme__has_corners(t) || !(q > 0.0) ||
         q >= run->guard_skip_q[t])
         return q;
     double x[3 * GETME_MAX_NV];
-    trial_gather(run, t, e, x);
+    getme__ws_gather(ws, ws->x, t, e, x);
     double sj = getme__corner_sj(t, x);
     if (sj >= run->corner_floor)
         return q;
-    getme__ws_gather(ws, ws->x, t, e, x);
+    const int32_t *c = getme__ws_nodes(ws, t, e); /* the old shape */
+    for (int i = 0; i < getme__nv[t]; i++)
+        if (run->in_t[c[i]])
+            memcpy(x + 3 * i, old_slot(run, c[i]), 3 * sizeof *x);
     return sj < getme__corner_sj(t, x) ? 0.0 : q;
 }
 
@@ -78,7 +85,7 @@ static inline double trial_quality(const getme_run *run, int32_t e)
 {
     double x[3 * GETME_MAX_NV];
     int t = getme__ws_type(run->ws, e);
-    trial_gather(run, t, e, x);
+    getme__ws_gather(run->ws, run->ws->x, t, e, x);
     return trial_check(run, e, t, getme__quality(t, x));
 }
 
@@ -114,12 +121,9 @@ static inline void trial_batch(int t, getme_run *run, const int32_t *elems,
     if (same) {
         for (int l = 0; l < GETME_LANES; l++) {
             const int32_t *c = getme__ws_nodes(ws, t, elems[l < n ? l : 0]);
-            for (int i = 0; i < getme__nv[t]; i++) {
-                double p[3];
-                memcpy(p, trial_at(run, c[i]), sizeof p);
+            for (int i = 0; i < getme__nv[t]; i++)
                 for (int d = 0; d < 3; d++)
-                    x[3 * i + d][l] = p[d];
-            }
+                    x[3 * i + d][l] = ws->x[3 * (int64_t)c[i] + d];
         }
         if (getme__quality_lanes(t, (const double(*)[GETME_LANES])x, q)) {
             for (int32_t l = 0; l < n; l++)
@@ -362,7 +366,7 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
 #pragma omp parallel for schedule(static) num_threads(nt) if (nn > GETME_PAR_MIN)
     for (int32_t k = 0; k < nn; k++) {
         run->ridx[nodes[k]] = 0;
-        place(run, nodes[k], R[0]);
+        place_first(run, nodes[k], R[0]);
     }
     if (run->live) { /* the q_mean stage: the list is every free element */
         getme__blocks_run(&run->adj->blk, ws, trial_block_any, run);
@@ -391,7 +395,6 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
     reduction(+ : relaxed) if (nn > GETME_PAR_MIN)
     for (int32_t k = 0; k < nn; k++) {
         int32_t i = nodes[k];
-        memcpy(ws->x + 3 * (int64_t)i, trial_at(run, i), 3 * sizeof(double));
         relaxed += run->ridx[i] > 0;
     }
     return relaxed;

@@ -15,8 +15,6 @@ getme_status getme__run_alloc(getme_run *run)
     const getme_ws *ws = run->ws;
     size_t nn = (size_t)(ws->nn ? ws->nn : 1), ne = (size_t)(ws->ne ? ws->ne : 1);
     run->q = malloc(ne * sizeof *run->q);
-    if (ws->ho) /* second order only (smooth_internal.h) */
-        run->xnew = malloc(nn * 3 * sizeof *run->xnew);
     run->in_t = calloc(nn, 1);
     run->flag = calloc(nn, 1);
     run->ridx = calloc(nn, 1);
@@ -24,18 +22,15 @@ getme_status getme__run_alloc(getme_run *run)
     run->nodes = malloc(nn * sizeof *run->nodes);
     run->elems = malloc(ne * sizeof *run->elems);
     run->list = malloc(nn * sizeof *run->list);
-    if (!run->q || (ws->ho && !run->xnew) || !run->in_t || !run->flag ||
+    if (!run->q || !run->in_t || !run->flag ||
         !run->ridx || !run->eflag || !run->nodes || !run->elems || !run->list)
         return GETME_ERR_NOMEM;
-    if (run->xnew)
-        memcpy(run->xnew, ws->x, (size_t)ws->nn * 3 * sizeof *run->xnew);
     return GETME_OK;
 }
 
 void getme__run_free(getme_run *run)
 {
     free(run->q);
-    free(run->xnew);
     free(run->in_t);
     free(run->flag);
     free(run->ridx);
@@ -184,9 +179,6 @@ static getme_status untangle(getme_mesh *mesh, getme_ws *ws, getme_run *run)
     if (st != GETME_OK)
         return getme__fail(mesh, st, "out of memory untangling %d elements",
                            (int)ws->ne);
-    /* the relaxation's trial coordinates must equal ws->x outside it */
-    if (run->xnew)
-        memcpy(run->xnew, ws->x, (size_t)ws->nn * 3 * sizeof *run->xnew);
     return ur.num_invalid_after ? getme__untangle_message(mesh, &ur)
                                 : GETME_OK;
 }

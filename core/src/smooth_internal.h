@@ -8,8 +8,8 @@
 #include "exact.h"
 #include "workspace.h"
 
-/* Byte offset of a node's trial coordinates after its p-hat (getme_run). */
-#define GETME_TRIAL_OFF (3 * (int64_t)sizeof(double))
+/* Byte offset of a node's old coordinates after its p-hat (getme_run). */
+#define GETME_XOLD_OFF (3 * (int64_t)sizeof(double))
 
 /* Loops over fewer items than this run on one thread: in the q*_min stage
    the lists are small, and a parallel loop's barrier then costs more than
@@ -31,19 +31,15 @@ typedef struct getme_run {
     double t0;          /* omp_get_wtime() at start                        */
     double *q;          /* ne: quality at ws->x                            */
     /* The target p-hat of node i: 3 doubles at phat + i * phat_step bytes,
-       and the node's trial coordinates of the relaxation (Eq. 10) the 3
-       doubles after them (GETME_TRIAL_OFF), both read and written with
-       memcpy, only for the nodes that move (in_t).  In GETMe adaptive they
-       are the first 48 bytes of the node's exact sums (facc), which are
-       zero from ComputeNewNodes to getme__reset_nodes, so neither needs
-       an array of its own (56 B per node less); Laplace owns a 6 * nn
-       array. */
+       and during the relaxation (Eq. 10, relax.c), which moves the nodes
+       of I_T (in_t) in ws->x itself, their old coordinates in the 3
+       doubles after it (GETME_XOLD_OFF); read and written with memcpy.  In
+       GETMe adaptive they are the first 48 bytes of the node's exact sums
+       (facc), which are zero from ComputeNewNodes to getme__reset_nodes,
+       so neither needs an array of its own (56 B per node less); Laplace
+       owns a 6 * nn array. */
     unsigned char *phat;
     int64_t phat_step;
-    /* Second-order meshes only (NULL otherwise): the trial coordinates of
-       every node as one 3 * nn array (getme__ho_valid reads an array);
-       equals ws->x outside the relaxation step. */
-    double *xnew;
     uint8_t *in_t;      /* nn: node is in I_T (moves this iteration)        */
     uint8_t *flag;      /* nn: scratch flag, all zero between uses          */
     uint8_t *ridx;      /* nn: index into the relaxation table              */
