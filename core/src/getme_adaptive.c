@@ -476,22 +476,33 @@ static getme_status start_tlist(getme_run *run, double qt)
 /* ComputeNewNodes: p-hat = weighted sum / weight sum, for I_T, from the
    exact sums, written over them (cleared by getme__reset_nodes).  The quotient of
    the two integers' doubles is scaled back by 1 / pscale, a power of two,
-   so the only roundings are the two conversions and the division. */
-static void compute_new_nodes(getme_run *run)
+   so the only roundings are the two conversions and the division.  In the
+   same pass each node takes the relaxation's first position (rho0 =
+   R[0]; getme__place_first), which saves the relaxation a pass over the
+   nodes' sums. */
+static void compute_new_nodes(getme_run *run, double rho0)
 {
     double back = 1.0 / run->pscale;
+    getme_fx *facc = run->facc;
+    double *x = run->ws->x;
+    uint8_t *ridx = run->ridx;
+    const int32_t *nodes = run->nodes;
+    int32_t nn = run->num_nodes;
 #pragma omp parallel for schedule(static) num_threads(run->ws->nt) \
-    if (run->num_nodes > GETME_PAR_MIN)
-    for (int32_t k = 0; k < run->num_nodes; k++) {
-        int64_t n = run->nodes[k];
-        const getme_fx *f = run->facc + 4 * n;
+    if (nn > GETME_PAR_MIN)
+    for (int32_t k = 0; k < nn; k++) {
+        int32_t n = nodes[k];
+        getme_fx *f = facc + 4 * (int64_t)n;
         double inv = 1.0 / (double)f[3];
         double a[3] = {(double)f[0] * inv * back, (double)f[1] * inv * back,
                        (double)f[2] * inv * back};
         /* p-hat over the node's sums (run->phat): getme__reset_nodes
            zeroes them again before the next scatter. */
-        memcpy(run->phat + n * run->phat_step, a, sizeof a);
+        unsigned char *p = (unsigned char *)f;
+        memcpy(p, a, sizeof a);
+        getme__place_first(x, p + GETME_XOLD_OFF, ridx, n, rho0, a);
     }
+    run->placed = 1;
 }
 
 /* Undo a scatter: zero the sums and the I_T flags it set. */
@@ -627,7 +638,7 @@ static getme_status iterate(getme_run *run, int mean_stage, double qt,
             getme__dist_node_or(run, run->in_t);
         getme__dist_node_sum(run, run->facc, 4);
     }
-    compute_new_nodes(run);
+    compute_new_nodes(run, R[0]);
     if (!mean_stage) {
         qold_reserve(run);
         for (int32_t k = 0; run->qold && k < run->num_elems; k++)

@@ -13,46 +13,14 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* During the relaxation ws->x holds the trial coordinates, and a node
-   that moves (I_T, in_t) keeps its old coordinates after its p-hat
-   (GETME_XOLD_OFF, smooth_internal.h): the trial qualities gather from
-   the dense coordinate array, the step that ends the relaxation has
-   nothing to copy, and no trial array is needed (24 B per node). */
-static inline unsigned char *old_slot(const getme_run *run, int32_t i)
-{
-    return run->phat + i * run->phat_step + GETME_XOLD_OFF;
-}
-
-/* Eq. 10 for node i (in I_T) with table entry rho and old coordinates
-   x, into ws->x.  rho = 0 and rho = 1 are taken literally so that a
-   reset node gets its old coordinates bit for bit. */
-static inline void place_from(getme_run *run, int32_t i, double rho,
-                              const double x[3])
-{
-    double ph[3], xn[3];
-    memcpy(ph, run->phat + i * run->phat_step, sizeof ph);
-    for (int d = 0; d < 3; d++)
-        xn[d] = rho == 0.0 ? x[d]
-              : rho == 1.0 ? ph[d]
-                           : (1.0 - rho) * x[d] + rho * ph[d];
-    memcpy(run->ws->x + 3 * (int64_t)i, xn, sizeof xn);
-}
-
-/* The first placement of node i: its coordinates saved as the old ones. */
-static inline void place_first(getme_run *run, int32_t i, double rho)
-{
-    double x[3];
-    memcpy(x, run->ws->x + 3 * (int64_t)i, sizeof x);
-    memcpy(old_slot(run, i), x, sizeof x);
-    place_from(run, i, rho, x);
-}
-
 /* A later placement of node i, from its saved old coordinates. */
 static inline void place(getme_run *run, int32_t i, double rho)
 {
-    double x[3];
-    memcpy(x, old_slot(run, i), sizeof x);
-    place_from(run, i, rho, x);
+    double x[3], ph[3], xn[3];
+    memcpy(x, getme__xold(run, i), sizeof x);
+    memcpy(ph, run->phat + i * run->phat_step, sizeof ph);
+    getme__eq10(rho, x, ph, xn);
+    memcpy(run->ws->x + 3 * (int64_t)i, xn, sizeof xn);
 }
 
 /* Quality of element e (type t) at the trial coordinates (ws->x), given
@@ -77,7 +45,7 @@ static inline double trial_check(const getme_run *run, int32_t e, int t,
     const int32_t *c = getme__ws_nodes(ws, t, e); /* the old shape */
     for (int i = 0; i < getme__nv[t]; i++)
         if (run->in_t[c[i]])
-            memcpy(x + 3 * i, old_slot(run, c[i]), 3 * sizeof *x);
+            memcpy(x + 3 * i, getme__xold(run, c[i]), 3 * sizeof *x);
     return sj < getme__corner_sj(t, x) ? 0.0 : q;
 }
 
@@ -363,11 +331,19 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
     const int32_t nn = run->num_nodes, ne = run->num_elems;
     int nt = ws->nt;
 
+    if (!run->placed) {
+        unsigned char *phat = run->phat;
+        int64_t step = run->phat_step;
 #pragma omp parallel for schedule(static) num_threads(nt) if (nn > GETME_PAR_MIN)
-    for (int32_t k = 0; k < nn; k++) {
-        run->ridx[nodes[k]] = 0;
-        place_first(run, nodes[k], R[0]);
+        for (int32_t k = 0; k < nn; k++) {
+            double ph[3];
+            unsigned char *p = phat + nodes[k] * step;
+            memcpy(ph, p, sizeof ph);
+            getme__place_first(ws->x, p + GETME_XOLD_OFF, run->ridx,
+                               nodes[k], R[0], ph);
+        }
     }
+    run->placed = 0;
     if (run->live) { /* the q_mean stage: the list is every free element */
         getme__blocks_run(&run->adj->blk, ws, trial_block_any, run);
     } else {

@@ -8,6 +8,8 @@
 #include "exact.h"
 #include "workspace.h"
 
+#include <string.h>
+
 /* Byte offset of a node's old coordinates after its p-hat (getme_run). */
 #define GETME_XOLD_OFF (3 * (int64_t)sizeof(double))
 
@@ -40,6 +42,10 @@ typedef struct getme_run {
        owns a 6 * nn array. */
     unsigned char *phat;
     int64_t phat_step;
+    /* The nodes of run->nodes are already at R[0] (getme__place_first,
+       done by GETMe adaptive's ComputeNewNodes in the same pass);
+       getme__relax clears it. */
+    int placed;
     uint8_t *in_t;      /* nn: node is in I_T (moves this iteration)        */
     uint8_t *flag;      /* nn: scratch flag, all zero between uses          */
     uint8_t *ridx;      /* nn: index into the relaxation table              */
@@ -119,6 +125,44 @@ double getme__weight_union(const getme_run *run, int t, int32_t e);
 /* Build run->nodes from run->in_t and run->elems (elements with a node in
    I_T), both ascending; deterministic. */
 void getme__collect(getme_run *run);
+
+/* During the relaxation ws->x holds the trial coordinates, and a node
+   that moves (I_T, in_t) keeps its old coordinates after its p-hat
+   (GETME_XOLD_OFF): the trial qualities gather from the dense coordinate
+   array, the end of the relaxation has nothing to copy, and no trial
+   array is needed (24 B per node).  Node i's old coordinates: */
+static inline unsigned char *getme__xold(const getme_run *run, int32_t i)
+{
+    return run->phat + i * run->phat_step + GETME_XOLD_OFF;
+}
+
+/* Eq. 10: the trial position xn at table entry rho between old
+   coordinates x and p-hat ph.  rho = 0 and rho = 1 are taken literally so
+   that a reset node gets its old coordinates bit for bit. */
+static inline void getme__eq10(double rho, const double x[3],
+                               const double ph[3], double xn[3])
+{
+    for (int d = 0; d < 3; d++)
+        xn[d] = rho == 0.0 ? x[d]
+              : rho == 1.0 ? ph[d]
+                           : (1.0 - rho) * x[d] + rho * ph[d];
+}
+
+/* The relaxation's first placement of node i at table entry rho (index
+   0), from its p-hat ph, in one pass with ComputeNewNodes: its
+   coordinates saved as the old ones (xold, getme__xold), the trial ones
+   into x = ws->x.  Plain pointers: stores through the byte array phat
+   could alias run's fields, which a loop would then reload per node. */
+static inline void getme__place_first(double *x, unsigned char *xold,
+                                      uint8_t *ridx, int32_t i, double rho,
+                                      const double ph[3])
+{
+    double *xi = x + 3 * (int64_t)i, o[3] = {xi[0], xi[1], xi[2]}, xn[3];
+    memcpy(xold, o, sizeof o);
+    ridx[i] = 0;
+    getme__eq10(rho, o, ph, xn);
+    xi[0] = xn[0], xi[1] = xn[1], xi[2] = xn[2];
+}
 
 /*
  * IterativeNodeRelaxation (paper Sec. 2.2, Eq. 10): move every node of
