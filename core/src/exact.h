@@ -73,6 +73,31 @@ static inline getme_fx getme__fx_q(double q)
     return getme__fx(q, GETME_FX_QSCALE);
 }
 
+/* The sum of getme__fx_q(v[i]) over [0, n), n < 2^31, |v[i]| <= 2: the
+   same integer, in int64 parts that vector instructions add lane by lane
+   (q_mean's sum runs over every element in every iteration).  A term's
+   magnitude a = trunc(|v| 2^90) < 2^91 is hi 2^63 + lo as in getme__fx
+   (hi < 2^28), and lo = l1 2^32 + l0 (l1 < 2^31, l0 < 2^32); the three
+   signed sums of n < 2^31 such parts stay below 2^59, 2^62 and 2^63. */
+static inline getme_fx getme__fx_q_sum(const double *v, int64_t n)
+{
+    int64_t sh = 0, s1 = 0, s0 = 0;
+#pragma omp simd reduction(+ : sh, s1, s0)
+    for (int64_t i = 0; i < n; i++) {
+        double a = fabs(v[i] * GETME_FX_QSCALE);
+        int64_t hi = (int64_t)(a * 0x1p-63);
+        int64_t lo = (int64_t)(a - (double)hi * 0x1p63);
+        int64_t l1 = lo >> 32, l0 = lo & 0xffffffff;
+        int neg = v[i] < 0.0;
+        sh += neg ? -hi : hi;
+        s1 += neg ? -l1 : l1;
+        s0 += neg ? -l0 : l0;
+    }
+    /* wrapping unsigned shifts, then the two's complement value */
+    return (getme_fx)(((getme_ufx)sh << 63) + ((getme_ufx)s1 << 32) +
+                      (getme_ufx)s0);
+}
+
 /* trunc(v * scale) for |v * scale| < 2^63: one conversion instruction.
    The Eq. 9 sums use it (adjacency.h): half the memory of 128 bits, which
    is what their scattered loads cost. */

@@ -576,12 +576,15 @@ void getme__ws_qualities(const getme_ws *ws, double *q)
 double getme__det_sum(const double *v, int32_t n, int nt)
 {
     getme_ufx s = 0;
+    int32_t nb = (n + 4095) / 4096; /* getme__fx_q_sum over 4096 at a time */
 #pragma omp parallel num_threads(nt)
     {
         getme_ufx part = 0;
 #pragma omp for schedule(static) nowait
-        for (int32_t i = 0; i < n; i++)
-            part += (getme_ufx)getme__fx_q(v[i]);
+        for (int32_t b = 0; b < nb; b++) {
+            int32_t i = 4096 * b;
+            part += (getme_ufx)getme__fx_q_sum(v + i, n - i < 4096 ? n - i : 4096);
+        }
 #pragma omp critical(getme_det_sum)
         s += part;
     }

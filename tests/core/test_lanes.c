@@ -13,10 +13,14 @@
  * because the library's one-element and lane kernels share their edges
  * and cube roots across corners and must still give its bits.
  *
+ * q_mean's vectorised exact sum (exact.h getme__fx_q_sum, int64 parts)
+ * must be the integer the scalar terms getme__fx_q add up to.
+ *
  * Built from the core's sources (not libgetme), because it checks private
  * functions.
  */
 #include "check.h"
+#include "exact.h"
 #include "internal.h"
 
 #include <math.h>
@@ -165,8 +169,43 @@ static void check_qualities(int t)
     CHECK(ok);
 }
 
+/* getme__fx_q_sum against the scalar sum of getme__fx_q, on qualities in
+   [-2, 2] (all signs, the bounds, zeros, subnormal and tiny values) and
+   every length up to a few vectors (the vector loop's tails). */
+static void check_fx_sum(void)
+{
+    enum { N = 4099 };
+    static double v[N];
+    for (int i = 0; i < N; i++) {
+        double r = srand1();
+        switch (i % 11) {
+        case 0: v[i] = 2.0 * r; break;
+        case 1: v[i] = r * 0x1p-40; break;
+        case 2: v[i] = i % 2 ? 2.0 : -2.0; break;
+        case 3: v[i] = i % 2 ? 0.0 : -0.0; break;
+        case 4: v[i] = r * 0x1p-1060; break; /* subnormal */
+        case 5: v[i] = 1.0 - 0x1p-53; break;
+        default: v[i] = 0.5 + 0.5 * fabs(r);
+        }
+    }
+    for (int n = 0; n <= N; n += n < 70 ? 1 : 397) {
+        getme_ufx ref = 0;
+        for (int i = 0; i < n; i++)
+            ref += (getme_ufx)getme__fx_q(v[i]);
+        getme_fx got = getme__fx_q_sum(v, n);
+        CHECK((getme_ufx)got == ref);
+    }
+    for (int i = 0; i < N; i++) /* all of one sign, the largest terms */
+        v[i] = -2.0;
+    getme_ufx ref = 0;
+    for (int i = 0; i < N; i++)
+        ref += (getme_ufx)getme__fx_q(v[i]);
+    CHECK((getme_ufx)getme__fx_q_sum(v, N) == ref);
+}
+
 int main(void)
 {
+    check_fx_sum();
     for (int t = 0; t < GETME_NUM_TYPES; t++)
         check_qualities(t);
     check_type(GETME_TET);
