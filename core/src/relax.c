@@ -111,7 +111,8 @@ static inline void trial_batch(int t, getme_run *run, const int32_t *elems,
    that run at the same time share no node, hence no edge
    (block_local.h), so the sums need no atomics. */
 __attribute__((always_inline)) /* one copy per type: t is a constant */
-static inline void trial_block(int t, getme_run *run, int32_t b)
+static inline void trial_block(int t, getme_run *run, int32_t b,
+                               int64_t *bad)
 {
     const getme_ws *ws = run->ws;
     int32_t *list = run->adj->blk.scratch[omp_get_thread_num()].list;
@@ -122,14 +123,19 @@ static inline void trial_block(int t, getme_run *run, int32_t b)
     for (int32_t j = 0; j < n; j += GETME_LANES)
         trial_batch(t, run, list + j,
                     n - j < GETME_LANES ? n - j : GETME_LANES);
+    for (int32_t k = 0; k < n; k++)
+        *bad += !(run->q[list[k]] > 0.0);
 }
 
+/* trial_block of block b; returns how many of its elements are invalid
+   at the trial coordinates (their sum saves count_invalid's pass). */
 static int64_t trial_block_any(void *ctx, int32_t b)
 {
     getme_run *run = ctx;
+    int64_t bad = 0;
     GETME_FOR_TYPE(getme__ws_type(run->ws, run->ws->block_start[b]),
-                   trial_block, run, b);
-    return 0;
+                   trial_block, run, b, &bad);
+    return bad;
 }
 
 /* The relaxation's element list: run->elems, or in the q_mean stage
@@ -167,14 +173,15 @@ static int32_t count_invalid(const getme_run *run)
     return bad;
 }
 
-/* The invalid elements of the list (q <= 0 at the trial coordinates), in
+/* The n invalid elements of the list (q <= 0 at the trial coordinates), in
    list order, into *bad (grown as needed; *cap its room).  Returns how
    many, or -1 if out of memory.  Few elements are invalid, so after this
    one scan each step of the table re-checks only them and the stars it
    touched, instead of counting over the whole list again. */
-static int32_t list_invalid(const getme_run *run, int32_t **bad, int64_t *cap)
+static int32_t list_invalid(const getme_run *run, int32_t **bad, int64_t *cap,
+                            int32_t n)
 {
-    int32_t n = count_invalid(run), m = 0;
+    int32_t m = 0;
     if (n > *cap) {
         int32_t *p = realloc(*bad, (size_t)n * 2 * sizeof *p);
         if (!p)
@@ -277,12 +284,13 @@ static void steps_dist(getme_run *run, const double *R, int nR)
 
 /* One process: the invalid elements are listed once, then each step of
    the table re-checks only them and the stars it re-evaluated. */
-static void steps_local(getme_run *run, const double *R, int nR)
+static void steps_local(getme_run *run, const double *R, int nR,
+                        int32_t invalid)
 {
     const getme_ws *ws = run->ws;
     int64_t cap = 0;
     int32_t *bad = NULL, *next = NULL;
-    int32_t nbad = list_invalid(run, &bad, &cap);
+    int32_t nbad = invalid ? list_invalid(run, &bad, &cap, invalid) : 0;
     int64_t cap_next = cap;
     if (nbad > 0 && !(next = malloc((size_t)cap * sizeof *next)))
         nbad = -1;
@@ -330,6 +338,7 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
     const int32_t *nodes = run->nodes, *elems = run->elems;
     const int32_t nn = run->num_nodes, ne = run->num_elems;
     int nt = ws->nt;
+    int32_t invalid; /* elements of the list invalid after the first pass */
 
     if (!run->placed) {
         unsigned char *phat = run->phat;
@@ -345,7 +354,8 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
     }
     run->placed = 0;
     if (run->live) { /* the q_mean stage: the list is every free element */
-        getme__blocks_run(&run->adj->blk, ws, trial_block_any, run);
+        invalid = (int32_t)getme__blocks_run(&run->adj->blk, ws,
+                                             trial_block_any, run);
     } else {
         int32_t nbatch = ne / GETME_LANES;
 #pragma omp parallel for schedule(static) num_threads(nt) if (ne > GETME_PAR_MIN)
@@ -354,6 +364,7 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
                         elems + j * GETME_LANES, GETME_LANES);
         for (int32_t k = nbatch * GETME_LANES; k < ne; k++)
             q[elems[k]] = trial_quality(run, elems[k]);
+        invalid = run->comm ? 0 : count_invalid(run);
     }
 
     /* Step the nodes of invalid elements down the table until none is
@@ -364,7 +375,7 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
     if (run->comm)
         steps_dist(run, R, nR);
     else
-        steps_local(run, R, nR);
+        steps_local(run, R, nR, invalid);
 
     int32_t relaxed = 0;
 #pragma omp parallel for schedule(static) num_threads(nt) \
