@@ -39,76 +39,128 @@ static inline uint64_t check_value(int32_t n)
     return z ^ (z >> 31);
 }
 
-/* Other end of local edge j of a type-t element at local node li, or -1 if
-   the edge does not touch li. */
-static inline int edge_other(int t, int j, int li)
+/* The edges of each type at each corner: corner li of a type-t element
+   has num[t][li] edges, local edge j[t][li][k] to corner o[t][li][k]
+   (at most 4: a pyramid's apex).  From getme__edges, once per build. */
+typedef struct corner_edges {
+    int8_t num[GETME_NUM_TYPES][GETME_MAX_NV];
+    int8_t j[GETME_NUM_TYPES][GETME_MAX_NV][4];
+    int8_t o[GETME_NUM_TYPES][GETME_MAX_NV][4];
+} corner_edges;
+
+static void corner_edge_table(corner_edges *ce)
 {
-    const getme_edge_table *et = &getme__edges[t];
-    return et->node[j][0] == li   ? et->node[j][1]
-           : et->node[j][1] == li ? et->node[j][0]
-                                  : -1;
+    memset(ce, 0, sizeof *ce);
+    for (int t = 0; t < GETME_NUM_TYPES; t++)
+        for (int j = 0; j < getme__edges[t].num_edges; j++)
+            for (int s = 0; s < 2; s++) {
+                int li = getme__edges[t].node[j][s];
+                int k = ce->num[t][li]++;
+                ce->j[t][li][k] = (int8_t)j;
+                ce->o[t][li][k] = getme__edges[t].node[j][1 - s];
+            }
 }
 
-/* Slot of w in the list buf[0..*m) of node u's upper neighbours (the
-   other ends w > u of the edges at u), appended if new.  The lists are
-   short (~7 in a tet mesh), so a linear search beats sorting them. */
-static inline int slot_of(int32_t *buf, int *m, int32_t w)
+/* What one thread keeps while it walks its nodes: the current node's
+   upper neighbours (the other ends w > u of its edges, in the order its
+   star meets them: the slots) with each edge's element count and check
+   sum, and the edges of all its nodes so far, appended in node order. */
+typedef struct edge_walk {
+    int32_t *nbr, *deg;  /* the current node's list (max_star * 4 + 1)  */
+    uint64_t *chk;
+    int32_t *edeg;       /* all edges of the thread's nodes so far       */
+    uint64_t *re;
+    int64_t len, cap;
+} edge_walk;
+
+/* Append the current node's m edges; 0 if out of memory. */
+static int walk_append(edge_walk *w, int m, int checks)
 {
-    for (int i = 0; i < *m; i++)
-        if (buf[i] == w)
-            return i;
-    buf[*m] = w;
-    return (*m)++;
+    if (w->len + m > w->cap) {
+        int64_t cap = w->cap * 2 > w->len + m ? w->cap * 2 : w->len + m + 1024;
+        int32_t *d = realloc(w->edeg, (size_t)cap * sizeof *d);
+        if (d)
+            w->edeg = d;
+        uint64_t *r = checks ? realloc(w->re, (size_t)cap * sizeof *r) : NULL;
+        if (r)
+            w->re = r;
+        if (!d || (checks && !r))
+            return 0;
+        w->cap = cap;
+    }
+    memcpy(w->edeg + w->len, w->deg, (size_t)m * sizeof *w->deg);
+    if (checks)
+        memcpy(w->re + w->len, w->chk, (size_t)m * sizeof *w->chk);
+    w->len += m;
+    return 1;
 }
 
-/* Every edge belongs to its lower node.  Visit the edges that node u owns,
-   element by element along its star: f(ctx, element, local edge, slot of
-   the edge in u's list).  Returns the length of u's list (its edges). */
-static int upper_edges(const getme_ws *ws, int32_t u, int32_t *buf,
-                       void (*f)(void *, int32_t, int, int, int), void *ctx)
+/* The only type of ws's elements, or -1 if it has several. */
+static int single_type(const getme_ws *ws)
+{
+    for (int t = 0; t < GETME_NUM_TYPES; t++)
+        if (ws->tstart[t + 1] - ws->tstart[t] == ws->ne)
+            return t;
+    return -1;
+}
+
+/* Every edge belongs to its lower node u: walk u's star once (elements
+   ascending), giving each element edge at u whose other end is higher its
+   slot (the other end's position in u's list, appended if new: the lists
+   are short, ~7 in a tet mesh, so a linear search beats anything
+   cleverer) and counting its elements.  Returns the number of u's edges.
+   tf: the mesh's one type (a constant in each inlined copy), or -1.
+   Branch-free inside an element: the branches it replaced (local index,
+   which end is higher, found or new) were mispredicted about half the
+   time, and were most of its cost. */
+static inline __attribute__((always_inline)) int
+node_edges(int tf, getme_adj *adj, const getme_ws *ws,
+           const corner_edges *ce, int32_t u, edge_walk *w, int checks)
 {
     int m = 0;
-    for (int64_t k = ws->star_ptr[u]; k < ws->star_ptr[u + 1]; k++) {
+    uint8_t dummy;
+    int32_t kend = ws->star_ptr[ws->nn];
+    for (int32_t k = ws->star_ptr[u]; k < ws->star_ptr[u + 1]; k++) {
         int32_t n = ws->star[k];
-        int t = getme__ws_type(ws, n), nv = getme__nv[t];
+        if (tf >= 0 && k + GETME_STAR_AHEAD < kend) {
+            /* the stars' elements are scattered: fetch ahead */
+            int32_t a = ws->star[k + GETME_STAR_AHEAD];
+            __builtin_prefetch(getme__ws_nodes(ws, tf, a));
+            __builtin_prefetch(getme__adj_slots(adj, ws, tf, a), 1);
+        }
+        int t = tf >= 0 ? tf : getme__ws_type(ws, n), nv = getme__nv[t];
         const int32_t *c = getme__ws_nodes(ws, t, n);
-        int li = getme__local_index(c, nv, u);
-        for (int j = 0; j < getme__edges[t].num_edges; j++) {
-            int o = edge_other(t, j, li);
-            if (o >= 0 && c[o] > u) {
-                int slot = slot_of(buf, &m, c[o]);
-                if (f)
-                    f(ctx, n, t, j, slot);
-            }
+        int li = 0;
+        for (int i = 1; i < nv; i++)
+            li |= (c[i] == u) * i;
+        uint8_t *slots = getme__adj_slots(adj, ws, t, n);
+        uint64_t cv = checks ? check_value(n) : 0;
+        for (int i = 0; i < ce->num[t][li]; i++) {
+            int32_t o = c[ce->o[t][li][i]];
+            int up = o > u;
+            int s = m;
+            for (int q = m - 1; q >= 0; q--)
+                s = w->nbr[q] == o ? q : s;
+            int fresh = s == m;
+            w->nbr[m] = o; /* past the list's end unless fresh and up */
+            w->deg[s] = (fresh ? 0 : w->deg[s]) + up;
+            w->chk[s] = (fresh ? 0 : w->chk[s]) + (up ? cv : 0);
+            m += fresh & up;
+            *(up ? &slots[ce->j[t][li][i]] : &dummy) =
+                (uint8_t)(s < GETME_NO_SLOT ? s : GETME_NO_SLOT);
         }
     }
     return m;
 }
 
-/* What the second pass over a node's edges fills in. */
-typedef struct edge_pass {
-    getme_adj *adj;
-    const getme_ws *ws;
-    int64_t first;  /* id of the node's first edge */
-    int32_t *edeg;
-    uint64_t *re;
-} edge_pass;
-
-static void assign_edge(void *ctx, int32_t n, int t, int j, int slot)
-{
-    edge_pass *p = ctx;
-    int32_t id = (int32_t)(p->first + slot);
-    getme__adj_slots(p->adj, p->ws, t, n)[j] =
-        (uint8_t)(slot < GETME_NO_SLOT ? slot : GETME_NO_SLOT);
-    p->edeg[id]++;
-    if (p->re)
-        p->re[id] += check_value(n);
-}
-
 /* Edge ids of every element edge (3-D), numbered node by node (a node's
    edges in the order its star meets them), how many elements have each
    edge (edeg), and if checks is set the check-value sums of every edge
-   (re).  Each node writes only its own edges' entries. */
+   (re).  One walk over the stars: each thread takes one contiguous range
+   of nodes, writes its elements' slots (each node writes only its own
+   edges' entries) and appends its edges' counts in node order; the prefix
+   sum of the nodes' edge counts then says where each thread's edges go,
+   so the arrays are the same for any number of threads. */
 static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
                                 int32_t **edeg_out, int checks,
                                 uint64_t **re_out)
@@ -119,45 +171,79 @@ static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
         total += (int64_t)(ws->tstart[t + 1] - ws->tstart[t]) *
                  getme__edges[t].num_edges;
     }
-    int64_t *eptr = malloc(((size_t)ws->nn + 1) * sizeof *eptr);
+    int nt = ws->nt;
+    size_t bufsize = (size_t)ws->max_star * 4 + 1;
     adj->eptr = malloc(((size_t)ws->nn + 1) * sizeof *adj->eptr);
     adj->eslot = malloc((size_t)(total ? total : 1));
-    size_t bufsize = (size_t)ws->max_star * 4 + 1;
-    int32_t *bufs = malloc((size_t)ws->nt * bufsize * sizeof *bufs);
-    if (!eptr || !adj->eptr || !adj->eslot || !bufs) {
-        free(eptr), free(bufs);
-        return GETME_ERR_NOMEM;
+    int64_t *first = calloc((size_t)nt + 1, sizeof *first);
+    edge_walk *walks = calloc((size_t)nt, sizeof *walks);
+    int32_t *bufs = malloc((size_t)nt * bufsize * 2 * sizeof *bufs);
+    uint64_t *chks = malloc((size_t)nt * bufsize * sizeof *chks);
+    int32_t *edeg = NULL;
+    uint64_t *re = NULL;
+    getme_status st = GETME_ERR_NOMEM;
+    if (!adj->eptr || !adj->eslot || !first || !walks || !bufs || !chks)
+        goto done;
+    corner_edges ce;
+    corner_edge_table(&ce);
+    int ok = 1, single = single_type(ws);
+    adj->eptr[0] = 0;
+#pragma omp parallel num_threads(nt) reduction(&& : ok)
+    {
+        int th = omp_get_thread_num(), n = omp_get_num_threads();
+        edge_walk *w = &walks[th];
+        w->nbr = bufs + (size_t)th * 2 * bufsize;
+        w->deg = w->nbr + bufsize;
+        w->chk = chks + (size_t)th * bufsize;
+        int32_t u0 = (int32_t)((int64_t)ws->nn * th / n);
+        int32_t u1 = (int32_t)((int64_t)ws->nn * (th + 1) / n);
+        for (int32_t u = u0; u < u1 && ok; u++) {
+            int m = single == GETME_TET
+                        ? node_edges(GETME_TET, adj, ws, &ce, u, w, checks)
+                    : single == GETME_HEX
+                        ? node_edges(GETME_HEX, adj, ws, &ce, u, w, checks)
+                        : node_edges(-1, adj, ws, &ce, u, w, checks);
+            adj->eptr[u + 1] = m; /* a count until the prefix sum */
+            ok = walk_append(w, m, checks);
+        }
+        first[th + 1] = w->len;
     }
-    eptr[0] = 0;
-#pragma omp parallel for schedule(dynamic, 1024) num_threads(ws->nt)
-    for (int32_t u = 0; u < ws->nn; u++)
-        eptr[u + 1] = upper_edges(ws, u, bufs + omp_get_thread_num() * bufsize,
-                                  NULL, NULL);
-    for (int32_t u = 0; u < ws->nn; u++)
-        eptr[u + 1] += eptr[u];
-    if (eptr[ws->nn] > INT32_MAX) {
-        free(eptr), free(bufs);
-        return GETME_ERR_NOMEM;
+    if (!ok)
+        goto done;
+    for (int k = 0; k < nt; k++)
+        first[k + 1] += first[k];
+    if (first[nt] > INT32_MAX)
+        goto done;
+    for (int32_t u = 0; u < ws->nn; u++) /* fits: the sum is first[nt] */
+        adj->eptr[u + 1] += adj->eptr[u];
+    adj->num_edges = (int32_t)first[nt];
+    /* The first thread's arrays become the whole (no copy with one
+       thread); the others' are appended in thread order. */
+    size_t nedge = (size_t)(first[nt] ? first[nt] : 1);
+    edeg = realloc(walks[0].edeg, nedge * sizeof *edeg);
+    if (edeg)
+        walks[0].edeg = NULL;
+    re = checks ? realloc(walks[0].re, nedge * sizeof *re) : NULL;
+    if (re)
+        walks[0].re = NULL;
+    if (!edeg || (checks && !re))
+        goto done;
+    for (int k = 1; k < nt; k++) {
+        size_t len = (size_t)(first[k + 1] - first[k]);
+        if (len)
+            memcpy(edeg + first[k], walks[k].edeg, len * sizeof *edeg);
+        if (len && checks)
+            memcpy(re + first[k], walks[k].re, len * sizeof *re);
     }
-    adj->num_edges = (int32_t)eptr[ws->nn];
-    for (int32_t u = 0; u <= ws->nn; u++)
-        adj->eptr[u] = (int32_t)eptr[u];
-    size_t nedge = (size_t)(adj->num_edges ? adj->num_edges : 1);
-    int32_t *edeg = calloc(nedge, sizeof *edeg);
-    uint64_t *re = checks ? calloc(nedge, sizeof *re) : NULL;
-    if (!edeg || (checks && !re)) {
-        free(eptr), free(bufs), free(edeg), free(re);
-        return GETME_ERR_NOMEM;
-    }
-#pragma omp parallel for schedule(dynamic, 1024) num_threads(ws->nt)
-    for (int32_t u = 0; u < ws->nn; u++) {
-        edge_pass p = {adj, ws, eptr[u], edeg, re};
-        upper_edges(ws, u, bufs + omp_get_thread_num() * bufsize, assign_edge, &p);
-    }
-    free(eptr), free(bufs);
     *edeg_out = edeg;
     *re_out = re;
-    return GETME_OK;
+    edeg = NULL, re = NULL;
+    st = GETME_OK;
+done:
+    for (int k = 0; walks && k < nt; k++)
+        free(walks[k].edeg), free(walks[k].re);
+    free(walks), free(first), free(bufs), free(chks), free(edeg), free(re);
+    return st;
 }
 
 /* Check-value sums of every node's star. */

@@ -66,6 +66,10 @@ typedef struct getme_ws {
                              over, or NULL                                  */
 } getme_ws;
 
+/* Walks over the stars (edges, faces) touch each star's elements at
+   scattered places: they prefetch the element this many entries ahead. */
+#define GETME_STAR_AHEAD 12
+
 /* Build the workspace; renumber: 1 for locality ordering, 0 keeps the
    caller's order.  With renumber 1 it takes over the mesh's cached
    workspace (getme__ws_keep) when there is one: the same arrays a build
