@@ -117,14 +117,19 @@ static inline __attribute__((always_inline)) int
 node_edges(int tf, getme_adj *adj, const getme_ws *ws,
            const corner_edges *ce, int32_t u, edge_walk *w, int checks)
 {
-    int m = 0;
-    uint8_t dummy;
+    /* Locals and restrict: the byte stores into the slots may alias
+       anything, which made the compiler reload every pointer after each. */
+    int32_t *restrict nbr = w->nbr, *restrict deg = w->deg;
+    uint64_t *restrict chk = w->chk;
+    const int32_t *restrict star = ws->star;
+    int32_t k0 = ws->star_ptr[u], k1 = ws->star_ptr[u + 1];
     int32_t kend = ws->star_ptr[ws->nn];
-    for (int32_t k = ws->star_ptr[u]; k < ws->star_ptr[u + 1]; k++) {
-        int32_t n = ws->star[k];
+    int m = 0;
+    for (int32_t k = k0; k < k1; k++) {
+        int32_t n = star[k];
         if (tf >= 0 && k + GETME_STAR_AHEAD < kend) {
             /* the stars' elements are scattered: fetch ahead */
-            int32_t a = ws->star[k + GETME_STAR_AHEAD];
+            int32_t a = star[k + GETME_STAR_AHEAD];
             __builtin_prefetch(getme__ws_nodes(ws, tf, a));
             __builtin_prefetch(getme__adj_slots(adj, ws, tf, a), 1);
         }
@@ -133,22 +138,28 @@ node_edges(int tf, getme_adj *adj, const getme_ws *ws,
         int li = 0;
         for (int i = 1; i < nv; i++)
             li |= (c[i] == u) * i;
-        uint8_t *slots = getme__adj_slots(adj, ws, t, n);
         uint64_t cv = checks ? check_value(n) : 0;
-        for (int i = 0; i < ce->num[t][li]; i++) {
+        int ne = ce->num[t][li];
+        uint8_t sl[4];
+        for (int i = 0; i < ne; i++) {
             int32_t o = c[ce->o[t][li][i]];
             int up = o > u;
             int s = m;
             for (int q = m - 1; q >= 0; q--)
-                s = w->nbr[q] == o ? q : s;
+                s = nbr[q] == o ? q : s;
             int fresh = s == m;
-            w->nbr[m] = o; /* past the list's end unless fresh and up */
-            w->deg[s] = (fresh ? 0 : w->deg[s]) + up;
-            w->chk[s] = (fresh ? 0 : w->chk[s]) + (up ? cv : 0);
+            nbr[m] = o; /* past the list's end unless fresh and up */
+            deg[s] = (fresh ? 0 : deg[s]) + up;
+            if (checks)
+                chk[s] = (fresh ? 0 : chk[s]) + (up ? cv : 0);
             m += fresh & up;
-            *(up ? &slots[ce->j[t][li][i]] : &dummy) =
-                (uint8_t)(s < GETME_NO_SLOT ? s : GETME_NO_SLOT);
+            sl[i] = (uint8_t)(!up ? 0 : s < GETME_NO_SLOT ? s : GETME_NO_SLOT);
         }
+        uint8_t *slots = getme__adj_slots(adj, ws, t, n);
+        for (int i = 0; i < ne; i++)
+            if (c[ce->o[t][li][i]] > u) /* the other ends' entries are
+                                           their lower nodes' */
+                slots[ce->j[t][li][i]] = sl[i];
     }
     return m;
 }
@@ -315,14 +326,17 @@ static void check_element(getme_adj *adj, const getme_ws *ws,
     uint32_t now = ++sc->now;
     int32_t cnt = 0;
     uint64_t truth = 0;
+    /* Branch-free: whether an element was seen already is a coin toss
+       (a hex's 8 stars hold ~64 entries, ~27 of them distinct). */
+    uint32_t *restrict stamp = sc->stamp;
+    const int32_t *restrict star = ws->star;
     for (int i = 0; i < nv; i++)
-        for (int64_t k = ws->star_ptr[c[i]]; k < ws->star_ptr[c[i] + 1]; k++) {
-            int32_t n = ws->star[k];
-            if (sc->stamp[n] != now) {
-                sc->stamp[n] = now;
-                truth += check_value(n);
-                cnt++;
-            }
+        for (int32_t k = ws->star_ptr[c[i]]; k < ws->star_ptr[c[i] + 1]; k++) {
+            int32_t n = star[k];
+            int fresh = stamp[n] != now;
+            stamp[n] = now;
+            truth += fresh ? check_value(n) : 0;
+            cnt += fresh;
         }
     const int32_t *f = getme__adj_faces(adj, ws, t, e);
     uint64_t formula = 0, fs = 0;
