@@ -110,9 +110,10 @@ static int single_type(const getme_ws *ws)
    are short, ~7 in a tet mesh, so a linear search beats anything
    cleverer) and counting its elements.  Returns the number of u's edges.
    tf: the mesh's one type (a constant in each inlined copy), or -1.
-   Branch-free inside an element: the branches it replaced (local index,
-   which end is higher, found or new) were mispredicted about half the
-   time, and were most of its cost. */
+   The element's edges at u that are u's (the other end higher) are
+   picked without a branch first: which they are is a coin toss, and
+   its mispredictions, and searches for edges that are not u's, were
+   most of the cost. */
 static inline __attribute__((always_inline)) int
 node_edges(int tf, getme_adj *adj, const getme_ws *ws,
            const corner_edges *ce, int32_t u, edge_walk *w, int checks)
@@ -139,27 +140,30 @@ node_edges(int tf, getme_adj *adj, const getme_ws *ws,
         for (int i = 1; i < nv; i++)
             li |= (c[i] == u) * i;
         uint64_t cv = checks ? check_value(n) : 0;
-        int ne = ce->num[t][li];
-        uint8_t sl[4];
+        /* the edges whose other end is higher, compacted branch-free */
+        int ne = ce->num[t][li], nu = 0;
+        int32_t ou[4];
+        int8_t ju[4];
         for (int i = 0; i < ne; i++) {
             int32_t o = c[ce->o[t][li][i]];
-            int up = o > u;
+            ou[nu] = o;
+            ju[nu] = ce->j[t][li][i];
+            nu += o > u;
+        }
+        uint8_t *slots = getme__adj_slots(adj, ws, t, n);
+        for (int i = 0; i < nu; i++) {
+            int32_t o = ou[i];
             int s = m;
             for (int q = m - 1; q >= 0; q--)
                 s = nbr[q] == o ? q : s;
             int fresh = s == m;
-            nbr[m] = o; /* past the list's end unless fresh and up */
-            deg[s] = (fresh ? 0 : deg[s]) + up;
+            nbr[m] = o; /* past the list's end unless fresh */
+            deg[s] = (fresh ? 0 : deg[s]) + 1;
             if (checks)
-                chk[s] = (fresh ? 0 : chk[s]) + (up ? cv : 0);
-            m += fresh & up;
-            sl[i] = (uint8_t)(!up ? 0 : s < GETME_NO_SLOT ? s : GETME_NO_SLOT);
+                chk[s] = (fresh ? 0 : chk[s]) + cv;
+            m += fresh;
+            slots[ju[i]] = (uint8_t)(s < GETME_NO_SLOT ? s : GETME_NO_SLOT);
         }
-        uint8_t *slots = getme__adj_slots(adj, ws, t, n);
-        for (int i = 0; i < ne; i++)
-            if (c[ce->o[t][li][i]] > u) /* the other ends' entries are
-                                           their lower nodes' */
-                slots[ce->j[t][li][i]] = sl[i];
     }
     return m;
 }
