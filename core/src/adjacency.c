@@ -95,15 +95,6 @@ static int walk_append(edge_walk *w, int m, int checks)
     return 1;
 }
 
-/* The only type of ws's elements, or -1 if it has several. */
-static int single_type(const getme_ws *ws)
-{
-    for (int t = 0; t < GETME_NUM_TYPES; t++)
-        if (ws->tstart[t + 1] - ws->tstart[t] == ws->ne)
-            return t;
-    return -1;
-}
-
 /* Every edge belongs to its lower node u: walk u's star once (elements
    ascending), giving each element edge at u whose other end is higher its
    slot (the other end's position in u's list, appended if new: the lists
@@ -201,7 +192,7 @@ static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
         goto done;
     corner_edges ce;
     corner_edge_table(&ce);
-    int ok = 1, single = single_type(ws);
+    int ok = 1, single = getme__ws_single_type(ws);
     adj->eptr[0] = 0;
 #pragma omp parallel num_threads(nt) reduction(&& : ok)
     {
@@ -212,6 +203,15 @@ static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
         w->chk = chks + (size_t)th * bufsize;
         int32_t u0 = (int32_t)((int64_t)ws->nn * th / n);
         int32_t u1 = (int32_t)((int64_t)ws->nn * (th + 1) / n);
+        /* Room for the range's edges at once (about one per 3 star
+           entries in tet and hex meshes; half of them allowed): grown
+           from small sizes, the arrays left freed blocks in the heap that
+           stayed resident. */
+        w->cap = (ws->star_ptr[u1] - ws->star_ptr[u0]) / 2 + 1024;
+        w->edeg = malloc((size_t)w->cap * sizeof *w->edeg);
+        w->re = checks ? malloc((size_t)w->cap * sizeof *w->re) : NULL;
+        if (!w->edeg || (checks && !w->re))
+            ok = 0, w->cap = 0;
         for (int32_t u = u0; u < u1 && ok; u++) {
             int m = single == GETME_TET
                         ? node_edges(GETME_TET, adj, ws, &ce, u, w, checks)

@@ -182,10 +182,7 @@ getme_status getme__ws_faces(const getme_ws *ws, const int64_t *foff,
     memset(hashes, 0xff, (size_t)ws->nt * hsize * sizeof *hashes);
     corner_faces table[GETME_NUM_TYPES][GETME_MAX_NV];
     corner_table(table);
-    int single = -1;
-    for (int t = 0; t < GETME_NUM_TYPES; t++)
-        if (ws->tstart[t + 1] - ws->tstart[t] == ws->ne)
-            single = t;
+    int single = getme__ws_single_type(ws);
 #pragma omp parallel for schedule(dynamic, 1024) num_threads(ws->nt)
     for (int32_t u = 0; u < ws->nn; u++) {
         int th = omp_get_thread_num(), ng;

@@ -133,6 +133,16 @@ static inline const int32_t *getme__ws_nodes(const getme_ws *ws, int t,
     return ws->conn + ws->coff[t] + (int64_t)(e - ws->tstart[t]) * getme__nv[t];
 }
 
+/* The type of all of ws's elements, or -1 if it has several: walks over
+   the stars hoist it out of their loops (a constant in each copy). */
+static inline int getme__ws_single_type(const getme_ws *ws)
+{
+    for (int t = 0; t < GETME_NUM_TYPES; t++)
+        if (ws->tstart[t + 1] - ws->tstart[t] == ws->ne)
+            return t;
+    return -1;
+}
+
 /* Position of node u among the nv nodes c of an element, or -1. */
 static inline int getme__local_index(const int32_t *c, int nv, int32_t u)
 {
