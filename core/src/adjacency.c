@@ -159,6 +159,22 @@ node_edges(int tf, getme_adj *adj, const getme_ws *ws,
     return m;
 }
 
+/* The first node of range th of n ranges with equal star entries (the
+   first node whose stars start at or after th / n of them). */
+static int32_t star_split(const getme_ws *ws, int th, int n)
+{
+    int64_t want = (int64_t)ws->star_ptr[ws->nn] * th / n;
+    int32_t lo = 0, hi = ws->nn;
+    while (lo < hi) {
+        int32_t mid = lo + (hi - lo) / 2;
+        if (ws->star_ptr[mid] < want)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return th == n ? ws->nn : lo;
+}
+
 /* Edge ids of every element edge (3-D), numbered node by node (a node's
    edges in the order its star meets them), how many elements have each
    edge (edeg), and if checks is set the check-value sums of every edge
@@ -201,8 +217,9 @@ static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
         w->nbr = bufs + (size_t)th * 2 * bufsize;
         w->deg = w->nbr + bufsize;
         w->chk = chks + (size_t)th * bufsize;
-        int32_t u0 = (int32_t)((int64_t)ws->nn * th / n);
-        int32_t u1 = (int32_t)((int64_t)ws->nn * (th + 1) / n);
+        /* ranges of equal star entries, not nodes: the work is the stars
+           (nodes used by no element are numbered last) */
+        int32_t u0 = star_split(ws, th, n), u1 = star_split(ws, th + 1, n);
         /* Room for the range's edges at once (about one per 3 star
            entries in tet and hex meshes; half of them allowed): grown
            from small sizes, the arrays left freed blocks in the heap that
