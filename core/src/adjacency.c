@@ -39,76 +39,151 @@ static inline uint64_t check_value(int32_t n)
     return z ^ (z >> 31);
 }
 
-/* Other end of local edge j of a type-t element at local node li, or -1 if
-   the edge does not touch li. */
-static inline int edge_other(int t, int j, int li)
-{
-    const getme_edge_table *et = &getme__edges[t];
-    return et->node[j][0] == li   ? et->node[j][1]
-           : et->node[j][1] == li ? et->node[j][0]
-                                  : -1;
-}
+/* The edges of each type at each corner: corner li of a type-t element
+   has num[t][li] edges, local edge j[t][li][k] to corner o[t][li][k]
+   (at most 4: a pyramid's apex).  From getme__edges, once per build. */
+typedef struct corner_edges {
+    int8_t num[GETME_NUM_TYPES][GETME_MAX_NV];
+    int8_t j[GETME_NUM_TYPES][GETME_MAX_NV][4];
+    int8_t o[GETME_NUM_TYPES][GETME_MAX_NV][4];
+} corner_edges;
 
-/* Slot of w in the list buf[0..*m) of node u's upper neighbours (the
-   other ends w > u of the edges at u), appended if new.  The lists are
-   short (~7 in a tet mesh), so a linear search beats sorting them. */
-static inline int slot_of(int32_t *buf, int *m, int32_t w)
+static void corner_edge_table(corner_edges *ce)
 {
-    for (int i = 0; i < *m; i++)
-        if (buf[i] == w)
-            return i;
-    buf[*m] = w;
-    return (*m)++;
-}
-
-/* Every edge belongs to its lower node.  Visit the edges that node u owns,
-   element by element along its star: f(ctx, element, local edge, slot of
-   the edge in u's list).  Returns the length of u's list (its edges). */
-static int upper_edges(const getme_ws *ws, int32_t u, int32_t *buf,
-                       void (*f)(void *, int32_t, int, int, int), void *ctx)
-{
-    int m = 0;
-    for (int64_t k = ws->star_ptr[u]; k < ws->star_ptr[u + 1]; k++) {
-        int32_t n = ws->star[k];
-        int t = getme__ws_type(ws, n), nv = getme__nv[t];
-        const int32_t *c = getme__ws_nodes(ws, t, n);
-        int li = getme__local_index(c, nv, u);
-        for (int j = 0; j < getme__edges[t].num_edges; j++) {
-            int o = edge_other(t, j, li);
-            if (o >= 0 && c[o] > u) {
-                int slot = slot_of(buf, &m, c[o]);
-                if (f)
-                    f(ctx, n, t, j, slot);
+    memset(ce, 0, sizeof *ce);
+    for (int t = 0; t < GETME_NUM_TYPES; t++)
+        for (int j = 0; j < getme__edges[t].num_edges; j++)
+            for (int s = 0; s < 2; s++) {
+                int li = getme__edges[t].node[j][s];
+                int k = ce->num[t][li]++;
+                ce->j[t][li][k] = (int8_t)j;
+                ce->o[t][li][k] = getme__edges[t].node[j][1 - s];
             }
+}
+
+/* What one thread keeps while it walks its nodes: the current node's
+   upper neighbours (the other ends w > u of its edges, in the order its
+   star meets them: the slots) with each edge's element count and check
+   sum, and the edges of all its nodes so far, appended in node order. */
+typedef struct edge_walk {
+    int32_t *nbr, *deg;  /* the current node's list (max_star * 4 + 1)  */
+    uint64_t *chk;
+    int32_t *edeg;       /* all edges of the thread's nodes so far       */
+    uint64_t *re;
+    int64_t len, cap;
+} edge_walk;
+
+/* Append the current node's m edges; 0 if out of memory. */
+static int walk_append(edge_walk *w, int m, int checks)
+{
+    if (w->len + m > w->cap) {
+        int64_t cap = w->cap * 2 > w->len + m ? w->cap * 2 : w->len + m + 1024;
+        int32_t *d = realloc(w->edeg, (size_t)cap * sizeof *d);
+        if (d)
+            w->edeg = d;
+        uint64_t *r = checks ? realloc(w->re, (size_t)cap * sizeof *r) : NULL;
+        if (r)
+            w->re = r;
+        if (!d || (checks && !r))
+            return 0;
+        w->cap = cap;
+    }
+    memcpy(w->edeg + w->len, w->deg, (size_t)m * sizeof *w->deg);
+    if (checks)
+        memcpy(w->re + w->len, w->chk, (size_t)m * sizeof *w->chk);
+    w->len += m;
+    return 1;
+}
+
+/* Every edge belongs to its lower node u: walk u's star once (elements
+   ascending), giving each element edge at u whose other end is higher its
+   slot (the other end's position in u's list, appended if new: the lists
+   are short, ~7 in a tet mesh, so a linear search; a per-thread table
+   over all nodes was faster on tets only, at 8 B per node per thread)
+   and counting its elements.  Returns the number of u's edges.
+   tf: the mesh's one type (a constant in each inlined copy), or -1.
+   The element's edges at u that are u's (the other end higher) are
+   picked without a branch first: which they are is a coin toss, and
+   its mispredictions, and searches for edges that are not u's, were
+   most of the cost. */
+static inline __attribute__((always_inline)) int
+node_edges(int tf, getme_adj *adj, const getme_ws *ws,
+           const corner_edges *ce, int32_t u, edge_walk *w, int checks)
+{
+    /* Locals and restrict: the byte stores into the slots may alias
+       anything, which made the compiler reload every pointer after each. */
+    int32_t *restrict nbr = w->nbr, *restrict deg = w->deg;
+    uint64_t *restrict chk = w->chk;
+    const int32_t *restrict star = ws->star;
+    int32_t k0 = ws->star_ptr[u], k1 = ws->star_ptr[u + 1];
+    int32_t kend = ws->star_ptr[ws->nn];
+    int m = 0;
+    for (int32_t k = k0; k < k1; k++) {
+        int32_t n = star[k];
+        if (tf >= 0 && k + GETME_STAR_AHEAD < kend) {
+            /* the stars' elements are scattered: fetch ahead */
+            int32_t a = star[k + GETME_STAR_AHEAD];
+            __builtin_prefetch(getme__ws_nodes(ws, tf, a));
+            __builtin_prefetch(getme__adj_slots(adj, ws, tf, a), 1);
+        }
+        int t = tf >= 0 ? tf : getme__ws_type(ws, n), nv = getme__nv[t];
+        const int32_t *c = getme__ws_nodes(ws, t, n);
+        int li = 0;
+        for (int i = 1; i < nv; i++)
+            li |= (c[i] == u) * i;
+        uint64_t cv = checks ? check_value(n) : 0;
+        /* the edges whose other end is higher, compacted branch-free */
+        int ne = ce->num[t][li], nu = 0;
+        int32_t ou[4];
+        int8_t ju[4];
+        for (int i = 0; i < ne; i++) {
+            int32_t o = c[ce->o[t][li][i]];
+            ou[nu] = o;
+            ju[nu] = ce->j[t][li][i];
+            nu += o > u;
+        }
+        uint8_t *slots = getme__adj_slots(adj, ws, t, n);
+        for (int i = 0; i < nu; i++) {
+            int32_t o = ou[i];
+            int s = m;
+            for (int q = m - 1; q >= 0; q--)
+                s = nbr[q] == o ? q : s;
+            int fresh = s == m;
+            nbr[m] = o; /* past the list's end unless fresh */
+            deg[s] = (fresh ? 0 : deg[s]) + 1;
+            if (checks)
+                chk[s] = (fresh ? 0 : chk[s]) + cv;
+            m += fresh;
+            slots[ju[i]] = (uint8_t)(s < GETME_NO_SLOT ? s : GETME_NO_SLOT);
         }
     }
     return m;
 }
 
-/* What the second pass over a node's edges fills in. */
-typedef struct edge_pass {
-    getme_adj *adj;
-    const getme_ws *ws;
-    int64_t first;  /* id of the node's first edge */
-    int32_t *edeg;
-    uint64_t *re;
-} edge_pass;
-
-static void assign_edge(void *ctx, int32_t n, int t, int j, int slot)
+/* The first node of range th of n ranges with equal star entries (the
+   first node whose stars start at or after th / n of them). */
+static int32_t star_split(const getme_ws *ws, int th, int n)
 {
-    edge_pass *p = ctx;
-    int32_t id = (int32_t)(p->first + slot);
-    getme__adj_slots(p->adj, p->ws, t, n)[j] =
-        (uint8_t)(slot < GETME_NO_SLOT ? slot : GETME_NO_SLOT);
-    p->edeg[id]++;
-    if (p->re)
-        p->re[id] += check_value(n);
+    int64_t want = (int64_t)ws->star_ptr[ws->nn] * th / n;
+    int32_t lo = 0, hi = ws->nn;
+    while (lo < hi) {
+        int32_t mid = lo + (hi - lo) / 2;
+        if (ws->star_ptr[mid] < want)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return th == n ? ws->nn : lo;
 }
 
 /* Edge ids of every element edge (3-D), numbered node by node (a node's
    edges in the order its star meets them), how many elements have each
    edge (edeg), and if checks is set the check-value sums of every edge
-   (re).  Each node writes only its own edges' entries. */
+   (re).  One walk over the stars: each thread takes one contiguous range
+   of nodes, writes its elements' slots (each node writes only its own
+   edges' entries) and appends its edges' counts in node order; the prefix
+   sum of the nodes' edge counts then says where each thread's edges go,
+   so the arrays are the same for any number of threads. */
 static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
                                 int32_t **edeg_out, int checks,
                                 uint64_t **re_out)
@@ -119,45 +194,89 @@ static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
         total += (int64_t)(ws->tstart[t + 1] - ws->tstart[t]) *
                  getme__edges[t].num_edges;
     }
-    int64_t *eptr = malloc(((size_t)ws->nn + 1) * sizeof *eptr);
+    int nt = ws->nt;
+    size_t bufsize = (size_t)ws->max_star * 4 + 1;
     adj->eptr = malloc(((size_t)ws->nn + 1) * sizeof *adj->eptr);
     adj->eslot = malloc((size_t)(total ? total : 1));
-    size_t bufsize = (size_t)ws->max_star * 4 + 1;
-    int32_t *bufs = malloc((size_t)ws->nt * bufsize * sizeof *bufs);
-    if (!eptr || !adj->eptr || !adj->eslot || !bufs) {
-        free(eptr), free(bufs);
-        return GETME_ERR_NOMEM;
+    int64_t *first = calloc((size_t)nt + 1, sizeof *first);
+    edge_walk *walks = calloc((size_t)nt, sizeof *walks);
+    int32_t *bufs = malloc((size_t)nt * bufsize * 2 * sizeof *bufs);
+    uint64_t *chks = malloc((size_t)nt * bufsize * sizeof *chks);
+    int32_t *edeg = NULL;
+    uint64_t *re = NULL;
+    getme_status st = GETME_ERR_NOMEM;
+    if (!adj->eptr || !adj->eslot || !first || !walks || !bufs || !chks)
+        goto done;
+    corner_edges ce;
+    corner_edge_table(&ce);
+    int ok = 1, single = getme__ws_single_type(ws);
+    adj->eptr[0] = 0;
+#pragma omp parallel num_threads(nt) reduction(&& : ok)
+    {
+        int th = omp_get_thread_num(), n = omp_get_num_threads();
+        edge_walk *w = &walks[th];
+        w->nbr = bufs + (size_t)th * 2 * bufsize;
+        w->deg = w->nbr + bufsize;
+        w->chk = chks + (size_t)th * bufsize;
+        /* ranges of equal star entries, not nodes: the work is the stars
+           (nodes used by no element are numbered last) */
+        int32_t u0 = star_split(ws, th, n), u1 = star_split(ws, th + 1, n);
+        /* Room for the range's edges at once (about one per 3 star
+           entries in tet and hex meshes; half of them allowed): grown
+           from small sizes, the arrays left freed blocks in the heap that
+           stayed resident. */
+        w->cap = (ws->star_ptr[u1] - ws->star_ptr[u0]) / 2 + 1024;
+        w->edeg = malloc((size_t)w->cap * sizeof *w->edeg);
+        w->re = checks ? malloc((size_t)w->cap * sizeof *w->re) : NULL;
+        if (!w->edeg || (checks && !w->re))
+            ok = 0, w->cap = 0;
+        for (int32_t u = u0; u < u1 && ok; u++) {
+            int m = single == GETME_TET
+                        ? node_edges(GETME_TET, adj, ws, &ce, u, w, checks)
+                    : single == GETME_HEX
+                        ? node_edges(GETME_HEX, adj, ws, &ce, u, w, checks)
+                        : node_edges(-1, adj, ws, &ce, u, w, checks);
+            adj->eptr[u + 1] = m; /* a count until the prefix sum */
+            ok = walk_append(w, m, checks);
+        }
+        first[th + 1] = w->len;
     }
-    eptr[0] = 0;
-#pragma omp parallel for schedule(dynamic, 1024) num_threads(ws->nt)
-    for (int32_t u = 0; u < ws->nn; u++)
-        eptr[u + 1] = upper_edges(ws, u, bufs + omp_get_thread_num() * bufsize,
-                                  NULL, NULL);
-    for (int32_t u = 0; u < ws->nn; u++)
-        eptr[u + 1] += eptr[u];
-    if (eptr[ws->nn] > INT32_MAX) {
-        free(eptr), free(bufs);
-        return GETME_ERR_NOMEM;
+    if (!ok)
+        goto done;
+    for (int k = 0; k < nt; k++)
+        first[k + 1] += first[k];
+    if (first[nt] > INT32_MAX)
+        goto done;
+    for (int32_t u = 0; u < ws->nn; u++) /* fits: the sum is first[nt] */
+        adj->eptr[u + 1] += adj->eptr[u];
+    adj->num_edges = (int32_t)first[nt];
+    /* The first thread's arrays become the whole (no copy with one
+       thread); the others' are appended in thread order. */
+    size_t nedge = (size_t)(first[nt] ? first[nt] : 1);
+    edeg = realloc(walks[0].edeg, nedge * sizeof *edeg);
+    if (edeg)
+        walks[0].edeg = NULL;
+    re = checks ? realloc(walks[0].re, nedge * sizeof *re) : NULL;
+    if (re)
+        walks[0].re = NULL;
+    if (!edeg || (checks && !re))
+        goto done;
+    for (int k = 1; k < nt; k++) {
+        size_t len = (size_t)(first[k + 1] - first[k]);
+        if (len)
+            memcpy(edeg + first[k], walks[k].edeg, len * sizeof *edeg);
+        if (len && checks)
+            memcpy(re + first[k], walks[k].re, len * sizeof *re);
     }
-    adj->num_edges = (int32_t)eptr[ws->nn];
-    for (int32_t u = 0; u <= ws->nn; u++)
-        adj->eptr[u] = (int32_t)eptr[u];
-    size_t nedge = (size_t)(adj->num_edges ? adj->num_edges : 1);
-    int32_t *edeg = calloc(nedge, sizeof *edeg);
-    uint64_t *re = checks ? calloc(nedge, sizeof *re) : NULL;
-    if (!edeg || (checks && !re)) {
-        free(eptr), free(bufs), free(edeg), free(re);
-        return GETME_ERR_NOMEM;
-    }
-#pragma omp parallel for schedule(dynamic, 1024) num_threads(ws->nt)
-    for (int32_t u = 0; u < ws->nn; u++) {
-        edge_pass p = {adj, ws, eptr[u], edeg, re};
-        upper_edges(ws, u, bufs + omp_get_thread_num() * bufsize, assign_edge, &p);
-    }
-    free(eptr), free(bufs);
     *edeg_out = edeg;
     *re_out = re;
-    return GETME_OK;
+    edeg = NULL, re = NULL;
+    st = GETME_OK;
+done:
+    for (int k = 0; walks && k < nt; k++)
+        free(walks[k].edeg), free(walks[k].re);
+    free(walks), free(first), free(bufs), free(chks), free(edeg), free(re);
+    return st;
 }
 
 /* Check-value sums of every node's star. */
@@ -229,14 +348,17 @@ static void check_element(getme_adj *adj, const getme_ws *ws,
     uint32_t now = ++sc->now;
     int32_t cnt = 0;
     uint64_t truth = 0;
+    /* Branch-free: whether an element was seen already is a coin toss
+       (a hex's 8 stars hold ~64 entries, ~27 of them distinct). */
+    uint32_t *restrict stamp = sc->stamp;
+    const int32_t *restrict star = ws->star;
     for (int i = 0; i < nv; i++)
-        for (int64_t k = ws->star_ptr[c[i]]; k < ws->star_ptr[c[i] + 1]; k++) {
-            int32_t n = ws->star[k];
-            if (sc->stamp[n] != now) {
-                sc->stamp[n] = now;
-                truth += check_value(n);
-                cnt++;
-            }
+        for (int32_t k = ws->star_ptr[c[i]]; k < ws->star_ptr[c[i] + 1]; k++) {
+            int32_t n = star[k];
+            int fresh = stamp[n] != now;
+            stamp[n] = now;
+            truth += fresh ? check_value(n) : 0;
+            cnt += fresh;
         }
     const int32_t *f = getme__adj_faces(adj, ws, t, e);
     uint64_t formula = 0, fs = 0;

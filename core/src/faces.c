@@ -6,7 +6,7 @@
  * Every face is met at its lowest node: walking that node's star, each
  * element contributes the faces it has there whose other nodes are all
  * higher, keyed by those other nodes (sorted); sides with equal keys are
- * the same face.  No global face table is built (a small per-thread hash
+ * the same face.  No global face table is built (a short per-thread list
  * groups the sides met at one node), each loop iteration
  * writes only the entries of faces whose lowest node it owns (race-free),
  * and the node order of the workspace keeps the stars it reads in cache.
@@ -55,45 +55,67 @@ static void corner_table(corner_faces table[GETME_NUM_TYPES][GETME_MAX_NV])
     }
 }
 
-/* One side of a face seen from its lowest node: the other nodes, sorted
-   (-1 padded), and which element face it is; rep: the first side with the
-   same key (its group), and for that first side, how many sides the group
-   has (n), the second one (second) and its hash slot (slot). */
-typedef struct face_key {
+/* A face seen from its lowest node: the other nodes, sorted (-1 padded),
+   how many sides (element faces) it has, and its first two. */
+typedef struct face_group {
     int32_t k[3];
-    int32_t elem;
-    int32_t face;
-    int32_t rep, n, second, slot;
-} face_key;
+    int32_t n, first, second;
+    int32_t slot; /* in the hash table */
+} face_group;
 
-static inline int key_same(const face_key *a, const face_key *b)
+/* One side: the element, which face of it, its group. */
+typedef struct face_side {
+    int32_t elem, face, group;
+} face_side;
+
+/* The node of a simplex face f's element not on f (tet: 6 minus the sum
+   of the face's local nodes, triangle: 3 minus it), or -1. */
+static int apex(int t, int f)
 {
-    return a->k[0] == b->k[0] && a->k[1] == b->k[1] && a->k[2] == b->k[2];
+    const getme_face_table *ft = &getme__faces[t];
+    int sum = 0;
+    for (int i = 0; i < ft->size[f]; i++)
+        sum += ft->node[f][i];
+    return t == GETME_TET ? 6 - sum : t == GETME_TRI ? 3 - sum : -1;
 }
 
-static inline uint32_t key_hash(const face_key *a)
+/* Are the two sides of a two-sided face the same simplex (duplicate
+   elements)?  They share the face's nodes, so exactly when their apexes
+   are the same node. */
+static int same_simplex(const getme_ws *ws, const face_side *a,
+                        const face_side *b)
 {
-    uint32_t h = (uint32_t)a->k[0] * 0x9E3779B1u ^
-                 (uint32_t)a->k[1] * 0x85EBCA77u ^
-                 (uint32_t)a->k[2] * 0xC2B2AE3Du;
-    return h ^ (h >> 15);
+    int ta = getme__ws_type(ws, a->elem), tb = getme__ws_type(ws, b->elem);
+    if (ta != tb || (ta != GETME_TET && ta != GETME_TRI))
+        return 0;
+    return getme__ws_nodes(ws, ta, a->elem)[apex(ta, a->face)] ==
+           getme__ws_nodes(ws, tb, b->elem)[apex(tb, b->face)];
 }
 
-/* The faces whose lowest node is u, as keys in buf, grouped by key through
-   the hash table (all -1 on entry and on return; mask + 1 slots, at least
-   twice the sides).  Only the groups matter, not their order, so no sort
-   is needed: a hash lookup per side is linear in the star, where the
-   sorted insertion it replaces was quadratic.  Returns how many sides. */
-static int faces_at(const getme_ws *ws,
-                    corner_faces table[GETME_NUM_TYPES][GETME_MAX_NV],
-                    int32_t u, face_key *buf, int32_t *hash, uint32_t mask)
+/* The faces whose lowest node is u: every side in sides, grouped by its
+   other nodes into groups through the hash table (all -1 on entry and on
+   return; mask + 1 slots, at least twice the sides: a linear search of
+   the ~11 faces a node has in a tet mesh was slower).  Returns how many
+   sides; *ng: how many groups.  tf: the mesh's
+   one type (a constant in each inlined copy), or -1. */
+static inline __attribute__((always_inline)) int
+faces_at(int tf, const getme_ws *ws,
+         corner_faces table[GETME_NUM_TYPES][GETME_MAX_NV], int32_t u,
+         face_side *sides, face_group *groups, int32_t *hash, uint32_t mask,
+         int *ng)
 {
-    int m = 0;
-    for (int64_t s = ws->star_ptr[u]; s < ws->star_ptr[u + 1]; s++) {
+    int m = 0, g = 0;
+    int32_t kend = ws->star_ptr[ws->nn];
+    for (int32_t s = ws->star_ptr[u]; s < ws->star_ptr[u + 1]; s++) {
         int32_t n = ws->star[s];
-        int t = getme__ws_type(ws, n);
+        if (tf >= 0 && s + GETME_STAR_AHEAD < kend)
+            __builtin_prefetch(getme__ws_nodes(ws, tf, ws->star[s + GETME_STAR_AHEAD]));
+        int t = tf >= 0 ? tf : getme__ws_type(ws, n), nv = getme__nv[t];
         const int32_t *c = getme__ws_nodes(ws, t, n);
-        const corner_faces *cf = &table[t][getme__local_index(c, getme__nv[t], u)];
+        int li = 0;
+        for (int i = 1; i < nv; i++)
+            li |= (c[i] == u) * i;
+        const corner_faces *cf = &table[t][li];
         for (int k = 0; k < cf->num; k++) {
             int32_t o[3] = {-1, -1, -1};
             int lowest = 1;
@@ -109,40 +131,29 @@ static int faces_at(const getme_ws *ws,
                     o[j] = o[j - 1];
                     o[j - 1] = tmp;
                 }
-            face_key *key = &buf[m];
-            *key = (face_key){{o[0], o[1], o[2]}, n, cf->face[k], m, 1, -1, 0};
-            uint32_t h = key_hash(key) & mask;
-            while (hash[h] >= 0 && !key_same(&buf[hash[h]], key))
+            uint32_t h = (((uint32_t)o[0] * 0x9E3779B1u) ^
+                          ((uint32_t)o[1] * 0x85EBCA77u) ^
+                          ((uint32_t)o[2] * 0xC2B2AE3Du));
+            h = (h ^ (h >> 15)) & mask;
+            while (hash[h] >= 0 && !(groups[hash[h]].k[0] == o[0] &&
+                                     groups[hash[h]].k[1] == o[1] &&
+                                     groups[hash[h]].k[2] == o[2]))
                 h = (h + 1) & mask;
-            if (hash[h] < 0) {
-                hash[h] = m;
-                key->slot = (int32_t)h;
-            } else {
-                face_key *r = &buf[hash[h]];
-                key->rep = hash[h];
-                if (r->n++ == 1)
-                    r->second = m;
+            int q = hash[h];
+            if (q < 0) {
+                q = hash[h] = g++;
+                groups[q] = (face_group){{o[0], o[1], o[2]}, 0, m, -1, (int32_t)h};
+            } else if (groups[q].n == 1) {
+                groups[q].second = m;
             }
-            m++;
+            groups[q].n++;
+            sides[m++] = (face_side){n, cf->face[k], q};
         }
     }
-    for (int i = 0; i < m; i++)
-        if (buf[i].rep == i)
-            hash[buf[i].slot] = -1;
+    for (int i = 0; i < g; i++)
+        hash[groups[i].slot] = -1;
+    *ng = g;
     return m;
-}
-
-/* Do simplices a and b have the same nodes (duplicates)? */
-static int same_simplex(const getme_ws *ws, int32_t a, int32_t b)
-{
-    int ta = getme__ws_type(ws, a), tb = getme__ws_type(ws, b);
-    if (ta != tb || (ta != GETME_TET && ta != GETME_TRI))
-        return 0;
-    const int32_t *ca = getme__ws_nodes(ws, ta, a), *cb = getme__ws_nodes(ws, tb, b);
-    for (int i = 0; i < getme__nv[ta]; i++)
-        if (getme__local_index(cb, getme__nv[tb], ca[i]) < 0)
-            return 0;
-    return 1;
 }
 
 /* Entry of out for face f of element e. */
@@ -158,39 +169,45 @@ getme_status getme__ws_faces(const getme_ws *ws, const int64_t *foff,
 {
     static const int max_faces_at_corner = 4; /* pyramid apex */
     size_t bufsize = (size_t)ws->max_star * max_faces_at_corner + 1;
+    face_side *sides = malloc((size_t)ws->nt * bufsize * sizeof *sides);
+    face_group *groups = malloc((size_t)ws->nt * bufsize * sizeof *groups);
     size_t hsize = 16;
     while (hsize < 2 * bufsize)
         hsize *= 2;
-    face_key *bufs = malloc((size_t)ws->nt * bufsize * sizeof *bufs);
     int32_t *hashes = malloc((size_t)ws->nt * hsize * sizeof *hashes);
-    if (!bufs || !hashes) {
-        free(bufs);
-        free(hashes);
+    if (!sides || !groups || !hashes) {
+        free(sides), free(groups), free(hashes);
         return GETME_ERR_NOMEM;
     }
     memset(hashes, 0xff, (size_t)ws->nt * hsize * sizeof *hashes);
     corner_faces table[GETME_NUM_TYPES][GETME_MAX_NV];
     corner_table(table);
+    int single = getme__ws_single_type(ws);
 #pragma omp parallel for schedule(dynamic, 1024) num_threads(ws->nt)
     for (int32_t u = 0; u < ws->nn; u++) {
-        int th = omp_get_thread_num();
-        face_key *buf = bufs + (size_t)th * bufsize;
-        int m = faces_at(ws, table, u, buf, hashes + (size_t)th * hsize,
-                         (uint32_t)(hsize - 1));
+        int th = omp_get_thread_num(), ng;
+        face_side *sd = sides + (size_t)th * bufsize;
+        face_group *gr = groups + (size_t)th * bufsize;
+        int32_t *hs = hashes + (size_t)th * hsize;
+        uint32_t mask = (uint32_t)(hsize - 1);
+        int m = single == GETME_TET
+                    ? faces_at(GETME_TET, ws, table, u, sd, gr, hs, mask, &ng)
+                : single == GETME_HEX
+                    ? faces_at(GETME_HEX, ws, table, u, sd, gr, hs, mask, &ng)
+                    : faces_at(-1, ws, table, u, sd, gr, hs, mask, &ng);
         for (int i = 0; i < m; i++) {
-            const face_key *r = &buf[buf[i].rep];
+            const face_group *r = &gr[sd[i].group];
             int32_t v = -1;
             if (r->n > 2) {
                 v = GETME_FACE_IRREGULAR;
             } else if (r->n == 2) {
-                v = buf[i].rep == i ? buf[r->second].elem : r->elem;
-                if (same_simplex(ws, buf[i].elem, v))
-                    v = GETME_FACE_IRREGULAR;
+                const face_side *other = &sd[r->first == i ? r->second : r->first];
+                v = same_simplex(ws, &sd[i], other) ? GETME_FACE_IRREGULAR
+                                                    : other->elem;
             }
-            *slot(ws, foff, out, buf[i].elem, buf[i].face) = v;
+            *slot(ws, foff, out, sd[i].elem, sd[i].face) = v;
         }
     }
-    free(bufs);
-    free(hashes);
+    free(sides), free(groups), free(hashes);
     return GETME_OK;
 }

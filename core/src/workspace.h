@@ -66,6 +66,10 @@ typedef struct getme_ws {
                              over, or NULL                                  */
 } getme_ws;
 
+/* Walks over the stars (edges, faces) touch each star's elements at
+   scattered places: they prefetch the element this many entries ahead. */
+#define GETME_STAR_AHEAD 12
+
 /* Build the workspace; renumber: 1 for locality ordering, 0 keeps the
    caller's order.  With renumber 1 it takes over the mesh's cached
    workspace (getme__ws_keep) when there is one: the same arrays a build
@@ -127,6 +131,16 @@ static inline const int32_t *getme__ws_nodes(const getme_ws *ws, int t,
                                              int32_t e)
 {
     return ws->conn + ws->coff[t] + (int64_t)(e - ws->tstart[t]) * getme__nv[t];
+}
+
+/* The type of all of ws's elements, or -1 if it has several: walks over
+   the stars hoist it out of their loops (a constant in each copy). */
+static inline int getme__ws_single_type(const getme_ws *ws)
+{
+    for (int t = 0; t < GETME_NUM_TYPES; t++)
+        if (ws->tstart[t + 1] - ws->tstart[t] == ws->ne)
+            return t;
+    return -1;
 }
 
 /* Position of node u among the nv nodes c of an element, or -1. */

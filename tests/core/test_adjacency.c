@@ -3,7 +3,9 @@
  * (core/src/adjacency.h) against a brute-force walk over the union of the
  * node stars, on conforming meshes of every type (where the formula must
  * be exact for every element), and on non-conforming ones (where the
- * elements it cannot count must be found and flagged).
+ * elements it cannot count must be found and flagged); and the whole
+ * set-up (workspace, faces, edges, counts, flags, blocks) built with 1, 2
+ * and 3 threads, entry for entry the same.
  *
  * Built from the core's sources (not libgetme), because it checks private
  * functions.
@@ -473,6 +475,106 @@ static void check_nonconforming(void)
     free(irr), getme__ws_free(&ws), getme_mesh_free(mesh), free_gen(&g);
 }
 
+/* ---- the same set-up for any number of threads ------------------------ */
+
+#define SAME(a, b, n) CHECK(!memcmp((a), (b), (size_t)(n) * sizeof *(a)))
+
+/* The workspace, face table, edges, counts, flags and the blocks' node
+   lists built with nt threads are those built with one, entry for entry
+   (each thread takes other nodes, elements and blocks, so a race or an
+   order that depends on the split would show). */
+static void same_setup(const getme_ws *a, const getme_adj *aa,
+                       const getme_ws *b, const getme_adj *ab)
+{
+    CHECK_EQ_INT(a->nn, b->nn);
+    CHECK_EQ_INT(a->ne, b->ne);
+    if (a->nn != b->nn || a->ne != b->ne)
+        return;
+    int64_t nc = 0, ns = 0, nf = 0;
+    for (int t = 0; t < GETME_NUM_TYPES; t++) {
+        int32_t n = a->tstart[t + 1] - a->tstart[t];
+        nc += (int64_t)n * getme__nv[t];
+        ns += (int64_t)n * getme__edges[t].num_edges;
+        nf += (int64_t)n * getme__faces[t].num_faces;
+    }
+    SAME(a->tstart, b->tstart, GETME_NUM_TYPES + 1);
+    SAME(a->conn, b->conn, nc);
+    SAME(a->elem_orig, b->elem_orig, a->ne);
+    SAME(a->node_orig, b->node_orig, a->nn);
+    SAME(a->x, b->x, 3 * (int64_t)a->nn);
+    SAME(a->star_ptr, b->star_ptr, a->nn + 1);
+    SAME(a->star, b->star, nc);
+    CHECK_EQ_INT(a->max_star, b->max_star);
+    SAME(a->fixed, b->fixed, a->nn);
+    SAME(a->free_elem, b->free_elem, a->ne);
+    CHECK_EQ_INT(a->num_free_elem, b->num_free_elem);
+    CHECK_EQ_INT(a->num_free_nodes, b->num_free_nodes);
+    CHECK_EQ_INT(a->num_blocks, b->num_blocks);
+    CHECK_EQ_INT(a->num_colours, b->num_colours);
+    if (a->num_blocks == b->num_blocks && a->num_colours == b->num_colours) {
+        SAME(a->block_start, b->block_start, a->num_blocks + 1);
+        SAME(a->colour_ptr, b->colour_ptr, a->num_colours + 1);
+        SAME(a->colour_blocks, b->colour_blocks, a->num_blocks);
+        SAME(aa->blk.nptr, ab->blk.nptr, a->num_blocks + 1);
+        SAME(aa->blk.nodes, ab->blk.nodes, aa->blk.nptr[a->num_blocks]);
+        SAME(aa->blk.lconn, ab->blk.lconn, nc);
+    }
+    SAME(aa->fnb, ab->fnb, nf);
+    SAME(aa->count, ab->count, a->ne);
+    SAME(aa->irregular, ab->irregular, a->ne);
+    CHECK_EQ_INT(aa->num_irregular, ab->num_irregular);
+    CHECK(aa->qscale == ab->qscale);
+    if (a->dim == 3) {
+        CHECK_EQ_INT(aa->num_edges, ab->num_edges);
+        SAME(aa->eptr, ab->eptr, a->nn + 1);
+        SAME(aa->eslot, ab->eslot, ns);
+    }
+}
+
+static void check_threads(const char *kind, int duplicates)
+{
+    int n0 = N;
+    int planar = !strncmp(kind, "tri", 3) || !strcmp(kind, "quad");
+    N = planar ? 40 : 13; /* more than 3 blocks */
+    gen g = make(kind);
+    /* duplicate elements: faces of three sides and twin simplices, so
+       the irregular paths run too */
+    for (int t = 0; t < GETME_NUM_TYPES && duplicates; t++)
+        for (int32_t e = 0; e < g.count[t]; e += 97) {
+            int32_t c[GETME_MAX_NV]; /* add_elem may move g.conn[t] */
+            memcpy(c, g.conn[t] + (size_t)e * getme__nv[t],
+                   (size_t)getme__nv[t] * sizeof *c);
+            add_elem(&g, t, c);
+        }
+    /* jittered, so the Morton keys differ (ties would keep input order) */
+    srand(11);
+    for (int32_t i = 0; i < 3 * g.nn; i++)
+        g.xyz[i] += 0.2 * ((double)rand() / RAND_MAX - 0.5);
+    if (g.dim == 2)
+        for (int32_t i = 0; i < g.nn; i++)
+            g.xyz[3 * i + 2] = 0.0;
+    getme_mesh *mesh = to_mesh(&g);
+    CHECK(getme_mesh_fix_boundary(mesh, GETME_FIX_SKIN, NULL) == GETME_OK);
+    getme__mesh_drop_ws(mesh); /* built here, with each thread count */
+    getme_ws ws[3];
+    getme_adj adj[3];
+    for (int k = 0; k < 3; k++) {
+        CHECK(getme__ws_build(&ws[k], mesh, 1, k + 1) == GETME_OK);
+        CHECK(getme__adj_build(&adj[k], &ws[k]) == GETME_OK);
+    }
+    CHECK(ws[0].nn > 500 && ws[0].num_blocks > 3);
+    CHECK(duplicates ? adj[0].num_irregular > 0 : 1);
+    for (int k = 1; k < 3; k++)
+        same_setup(&ws[0], &adj[0], &ws[k], &adj[k]);
+    for (int k = 0; k < 3; k++) {
+        getme__adj_free(&adj[k]);
+        getme__ws_free(&ws[k]);
+    }
+    getme_mesh_free(mesh);
+    free_gen(&g);
+    N = n0;
+}
+
 int main(void)
 {
     const char *kinds[] = {"tet", "hex", "mixed", "tri", "quad", "tri+quad"};
@@ -481,5 +583,9 @@ int main(void)
     check_nonconforming();
     check_block_order();
     check_live_sums();
+    for (size_t i = 0; i < sizeof kinds / sizeof *kinds; i++) {
+        check_threads(kinds[i], 0);
+        check_threads(kinds[i], 1);
+    }
     return check_summary("test_adjacency");
 }
