@@ -40,19 +40,39 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 GMSH_DOC = "/usr/share/doc/gmsh-doc/doc/gmsh"
 CCX_TESTS = "/usr/share/doc/calculix-ccx-test/examples/test"
 PY = "/usr/bin/python3"
-# The quick subset: models that cover 3D tets, 2D planar, extrusions
-# (prisms), transfinite hexes, physical groups and several volumes.
-QUICK_GEO = ["tutorial/t1.geo", "tutorial/t2.geo", "tutorial/t3.geo",
-             "tutorial/t6.geo", "demos/simple_geo/hex.geo",
-             "demos/boolean/boolean.geo"]
-QUICK_VARIANTS = ["o1", "o1-bin", "o1-22", "o1-inp", "o2", "hex20"]
-# Decks whose mesh getme moves (so that the output differs), with *NODE
-# blocks, sets, materials and steps around them; achtel2 and beampic are
-# solved by ccx in the quick run.
-QUICK_CCX = ["achtel2", "beampic", "beamnh", "segmentf", "dloadlinI",
-             "beamfsh1", "beamread", "axial"]
-QUICK_SOLVE = ["achtel2", "beampic"]
+# The quick subset: models that cover 3D tets, 2D planar (tris, quads,
+# mixed, second order), extrusions (prisms), transfinite hexes, physical
+# groups and several volumes, and the variants meshed for each.
+QUICK_GEO = {
+    "tutorial/t1.geo": ["o1", "o1-inp", "hex20"],
+    "tutorial/t2.geo": ["o1", "o1-bin", "o1-22", "o1-inp", "o2"],
+    "tutorial/t3.geo": ["o1", "o1-bin"],
+    "tutorial/t6.geo": ["o1", "o2", "hex20"],
+    "demos/simple_geo/hex.geo": ["o1", "o1-inp", "hex27"],
+    "demos/boolean/boolean.geo": ["o1", "o2"],
+}
+# Decks whose mesh getme moves (tets, hexes with contact, a planar one),
+# decks it refuses (beams only, no *NODE data), C3D8I lines with extra ids
+# and a data line before the first keyword; the planar and the tet deck
+# are solved by ccx before and after.
+QUICK_CCX = ["segmenttet", "contact2", "planestress", "simplebeam", "beamread",
+             "dloadlinI", "beamfsh1"]
+QUICK_SOLVE = ["planestress", "segmenttet"]
 REFUSALS = {5}          # documented refusals a valid file may get
+QSTAR_TOL = 1e-9        # a perfect mesh may lose rounding steps
+# Known, reported, not fixed here (docs/conformance.md "Open"): counted in
+# the table's "known" column, not as failures; printed when they stop
+# showing so that the entry can go.  (source, input kind, name) -> what
+# the failure's cause starts with.
+KNOWN = {
+    # the q_mean stage lowers q*min (and, on t6, q_mean) below the
+    # input's; keep_best only looks from the end of that stage on
+    # (core/src/getme_adaptive.c)
+    ("gmsh", k, g): "q*min"
+    for g in ("tutorial/t6.geo", "demos/boolean/revolve2.geo")
+    for k in ("o1", "o1-bin", "o1-22", "o1-inp", "o2", "o2-inp", "hex20", "hex27", "hex",
+              "cgns", "cgns-adf")
+}
 TIMEOUT = 120
 
 
@@ -67,12 +87,19 @@ class Sweep:
         self.failures = []
 
     def record(self, source, kind, name, status, cause=""):
-        r = self.rows.setdefault((source, kind), [0, 0, 0, 0, {}])
+        known = KNOWN.get((source, kind, name))
+        if known and status == "fail" and cause.startswith(known):
+            status = "known"
+            print("known: %s %s %s: %s" % (source, kind, name, cause), flush=True)
+        elif known:
+            print("NOTE: known issue does not show on %s %s %s (%s): remove it from "
+                  "KNOWN" % (source, kind, name, status), flush=True)
+        r = self.rows.setdefault((source, kind), [0, 0, 0, 0, 0, {}])
         r[0] += 1
-        r[{"pass": 1, "refused": 2, "fail": 3}[status]] += 1
+        r[{"pass": 1, "refused": 2, "known": 3, "fail": 4}[status]] += 1
         if cause:
             key = re.sub(r"\d+(\.\d+)?(e-?\d+)?", "N", cause)[:110]
-            r[4][key] = r[4].get(key, 0) + 1
+            r[5][key] = r[5].get(key, 0) + 1
         if status == "fail":
             self.failures.append("%s %s %s: %s" % (source, kind, name, cause))
             print("FAIL: %s %s %s: %s" % (source, kind, name, cause), flush=True)
@@ -105,8 +132,8 @@ class Sweep:
         errors = [l for l in p.stdout.splitlines() + p.stderr.splitlines()
                   if l.startswith("Error")]
         name = os.path.basename(src)
-        if p.returncode in REFUSALS or (p.returncode != 0 and kind == "ccx"
-                                        and p.returncode == 4):
+        # a CalculiX deck without a mesh (a restart deck) ends with exit 4
+        if p.returncode in REFUSALS or (source == "ccx" and p.returncode == 4):
             if len(errors) != 1 or name not in errors[0]:
                 return "fail", "exit %d without one Error line naming the file: %r" % (
                     p.returncode, errors[:3]), None, None
@@ -126,7 +153,7 @@ class Sweep:
         if a["invalid"]:
             return "fail", "%d invalid after" % a["invalid"], out, r
         if (b["q_min_star"] is not None and a["q_min_star"] is not None
-                and a["q_min_star"] < b["q_min_star"] and b["invalid"] == 0):
+                and a["q_min_star"] < b["q_min_star"] - QSTAR_TOL and b["invalid"] == 0):
             return "fail", "q*min %.6g -> %.6g" % (b["q_min_star"], a["q_min_star"]), out, r
         return "pass", "", out, r
 
@@ -141,8 +168,15 @@ class Sweep:
         geos = sorted(os.path.relpath(os.path.join(d, f), src)
                       for d, _, fs in os.walk(src) for f in fs if f.endswith(".geo"))
         if quick:
+            for g in sorted(set(QUICK_GEO) - set(geos)):
+                self.record("gmsh", "mesh", g, "fail", "quick model missing from %s" % GMSH_DOC)
             geos = [g for g in QUICK_GEO if g in geos]
         import gmsh_check
+        import cgns_check
+        cgns_ok = not cgns_check.missing_tools()
+        if not cgns_ok:
+            print("SKIP cgns inputs: cgns-convert's tools are missing: %s"
+                  % cgns_check.missing_tools())
         for g in geos:
             out = os.path.join(self.work, "gmsh", g[:-4].replace("/", "_"))
             shutil.rmtree(out, ignore_errors=True)
@@ -150,13 +184,16 @@ class Sweep:
             try:
                 p = subprocess.run([PY, os.path.join(HERE, "gmsh_variants.py"),
                                     os.path.join(src, g), out] +
-                                   (QUICK_VARIANTS if quick else []),
+                                   (QUICK_GEO[g] if quick else []),
                                    capture_output=True, text=True, timeout=30,
                                    cwd=os.path.dirname(os.path.join(src, g)))
             except subprocess.TimeoutExpired:
                 self.record("gmsh", "mesh", g, "refused", "Gmsh takes > 30 s")
                 continue
-            if p.returncode != 0 or "empty" in p.stdout:
+            for line in p.stdout.splitlines():
+                if line.startswith("variant failed"):   # gmsh_variants.py
+                    self.record("gmsh", "mesh", g, "refused", line[:100])
+            if not os.path.isdir(out) or not os.listdir(out):
                 self.record("gmsh", "mesh", g, "refused",
                             "Gmsh does not mesh it: " +
                             ((p.stderr.strip().splitlines() or ["empty"])[-1])[:80])
@@ -174,6 +211,11 @@ class Sweep:
                     elif d is None or d.returncode not in REFUSALS:
                         self.record("gmsh", "o1-dist", g, "fail", "getme distort: %s" % (
                             "time-out" if d is None else "exit %d %s" % (d.returncode, d.stdout[-200:])))
+                if kind == "o1" and cgns_ok:
+                    made = cgns_check.make(path, os.path.join(out, "cgns"))
+                    if made:
+                        variants += [("cgns", made[0]), ("cgns-adf", made[1])]
+                        skin = made[2]
                 for kind, path in variants:
                     status, cause, res, rep = self.smooth_one("gmsh", kind, path)
                     if status == "tangled":
@@ -182,7 +224,9 @@ class Sweep:
                         cause = ("input has %d elements with det J <= 0 at a node in Gmsh: "
                                  % bad if bad else "exit 8 on a valid input: ") + cause
                     if status == "pass":
-                        cause = gmsh_check.compare(path, res, rep)
+                        cause = (cgns_check.compare(path, res, skin, kind == "cgns")
+                                 if kind.startswith("cgns") else
+                                 gmsh_check.compare(path, res, rep))
                         status = "fail" if cause else "pass"
                     self.record("gmsh", kind, g, status, cause)
             print("gmsh %-40s %5.1f s" % (g, time.time() - t), flush=True)
@@ -201,6 +245,9 @@ class Sweep:
                        for f in os.listdir(CCX_TESTS)
                        if f.endswith(".inp") or f.endswith(".inp.gz"))
         if quick:
+            gone = set(QUICK_CCX) - set(decks)
+            for d in sorted(gone):
+                self.record("ccx", "deck", d, "fail", "quick deck missing from %s" % CCX_TESTS)
             decks = [d for d in decks if d in QUICK_CCX]
             solve = solve or QUICK_SOLVE
         for d in decks:
@@ -223,12 +270,13 @@ class Sweep:
         return True
 
     def table(self):
-        lines = ["| source | input | count | pass | refused | fail | causes (refusals and failures) |",
-                 "|---|---|---|---|---|---|---|"]
-        for (source, kind), (n, ok, ref, bad, causes) in sorted(self.rows.items()):
+        lines = ["| source | input | count | pass | refused | known | fail | causes (refusals, known, failures) |",
+                 "|---|---|---|---|---|---|---|---|"]
+        for (source, kind), (n, ok, ref, kn, bad, causes) in sorted(self.rows.items()):
             c = "; ".join("%s (%d)" % (k, v) for k, v in
                           sorted(causes.items(), key=lambda kv: -kv[1])[:6])
-            lines.append("| %s | %s | %d | %d | %d | %d | %s |" % (source, kind, n, ok, ref, bad, c))
+            lines.append("| %s | %s | %d | %d | %d | %d | %d | %s |" % (
+                source, kind, n, ok, ref, kn, bad, c.replace("|", "/")))
         return "\n".join(lines)
 
 
