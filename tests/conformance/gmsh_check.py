@@ -45,7 +45,7 @@ def bytes_outside_nodes(a, b):
 def gmsh_model(path):
     """{(dim, tag): (types, element tags, node tags)}, {node tag: xyz},
     fixed node tags (classified on, or of elements of, entities of lower
-    dimension than the mesh)."""
+    dimension than the mesh, partition cuts excepted), the mesh's dimension."""
     gmsh.initialize(["check"])
     try:
         gmsh.option.setNumber("General.Terminal", 0)
@@ -62,6 +62,11 @@ def gmsh_model(path):
         nodes = dict(zip(tags.tolist(), xyz.reshape(-1, 3).tolist()))
         fixed = set()
         for d, t in ents:
+            # a partition boundary inside a top-dimensional entity is free
+            # (getme fixes the mesh's own entities, not partition cuts)
+            if len(gmsh.model.getPartitions(d, t)) and \
+                    gmsh.model.getParent(d, t)[0] in (top, -1):
+                continue
             if d < top:
                 fixed.update(gmsh.model.mesh.getNodes(d, t)[0].tolist())
                 for nt in els[(d, t)][2]:
@@ -72,10 +77,11 @@ def gmsh_model(path):
 
 
 def invalid_in_gmsh(path):
-    """Elements of the file's highest dimension whose Jacobian determinant
-    changes sign between one of their nodes and their centre, as Gmsh
-    computes it (its own validity, independent of getme's): for surface
-    elements, the area vectors at the nodes against the one at the centre."""
+    """Elements of the file's highest dimension with a Jacobian determinant
+    <= 0 at one of their nodes or their centre, as Gmsh computes it (its
+    own validity, independent of getme's).  Gmsh's volume elements are
+    positively oriented; a surface element's area vectors are compared with
+    the normal of its straight corners."""
     if not path.endswith(".msh"):
         return 0
     gmsh.initialize(["check"])
@@ -84,8 +90,11 @@ def invalid_in_gmsh(path):
         gmsh.open(path)
         bad = 0
         dim = 3 if len(gmsh.model.mesh.getElements(3)[0]) else 2
-        types, tags, _ = gmsh.model.mesh.getElements(dim)
-        for t, tg in zip(types, tags):
+        tags_all, xyz, _ = gmsh.model.mesh.getNodes()
+        where = {int(t): i for i, t in enumerate(tags_all)}
+        xyz = xyz.reshape(-1, 3)
+        types, tags, nodes = gmsh.model.mesh.getElements(dim)
+        for t, tg, nt in zip(types, tags, nodes):
             props = gmsh.model.mesh.getElementProperties(t)
             local = np.asarray(props[4]).reshape(-1, dim)
             pts = np.vstack([local.mean(axis=0), local])
@@ -93,12 +102,16 @@ def invalid_in_gmsh(path):
             jac, det, _ = gmsh.model.mesh.getJacobians(t, pts)
             k = len(pts) // 3
             if dim == 3:
-                d = det.reshape(len(tg), k)
-                bad += int((d[:, 1:].min(axis=1) * d[:, :1].min(axis=1) <= 0).sum())
+                bad += int((det.reshape(len(tg), k).min(axis=1) <= 0).sum())
                 continue
             j = jac.reshape(len(tg), k, 3, 3)   # rows: d/du, d/dv, normal
             area = np.cross(j[:, :, 0, :], j[:, :, 1, :])
-            dots = np.einsum("ekc,ec->ek", area[:, 1:], area[:, 0])
+            c = xyz[[where[int(n)] for n in nt]].reshape(len(tg), props[3], 3)
+            if props[5] == 3:
+                normal = np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0])
+            else:
+                normal = np.cross(c[:, 2] - c[:, 0], c[:, 3] - c[:, 1])
+            dots = np.einsum("ekc,ec->ek", area, normal)
             bad += int((dots.min(axis=1) <= 0).sum())
         return bad
     finally:
