@@ -585,24 +585,41 @@ static getme_formats_status fix_nodes(builder *b, const getme_doc_options *opts,
 
 /* ---- the mesh --------------------------------------------------------------- */
 
+/* Corners and node ids per element of a block (second order: Abaqus'
+   corners come first too). */
+static void block_shape(const inp_elem_block *eb, int *ho, int *nv, int *corners)
+{
+    *ho = eb->gtype >= INP_HO ? eb->gtype - INP_HO : -1;
+    *nv = *ho >= 0 ? getme_ho_type_num_nodes((getme_ho_type)*ho)
+                   : getme_type_num_nodes((getme_elem_type)eb->gtype);
+    *corners = *ho >= 0 ? getme_type_num_nodes((getme_elem_type)getme_ho_type_linear(
+                              (getme_ho_type)*ho))
+                        : *nv;
+}
+
+/* Signed area of a planar block's elements (xy plane). */
+static double block_area(const getme_mesh *mesh, const inp_deck *d,
+                         const inp_elem_block *eb)
+{
+    int ho, nv, corners;
+    block_shape(eb, &ho, &nv, &corners);
+    return getme__planar_area(getme_mesh_coords(mesh), d->conn + eb->conn_beg,
+                              eb->count, corners, nv);
+}
+
 /* One block of elements to the core: second-order ones from Abaqus' node
-   order to Gmsh's; a planar block that is clockwise as a whole reversed
-   (Gmsh writes one block per surface, each oriented like its surface, and
-   two surfaces of one plane may turn opposite ways: model/planar.c does
-   the same per MSH entity).  Only the core's copy changes. */
+   order to Gmsh's, reversed when reverse is set (a planar block that turns
+   against the deck's majority: Gmsh writes one block per surface, each
+   oriented like its surface, and two surfaces of one plane may turn
+   opposite ways; model/planar.c does the same per MSH entity).  Only the
+   core's copy changes. */
 static getme_status inp_add_block(getme_mesh *mesh, const inp_deck *d,
-                                  const inp_elem_block *eb, int planar,
+                                  const inp_elem_block *eb, int reverse,
                                   const int32_t *region)
 {
-    int ho = eb->gtype >= INP_HO ? eb->gtype - INP_HO : -1;
-    int nv = ho >= 0 ? getme_ho_type_num_nodes((getme_ho_type)ho)
-                     : getme_type_num_nodes((getme_elem_type)eb->gtype);
-    int corners = ho >= 0 ? getme_type_num_nodes((getme_elem_type)getme_ho_type_linear(
-                                (getme_ho_type)ho))
-                          : nv;
+    int ho, nv, corners;
+    block_shape(eb, &ho, &nv, &corners);
     const int32_t *conn = d->conn + eb->conn_beg;
-    int reverse = planar && getme__planar_area(getme_mesh_coords(mesh), conn,
-                                               eb->count, corners, nv) < 0;
     if (ho < 0 && !reverse)
         return getme_mesh_add_elements(mesh, (getme_elem_type)eb->gtype,
                                        eb->count, conn, region);
@@ -630,13 +647,16 @@ static getme_formats_status add_blocks(builder *b, getme_mesh *mesh)
     if (!region)
         return getme_doc_fail(b->doc, GETME_FORMATS_ERR_INTERNAL, "out of memory");
     getme_formats_status st = regions(b, region);
+    double planar_area = 0;
+    for (size_t k = 0; b->smooth == INP_KIND_PLANAR && k < d->neblocks; k++)
+        if (d->eblocks[k].kind == b->smooth)
+            planar_area += block_area(mesh, d, &d->eblocks[k]);
     for (size_t k = 0; !st && k < d->neblocks; k++) {
         const inp_elem_block *eb = &d->eblocks[k];
         if (eb->kind != b->smooth || eb->count == 0)
             continue;
-        int ho = eb->gtype >= INP_HO ? eb->gtype - INP_HO : -1;
-        int nv = ho >= 0 ? getme_ho_type_num_nodes((getme_ho_type)ho)
-                         : getme_type_num_nodes((getme_elem_type)eb->gtype);
+        int ho, nv, corners;
+        block_shape(eb, &ho, &nv, &corners);
         for (int32_t e = 0; e < eb->count && !st; e++) {
             const int32_t *c = d->conn + eb->conn_beg + (size_t)e * nv;
             for (int i = 1; i < nv && !st; i++)
@@ -655,8 +675,12 @@ static getme_formats_status add_blocks(builder *b, getme_mesh *mesh)
         }
         if (st)
             break;
-        getme_status gs = inp_add_block(mesh, d, eb, b->smooth == INP_KIND_PLANAR,
-                                        region + b->sfirst[k]);
+        /* the majority's orientation (by area; a tie counts as
+           counter-clockwise) stays as it is, since libgetme mirrors an
+           all-clockwise mesh itself: only blocks against it turn */
+        double area = b->smooth == INP_KIND_PLANAR ? block_area(mesh, d, eb) : 0;
+        int reverse = planar_area < 0 ? area > 0 : area < 0;
+        getme_status gs = inp_add_block(mesh, d, eb, reverse, region + b->sfirst[k]);
         if (gs != GETME_OK) {
             char w[600];
             st = getme_doc_fail(b->doc, gs == GETME_ERR_NOMEM
