@@ -80,8 +80,10 @@ def invalid_in_gmsh(path):
     """Elements of the file's highest dimension with a Jacobian determinant
     <= 0 at one of their nodes or their centre, as Gmsh computes it (its
     own validity, independent of getme's).  Gmsh's volume elements are
-    positively oriented; a surface element's area vectors are compared with
-    the normal of its straight corners."""
+    positively oriented; a surface element's area vectors (Gmsh's
+    Jacobians) are compared with its surface's normal, the sum of its
+    elements' straight-corner normals: an element turned against the
+    others of its surface is folded over them."""
     if not path.endswith(".msh"):
         return 0
     gmsh.initialize(["check"])
@@ -93,26 +95,29 @@ def invalid_in_gmsh(path):
         tags_all, xyz, _ = gmsh.model.mesh.getNodes()
         where = {int(t): i for i, t in enumerate(tags_all)}
         xyz = xyz.reshape(-1, 3)
-        types, tags, nodes = gmsh.model.mesh.getElements(dim)
-        for t, tg, nt in zip(types, tags, nodes):
-            props = gmsh.model.mesh.getElementProperties(t)
-            local = np.asarray(props[4]).reshape(-1, dim)
-            pts = np.vstack([local.mean(axis=0), local])
-            pts = np.hstack([pts, np.zeros((len(pts), 3 - dim))]).ravel()
-            jac, det, _ = gmsh.model.mesh.getJacobians(t, pts)
-            k = len(pts) // 3
-            if dim == 3:
-                bad += int((det.reshape(len(tg), k).min(axis=1) <= 0).sum())
-                continue
-            j = jac.reshape(len(tg), k, 3, 3)   # rows: d/du, d/dv, normal
-            area = np.cross(j[:, :, 0, :], j[:, :, 1, :])
-            c = xyz[[where[int(n)] for n in nt]].reshape(len(tg), props[3], 3)
-            if props[5] == 3:
-                normal = np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0])
-            else:
-                normal = np.cross(c[:, 2] - c[:, 0], c[:, 3] - c[:, 1])
-            dots = np.einsum("ekc,ec->ek", area, normal)
-            bad += int((dots.min(axis=1) <= 0).sum())
+        for _, ent in gmsh.model.getEntities(dim):
+            types, tags, nodes = gmsh.model.mesh.getElements(dim, ent)
+            areas, normals = [], []
+            for t, tg, nt in zip(types, tags, nodes):
+                props = gmsh.model.mesh.getElementProperties(t)
+                local = np.asarray(props[4]).reshape(-1, dim)
+                pts = np.vstack([local.mean(axis=0), local])
+                pts = np.hstack([pts, np.zeros((len(pts), 3 - dim))]).ravel()
+                jac, det, _ = gmsh.model.mesh.getJacobians(t, pts, tag=ent)
+                k = len(pts) // 3
+                if dim == 3:
+                    bad += int((det.reshape(len(tg), k).min(axis=1) <= 0).sum())
+                    continue
+                j = jac.reshape(len(tg), k, 3, 3)   # rows: d/du, d/dv, normal
+                areas.append(np.cross(j[:, :, 0, :], j[:, :, 1, :]))
+                c = xyz[[where[int(n)] for n in nt]].reshape(len(tg), props[3], 3)
+                normals.append(np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0])
+                               if props[5] == 3 else
+                               np.cross(c[:, 2] - c[:, 0], c[:, 3] - c[:, 1]))
+            if areas:
+                normal = sum(n.sum(axis=0) for n in normals)
+                for a in areas:
+                    bad += int((np.einsum("ekc,c->ek", a, normal).min(axis=1) <= 0).sum())
         return bad
     finally:
         gmsh.finalize()
