@@ -187,6 +187,10 @@ class Sweep:
         if not cgns_ok:
             print("SKIP cgns inputs: cgns-convert's tools are missing: %s"
                   % cgns_check.missing_tools())
+        formats = self.getme_run("formats")
+        if cgns_ok and (formats is None or not re.search(r"^cgns ", formats.stdout, re.M)):
+            cgns_ok = False
+            print("SKIP cgns inputs: this getme is built without the CGNS adapter")
         for g in geos:
             out = os.path.join(self.work, "gmsh", g[:-4].replace("/", "_"))
             shutil.rmtree(out, ignore_errors=True)
