@@ -82,6 +82,7 @@ KNOWN = {
                  "demos/boolean/hybrid_occ_builtin.geo",
                  "demos/boolean/thicksolid.geo", "demos/simple_geo/piece-extr.geo")
        for k in ALL_KINDS},
+    ("ccx", "deck", "beam10p"): "q*min",     # one free node: 0.3876 -> 0.3807
 }
 TIMEOUT = 120
 
