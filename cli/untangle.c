@@ -5,11 +5,7 @@
  */
 #include "cli.h"
 
-#include <stdlib.h>
-
-/* Elements listed by file id in the error about elements that stay
-   invalid. */
-#define MAX_NAMED 20
+#include <stdio.h>
 
 /* Untangle an input with invalid elements: one warning line with the
    counts; the elements that stay invalid named by their file ids.
@@ -31,18 +27,16 @@ int cli_untangle(cli_smooth_opts *o, const char *input, getme_doc *doc,
     long long after = (long long)ur->num_invalid_after;
     if (after == 0)
         return 0;
-    int32_t ne = getme_mesh_num_elements(mesh);
-    double *q = malloc((size_t)ne * sizeof *q);
-    char list[MAX_NAMED * 22 + 8] = "";
+    /* The untangler's own list (its validity test: the node Jacobians of
+       second-order elements too, which the corner qualities of
+       getme_mesh_element_qualities() do not see). */
+    char list[GETME_MAX_REPORTED_INVALID * 22 + 8] = "";
     size_t len = 0;
-    int named = 0;
-    if (q && getme_mesh_element_qualities(mesh, q) == GETME_OK)
-        for (int32_t e = 0; e < ne && named < MAX_NAMED; e++)
-            if (!(q[e] > 0.0))
-                len += (size_t)snprintf(list + len, sizeof list - len, "%s%lld",
-                                        named++ ? ", " : "",
-                                        (long long)getme_doc_element_id(doc, e));
-    free(q);
+    int named = ur->num_reported;
+    for (int i = 0; i < named; i++)
+        len += (size_t)snprintf(list + len, sizeof list - len, "%s%lld",
+                                i ? ", " : "",
+                                (long long)getme_doc_element_id(doc, ur->remaining[i]));
     cli_error("%s: %lld element%s could not be untangled (%lld with every node "
               "fixed): %s%s; %s",
               input, after, after == 1 ? "" : "s",

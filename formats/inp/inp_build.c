@@ -13,6 +13,7 @@
  * solid deck, springs, rigid and surface elements...) are always fixed.
  */
 #include "inp_internal.h"
+#include "model.h"
 
 #include <stdarg.h>
 #include <stdio.h>
@@ -584,20 +585,57 @@ static getme_formats_status fix_nodes(builder *b, const getme_doc_options *opts,
 
 /* ---- the mesh --------------------------------------------------------------- */
 
-/* Second-order elements in Abaqus' node order, to the core in Gmsh's. */
-static getme_status inp_add_ho(getme_mesh *mesh, getme_ho_type type,
-                               int32_t count, const int32_t *conn,
-                               const int32_t *region)
+/* Corners and node ids per element of a block (second order: Abaqus'
+   corners come first too). */
+static void block_shape(const inp_elem_block *eb, int *ho, int *nv, int *corners)
 {
-    int nv = getme_ho_type_num_nodes(type);
-    const int8_t *order = inp_ho_order(type);
-    int32_t *g = malloc(((size_t)count * nv + 1) * sizeof *g);
+    *ho = eb->gtype >= INP_HO ? eb->gtype - INP_HO : -1;
+    *nv = *ho >= 0 ? getme_ho_type_num_nodes((getme_ho_type)*ho)
+                   : getme_type_num_nodes((getme_elem_type)eb->gtype);
+    *corners = *ho >= 0 ? getme_type_num_nodes((getme_elem_type)getme_ho_type_linear(
+                              (getme_ho_type)*ho))
+                        : *nv;
+}
+
+/* Signed area of a planar block's elements (xy plane). */
+static double block_area(const getme_mesh *mesh, const inp_deck *d,
+                         const inp_elem_block *eb)
+{
+    int ho, nv, corners;
+    block_shape(eb, &ho, &nv, &corners);
+    return getme__planar_area(getme_mesh_coords(mesh), d->conn + eb->conn_beg,
+                              eb->count, corners, nv);
+}
+
+/* One block of elements to the core: second-order ones from Abaqus' node
+   order to Gmsh's, reversed when reverse is set (a planar block that turns
+   against the deck's majority: Gmsh writes one block per surface, each
+   oriented like its surface, and two surfaces of one plane may turn
+   opposite ways; model/planar.c does the same per MSH entity).  Only the
+   core's copy changes. */
+static getme_status inp_add_block(getme_mesh *mesh, const inp_deck *d,
+                                  const inp_elem_block *eb, int reverse,
+                                  const int32_t *region)
+{
+    int ho, nv, corners;
+    block_shape(eb, &ho, &nv, &corners);
+    const int32_t *conn = d->conn + eb->conn_beg;
+    if (ho < 0 && !reverse)
+        return getme_mesh_add_elements(mesh, (getme_elem_type)eb->gtype,
+                                       eb->count, conn, region);
+    int32_t *g = malloc(((size_t)eb->count * nv + 1) * sizeof *g);
     if (!g)
         return GETME_ERR_NOMEM;
-    for (int32_t e = 0; e < count; e++)
+    const int8_t *order = ho >= 0 ? inp_ho_order((getme_ho_type)ho) : NULL;
+    for (int32_t e = 0; e < eb->count; e++)
         for (int k = 0; k < nv; k++)
-            g[(size_t)e * nv + k] = conn[(size_t)e * nv + order[k]];
-    getme_status st = getme_mesh_add_elements_ho(mesh, type, count, g, region);
+            g[(size_t)e * nv + k] = conn[(size_t)e * nv + (order ? order[k] : k)];
+    if (reverse)
+        getme__planar_reverse(g, eb->count, corners, nv);
+    getme_status st =
+        ho >= 0 ? getme_mesh_add_elements_ho(mesh, (getme_ho_type)ho, eb->count, g, region)
+                : getme_mesh_add_elements(mesh, (getme_elem_type)eb->gtype,
+                                          eb->count, g, region);
     free(g);
     return st;
 }
@@ -609,13 +647,16 @@ static getme_formats_status add_blocks(builder *b, getme_mesh *mesh)
     if (!region)
         return getme_doc_fail(b->doc, GETME_FORMATS_ERR_INTERNAL, "out of memory");
     getme_formats_status st = regions(b, region);
+    double planar_area = 0;
+    for (size_t k = 0; b->smooth == INP_KIND_PLANAR && k < d->neblocks; k++)
+        if (d->eblocks[k].kind == b->smooth)
+            planar_area += block_area(mesh, d, &d->eblocks[k]);
     for (size_t k = 0; !st && k < d->neblocks; k++) {
         const inp_elem_block *eb = &d->eblocks[k];
         if (eb->kind != b->smooth || eb->count == 0)
             continue;
-        int ho = eb->gtype >= INP_HO ? eb->gtype - INP_HO : -1;
-        int nv = ho >= 0 ? getme_ho_type_num_nodes((getme_ho_type)ho)
-                         : getme_type_num_nodes((getme_elem_type)eb->gtype);
+        int ho, nv, corners;
+        block_shape(eb, &ho, &nv, &corners);
         for (int32_t e = 0; e < eb->count && !st; e++) {
             const int32_t *c = d->conn + eb->conn_beg + (size_t)e * nv;
             for (int i = 1; i < nv && !st; i++)
@@ -634,12 +675,12 @@ static getme_formats_status add_blocks(builder *b, getme_mesh *mesh)
         }
         if (st)
             break;
-        getme_status gs =
-            ho >= 0 ? inp_add_ho(mesh, (getme_ho_type)ho, eb->count,
-                                 d->conn + eb->conn_beg, region + b->sfirst[k])
-                    : getme_mesh_add_elements(mesh, (getme_elem_type)eb->gtype,
-                                              eb->count, d->conn + eb->conn_beg,
-                                              region + b->sfirst[k]);
+        /* the majority's orientation (by area; a tie counts as
+           counter-clockwise) stays as it is, since libgetme mirrors an
+           all-clockwise mesh itself: only blocks against it turn */
+        double area = b->smooth == INP_KIND_PLANAR ? block_area(mesh, d, eb) : 0;
+        int reverse = planar_area < 0 ? area > 0 : area < 0;
+        getme_status gs = inp_add_block(mesh, d, eb, reverse, region + b->sfirst[k]);
         if (gs != GETME_OK) {
             char w[600];
             st = getme_doc_fail(b->doc, gs == GETME_ERR_NOMEM

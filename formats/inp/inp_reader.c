@@ -49,6 +49,11 @@ typedef struct reader {
     int extra_file;
     uint32_t extra_line;
     int32_t extra_elem;
+    /* data lines before the first keyword (ignored, as CalculiX does: its
+       own test deck beamfsh1.inp starts with one) */
+    int64_t lead;
+    int lead_file;
+    uint32_t lead_line;
     int threads;           /* for the fast path (inp_fast.c)             */
     size_t fast_want;      /* its window                                  */
     int depth;
@@ -812,9 +817,11 @@ static getme_formats_status data_line(reader *rd, const char *text, size_t len,
 {
     switch (rd->mode) {
     case M_NONE:
-        return fail(rd, GETME_FORMATS_ERR_PARSE,
-                    "data line before the first keyword (not an Abaqus input "
-                    "file?)");
+        if (rd->lead++ == 0) {
+            rd->lead_file = rd->file;
+            rd->lead_line = rd->line;
+        }
+        return GETME_FORMATS_OK;
     case M_NODE: return node_line(rd, text, len, offset);
     case M_ELEMENT: return element_line(rd, text, len);
     case M_NSET:
@@ -973,14 +980,21 @@ getme_formats_status inp_read(inp_deck *d, const char *path, getme_doc *doc,
         st = nomem(rd);
     if (!st)
         st = read_file(rd, path, -1);
+    size_t w = 0;
     if (!st && rd->extra)
-        snprintf(doc->warning, sizeof doc->warning,
+        w += (size_t)snprintf(doc->warning, sizeof doc->warning,
                  "%s:%u: element %d has more node ids than its type needs: "
                  "the extra ids are ignored, as CalculiX does (%lld element%s "
                  "like this)",
                  inp_file_name(d, rd->extra_file), rd->extra_line,
                  (int)rd->extra_elem, (long long)rd->extra,
                  rd->extra == 1 ? "" : "s");
+    if (!st && rd->lead && w < sizeof doc->warning)
+        snprintf(doc->warning + w, sizeof doc->warning - w,
+                 "%s%s:%u: %lld data line%s before the first keyword ignored, "
+                 "as CalculiX does (written back as they are)",
+                 w ? "; " : "", inp_file_name(d, rd->lead_file), rd->lead_line,
+                 (long long)rd->lead, rd->lead == 1 ? "" : "s");
     free(rd);
     return st;
 }

@@ -162,6 +162,16 @@ getme_status getme__model_type_error(int dim, int tag, int msh_type,
 getme_status getme__planar_prepare(getme__frame *frame, double *xyz,
                                    int32_t n, getme__model_block *blocks,
                                    size_t nb, char *msg, size_t size);
+/* Sum of the signed areas (xy plane) of count planar elements, nv corners
+   each, stride node ids apart (corners first, then Gmsh's mid-edge order),
+   and the same elements made to turn the other way (mid-edge nodes stay
+   on their edges): a surface, or an INP element block, that is clockwise
+   as a whole is handed to libgetme reversed (its elements keep their
+   orientation relative to each other, so a truly inverted one stays
+   inverted). */
+double getme__planar_area(const double *xyz, const int32_t *conn,
+                          int32_t count, int nv, int stride);
+void getme__planar_reverse(int32_t *conn, int32_t count, int nv, int stride);
 /* 1 if every node has the z of the first. */
 int getme__all_same_z(const double *xyz, int32_t n);
 /* Local (frame) coordinates of one node back to model coordinates. */

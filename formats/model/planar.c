@@ -258,26 +258,36 @@ static void reverse_element(int32_t *c, int nv, int all)
     }
 }
 
+double getme__planar_area(const double *xyz, const int32_t *conn,
+                          int32_t count, int nv, int stride)
+{
+    double total = 0;
+    for (int32_t i = 0; i < count; i++)
+        total += signed_area(xyz, conn + (size_t)stride * i, nv);
+    return total;
+}
+
+void getme__planar_reverse(int32_t *conn, int32_t count, int nv, int stride)
+{
+    for (int32_t i = 0; i < count; i++)
+        reverse_element(conn + (size_t)stride * i, nv, stride);
+}
+
 static void orient_surfaces(const double *xyz,
                             const getme__model_block *blocks, size_t nb)
 {
     for (size_t b0 = 0; b0 < nb; b0 = entity_end(blocks, nb, b0)) {
         size_t b1 = entity_end(blocks, nb, b0);
         double total = 0;
-        for (size_t b = b0; b < b1; b++) {
-            int nv = corners_of(&blocks[b]), stride = nodes_of(&blocks[b]);
-            for (int32_t i = 0; i < blocks[b].count; i++)
-                total += signed_area(xyz, blocks[b].conn + (size_t)stride * i,
-                                     nv);
-        }
+        for (size_t b = b0; b < b1; b++)
+            total += getme__planar_area(xyz, blocks[b].conn, blocks[b].count,
+                                        corners_of(&blocks[b]),
+                                        nodes_of(&blocks[b]));
         if (total >= 0)
             continue;
-        for (size_t b = b0; b < b1; b++) {
-            int nv = corners_of(&blocks[b]), stride = nodes_of(&blocks[b]);
-            for (int32_t i = 0; i < blocks[b].count; i++)
-                reverse_element(blocks[b].conn + (size_t)stride * i, nv,
-                                stride);
-        }
+        for (size_t b = b0; b < b1; b++)
+            getme__planar_reverse(blocks[b].conn, blocks[b].count,
+                                  corners_of(&blocks[b]), nodes_of(&blocks[b]));
     }
 }
 

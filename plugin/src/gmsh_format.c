@@ -18,9 +18,10 @@
  *
  * Writing keeps the input's MSH version and ASCII/binary flavour, its node
  * and element tags and its physical groups; only coordinates of moved nodes
- * differ.  MSH 4.x goes through Gmsh's writer (gmshWrite); when the input
- * has physical groups but also elements outside of them, Mesh.SaveAll is
- * set so that no element is dropped.
+ * differ.  MSH 4.1 and 2.2 are the input copied with new coordinates in
+ * $Nodes (patch_file); MSH 4.0 goes through Gmsh's writer
+ * (gmshWrite); when the input has physical groups but also elements
+ * outside of them, Mesh.SaveAll is set so that no element is dropped.
  *
  * Split partition files (Mesh.PartitionSplitMeshFiles=1: NAME_1.msh ..
  * NAME_N.msh): opening NAME_1.msh of a partitioned model merges NAME_2.msh,
@@ -28,7 +29,7 @@
  * (Gmsh joins the parts by node tag; partition boundaries are not fixed,
  * gmsh_fixed.c).  Writing it to OUT.msh writes OUT_1.msh .. OUT_N.msh the
  * same way (each through a temporary file + rename), never OUT.msh itself.  MSH 2.2 is written by copying the
- * input with new coordinates in $Nodes (see patch_msh2: Gmsh's MSH 2 writer
+ * input with new coordinates in $Nodes (see msh2_nodes: Gmsh's MSH 2 writer
  * would renumber the nodes).
  */
 #define _POSIX_C_SOURCE 200809L /* getline */
@@ -597,6 +598,24 @@ static int copy_line(FILE *in, FILE *out, char *buf, size_t size)
     return c == EOF && n == 0 ? -1 : 0;
 }
 
+/* "x y z" with the shortest of %.15g / %.16g / %.17g that reads back to
+   each double (what the native writer prints, so both paths write the
+   same bytes; %.17g always reads back). */
+static int print_xyz(FILE *out, const double *x)
+{
+    for (int k = 0; k < 3; k++) {
+        char buf[40];
+        for (int digits = 15; digits <= 17; digits++) {
+            snprintf(buf, sizeof buf, "%.*g", digits, x[k]);
+            if (strtod(buf, NULL) == x[k])
+                break;
+        }
+        if (fprintf(out, k ? " %s" : "%s", buf) < 0)
+            return -1;
+    }
+    return 0;
+}
+
 static int patch_ascii_nodes(FILE *in, FILE *out, const node_table *t,
                              long count)
 {
@@ -604,12 +623,19 @@ static int patch_ascii_nodes(FILE *in, FILE *out, const node_table *t,
     for (long i = 0; i < count; i++) {
         if (!fgets(line, sizeof line, in))
             return -1;
-        unsigned long long tag = strtoull(line, NULL, 10);
+        char *p;
+        unsigned long long tag = strtoull(line, &p, 10);
+        double old[3];
+        for (int k = 0; k < 3; k++)
+            old[k] = strtod(p, &p);
         const double *x = find_node(t, (size_t)tag);
-        if (x)
-            fprintf(out, "%llu %.17g %.17g %.17g\n", tag, x[0], x[1], x[2]);
-        else
-            fputs(line, out);
+        if (x && memcmp(x, old, sizeof old) != 0) { /* moved: new text */
+            if (fprintf(out, "%llu ", tag) < 0 || print_xyz(out, x) != 0 ||
+                fputs(p, out) == EOF) /* p: the line's end, as it was */
+                return -1;
+        } else if (fputs(line, out) == EOF) {
+            return -1;
+        }
     }
     return 0;
 }
@@ -631,34 +657,146 @@ static int patch_binary_nodes(FILE *in, FILE *out, const node_table *t,
     return 0;
 }
 
-static int patch_msh2(const char *in_path, const char *out_path, int binary)
+/* The copy of in_path to out_path with $Nodes' body rewritten by body()
+   (after the "$Nodes" line); 0 or -1. */
+typedef int (*nodes_body)(FILE *in, FILE *out, const node_table *t, int binary);
+
+static int patch_file(const char *in_path, const char *out_path, int binary,
+                      nodes_body body)
 {
     node_table t;
     FILE *in = fopen(in_path, "rb"), *out = fopen(out_path, "wb");
     int rc = in && out && load_nodes(&t) == 0 ? 0 : -1;
+    int loaded = rc == 0;
     char line[512];
     while (rc == 0 && (rc = copy_line(in, out, line, sizeof line)) == 0)
         if (strncmp(line, "$Nodes", 6) == 0)
             break;
-    long count = 0;
     if (rc == 0)
-        rc = copy_line(in, out, line, sizeof line) == 0 &&
-                     sscanf(line, "%ld", &count) == 1
-                 ? 0
-                 : -1;
-    if (rc == 0)
-        rc = binary ? patch_binary_nodes(in, out, &t, count)
-                    : patch_ascii_nodes(in, out, &t, count);
+        rc = body(in, out, &t, binary);
     size_t n;
     while (rc == 0 && (n = fread(line, 1, sizeof line, in)) > 0)
         rc = fwrite(line, 1, n, out) == n ? 0 : -1;
-    if (in && out)
+    if (loaded)
         free_nodes(&t);
     if (in)
         fclose(in);
     if (out && fclose(out) != 0)
         rc = -1;
     return rc;
+}
+
+/* MSH 2.2: the node count line, then "tag x y z" lines or records. */
+static int msh2_nodes(FILE *in, FILE *out, const node_table *t, int binary)
+{
+    char line[512];
+    long count = 0;
+    if (copy_line(in, out, line, sizeof line) != 0 ||
+        sscanf(line, "%ld", &count) != 1)
+        return -1;
+    return binary ? patch_binary_nodes(in, out, t, count)
+                  : patch_ascii_nodes(in, out, t, count);
+}
+
+/* ---- MSH 4.1: patched in place too --------------------------------------
+ * Gmsh's MSH 4 writer re-serializes the model it read, and in a binary
+ * file writes the entities' bounding boxes as zeros (Gmsh 4.8, found by
+ * tests/conformance on a partitioned tutorial mesh, docs/conformance.md).
+ * So MSH 4.1 is copied like MSH 2.2: in each $Nodes block (entityDim
+ * entityTag parametric n; n tags; n records of x y z and, if parametric,
+ * entityDim parametric coordinates) only x y z of the nodes whose
+ * coordinates changed are rewritten.  Parametric coordinates stay as they
+ * are, as gmshModelMeshSetNode without them leaves them.  -1 if the file
+ * is not laid out as expected (the caller then lets Gmsh write it). */
+static int patch41_ascii(FILE *in, FILE *out, const node_table *t,
+                         size_t blocks)
+{
+    char line[1024];
+    for (size_t b = 0; b < blocks; b++) {
+        int dim, tag, param;
+        size_t n;
+        if (copy_line(in, out, line, sizeof line) != 0 ||
+            sscanf(line, "%d %d %d %zu", &dim, &tag, &param, &n) != 4)
+            return -1;
+        size_t *tags = malloc((n ? n : 1) * sizeof *tags);
+        int rc = tags ? 0 : -1;
+        for (size_t i = 0; i < n && rc == 0; i++)
+            rc = copy_line(in, out, line, sizeof line) == 0 &&
+                         sscanf(line, "%zu", &tags[i]) == 1
+                     ? 0
+                     : -1;
+        for (size_t i = 0; i < n && rc == 0; i++) {
+            if (!fgets(line, sizeof line, in)) {
+                rc = -1;
+                break;
+            }
+            double old[3];
+            char *p = line;
+            for (int k = 0; k < 3; k++)
+                old[k] = strtod(p, &p);
+            const double *x = find_node(t, tags[i]);
+            /* p: the rest of the line (parametric coordinates, line end) */
+            if (!x || memcmp(x, old, sizeof old) == 0)
+                rc = fputs(line, out) == EOF ? -1 : 0;
+            else
+                rc = print_xyz(out, x) != 0 || fputs(p, out) == EOF ? -1 : 0;
+        }
+        free(tags);
+        if (rc != 0)
+            return -1;
+    }
+    return 0;
+}
+
+static int patch41_binary(FILE *in, FILE *out, const node_table *t,
+                          size_t blocks)
+{
+    for (size_t b = 0; b < blocks; b++) {
+        int head[3]; /* entityDim, entityTag, parametric */
+        size_t n;
+        if (fread(head, sizeof head, 1, in) != 1 || fread(&n, sizeof n, 1, in) != 1 ||
+            fwrite(head, sizeof head, 1, out) != 1 ||
+            fwrite(&n, sizeof n, 1, out) != 1 || head[0] < 0 || head[0] > 3)
+            return -1;
+        size_t rec = 3 + (head[2] ? (size_t)head[0] : 0);
+        if (n > ((size_t)1 << 40))
+            return -1;
+        size_t *tags = malloc((n ? n : 1) * sizeof *tags);
+        double *xyz = malloc((n ? n : 1) * rec * sizeof *xyz);
+        int rc = tags && xyz && fread(tags, sizeof *tags, n, in) == n &&
+                         fread(xyz, rec * sizeof *xyz, n, in) == n
+                     ? 0
+                     : -1;
+        for (size_t i = 0; i < n && rc == 0; i++) {
+            const double *x = find_node(t, tags[i]);
+            if (x)
+                memcpy(xyz + rec * i, x, 3 * sizeof *x);
+        }
+        if (rc == 0 && (fwrite(tags, sizeof *tags, n, out) != n ||
+                        fwrite(xyz, rec * sizeof *xyz, n, out) != n))
+            rc = -1;
+        free(tags);
+        free(xyz);
+        if (rc != 0)
+            return -1;
+    }
+    return 0;
+}
+
+/* MSH 4.1: numEntityBlocks numNodes minNodeTag maxNodeTag, then blocks. */
+static int msh41_nodes(FILE *in, FILE *out, const node_table *t, int binary)
+{
+    char line[512];
+    size_t head[4];
+    if (binary)
+        return fread(head, sizeof head, 1, in) == 1 &&
+                       fwrite(head, sizeof head, 1, out) == 1
+                   ? patch41_binary(in, out, t, head[0])
+                   : -1;
+    return copy_line(in, out, line, sizeof line) == 0 &&
+                   sscanf(line, "%zu", &head[0]) == 1
+               ? patch41_ascii(in, out, t, head[0])
+               : -1;
 }
 
 /* Write input part in_part (opened again as its own Gmsh model) with the
@@ -800,9 +938,12 @@ static fstatus write_model(getme_doc *doc, msh_impl *impl,
     if (impl->split_parts > 0)
         return write_split(doc, impl, tmp, out_path);
     if (impl->version < 3)
-        ierr = patch_msh2(getme_doc_path(doc), tmp_msh, impl->binary) != 0;
-    else
-        gmshWrite(tmp_msh, &ierr);
+        ierr = patch_file(getme_doc_path(doc), tmp_msh, impl->binary,
+                          msh2_nodes) != 0;
+    else if (impl->version != 4.1 ||
+             patch_file(getme_doc_path(doc), tmp_msh, impl->binary,
+                        msh41_nodes) != 0)
+        gmshWrite(tmp_msh, &ierr); /* MSH 4.0 (or a 4.1 file laid out otherwise) */
     FILE *check = ierr ? NULL : fopen(tmp_msh, "rb");
     if (check)
         fclose(check);
