@@ -119,9 +119,9 @@ int cli_write_report(const char *path, const char *input, const char *output,
     }
     fprintf(f, ",\n  \"iterations\": {\"total\": %d, \"mean_stage\": %d, "
                "\"min_stage\": %d, \"min_cycles\": %d, \"finish_passes\": %d, "
-               "\"finish_improved\": %d},\n",
+               "\"finish_improved\": %d, \"reverted_nodes\": %d},\n",
             r->iterations, r->iterations_mean, r->iterations_min, r->cycles_min,
-            r->passes_finish, (int)r->moved_finish);
+            r->passes_finish, (int)r->moved_finish, (int)r->reverted_nodes);
     fprintf(f, "  \"untangle\": {\"invalid\": %lld, \"sweeps\": %d, "
                "\"seconds\": %.6f},\n",
             (long long)r->num_invalid_initial, r->untangle_sweeps,

@@ -249,6 +249,15 @@ void cli_smooth_done(const cli_smooth_opts *o, const getme_result *res)
                       "(%d q*min cycles)",
              res->seconds, res->iterations_mean, res->iterations_min,
              res->cycles_min);
+    if (res->reverted_nodes > 0)
+        cli_info(&o->log, "%d node%s put back at %s input position%s: "
+                          "q*min had ended below the input's %.4f "
+                          "(keep_best)",
+                 (int)res->reverted_nodes,
+                 res->reverted_nodes == 1 ? "" : "s",
+                 res->reverted_nodes == 1 ? "its" : "their",
+                 res->reverted_nodes == 1 ? "" : "s",
+                 res->q_min_star_initial);
 }
 
 int cli_smooth_parse_args(cli_smooth_args *a, int argc, char **argv,

@@ -573,7 +573,10 @@ typedef struct getme_params {
                                   of free elements (DetermineTransformation-
                                   Threshold), see README for the choice      */
     int keep_best;             /* 1: end on the coordinates with the best
-                                  q*_min seen in the q*_min stage            */
+                                  q*_min seen in the q*_min stage, and
+                                  never below the input's q*_min (the nodes
+                                  of elements below it go back to their
+                                  input positions; 24 B per node)           */
     int finish;                /* 1: after the q*_min stage, the finishing
                                   step: worst elements first, local max-min
                                   optimisation of their free nodes; q*_min
@@ -694,6 +697,9 @@ typedef struct getme_result {
                                   before smoothing (params->untangle)        */
     int untangle_sweeps;      /* untangling sweeps (0 if the input was valid)*/
     double untangle_seconds;  /* wall time of the untangling, part of seconds*/
+    int32_t reverted_nodes;   /* nodes put back at their input positions so
+                                 that q*_min does not end below the input's
+                                 (keep_best; 0 if it did not)               */
 } getme_result;
 
 /*

@@ -25,6 +25,7 @@
  */
 #include "adjacency.h"
 #include "best.h"
+#include "revert.h"
 #include "smooth_internal.h"
 
 #include <math.h>
@@ -872,8 +873,14 @@ getme_status getme__adaptive(getme_run *run)
     const getme_params *p = run->params;
     getme_result *res = run->result;
     getme_best best; /* best.h: an undo log, not a copy */
+    getme_input input; /* revert.h: never below the input's q*_min */
     getme_status st = alloc_adaptive(run);
     if (getme__best_init(&best, run, p->keep_best) != GETME_OK)
+        st = GETME_ERR_NOMEM;
+    /* Distributed runs do not keep it: a process cannot tell alone which
+       of its nodes to put back (docs/distributed.md). */
+    if (getme__input_keep(&input, ws, run->q, p->keep_best && !run->comm) !=
+        GETME_OK)
         st = GETME_ERR_NOMEM;
     /* Distributed: all processes stop if one has no memory (the others
        would wait for it in the first hook). */
@@ -989,6 +996,12 @@ getme_status getme__adaptive(getme_run *run)
         getme__ws_qualities(ws, run->q);
         getme__summary(run, &q_mean, &q_min, NULL);
     }
+    if (st == GETME_OK && q_min < input.q_min_star) {
+        int64_t n = 0;
+        st = getme__input_revert(&input, ws, run->q, &n);
+        res->reverted_nodes = (int32_t)n;
+    }
+    getme__input_free(&input);
     /* Distributed: getme_smooth_finish() runs it on the gathered mesh. */
     if (st == GETME_OK && p->finish && !run->comm)
         st = getme__finish(run);
@@ -997,6 +1010,7 @@ getme_status getme__adaptive(getme_run *run)
         st = GETME_ERR_COMM;
     res->threshold = qt;
 done:
+    getme__input_free(&input);
     getme__best_free(&best);
     free_adaptive(run);
     return st;

@@ -214,6 +214,10 @@ static void log_end(gg_run *run)
     if (res->passes_finish)
         gg_log("info", "%d finishing passes raised %ld elements",
                res->passes_finish, (long)res->moved_finish);
+    if (res->reverted_nodes)
+        gg_log("info", "%ld nodes put back at their input positions: q*min "
+                       "had ended below the input's %.4f (keep_best)",
+               (long)res->reverted_nodes, res->q_min_star_initial);
     if (res->corner_sj_initial < 1.0 || res->corner_sj < 1.0)
         gg_log("info", "Worst corner scaled Jacobian (hex, prism, pyramid, "
                        "quad): %.4g before, %.4g after",

@@ -55,7 +55,8 @@ from .quality import stats_dict
 _VALUES = ("dim", "num_entities", "num_nodes", "num_elements", "num_fixed",
            "num_moved", "wall", "cpu", "iterations", "iterations_mean",
            "iterations_min", "cycles_min", "threshold", "passes_finish",
-           "moved_finish", "corner_sj_before", "corner_sj_after")
+           "moved_finish", "corner_sj_before", "corner_sj_after",
+           "reverted_nodes")
 _TYPES = ("tet", "hex", "prism", "pyramid", "tri", "quad")
 _REASONS = ("improvable", "all_nodes_fixed", "fixed_interface",
             "local_optimum")
@@ -108,7 +109,7 @@ def _report_dict(rep):
     for k in ("dim", "num_entities", "num_nodes", "num_elements",
               "num_fixed", "num_moved", "iterations", "iterations_mean",
               "iterations_min", "cycles_min", "passes_finish",
-              "moved_finish"):
+              "moved_finish", "reverted_nodes"):
         out[k] = int(out[k])
     out["worst"] = _worst_list(val, "worst")
     out["worst_free"] = _worst_list(val, "worst_free")
