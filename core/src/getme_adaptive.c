@@ -879,8 +879,8 @@ getme_status getme__adaptive(getme_run *run)
         st = GETME_ERR_NOMEM;
     /* Distributed runs do not keep it: a process cannot tell alone which
        of its nodes to put back (docs/distributed.md). */
-    if (getme__input_keep(&input, ws, run->q, p->keep_best && !run->comm) !=
-        GETME_OK)
+    if (getme__input_keep(&input, ws, res->q_min_star_initial,
+                          p->keep_best && !run->comm) != GETME_OK)
         st = GETME_ERR_NOMEM;
     /* Distributed: all processes stop if one has no memory (the others
        would wait for it in the first hook). */

@@ -15,6 +15,7 @@
 #include "getme.h"
 
 #include <stdint.h>
+#include <stdlib.h>
 
 #define GETME_MAX_NV 8 /* nodes of the largest element type (hex) */
 
@@ -85,6 +86,24 @@ static inline int getme__cmp_ranked(const void *a, const void *b)
     if (x->q != y->q)
         return x->q < y->q ? -1 : 1;
     return (x->e > y->e) - (x->e < y->e);
+}
+
+/* Append x to the growing index list *list (*n entries, room *cap; the
+   room doubles, so no allocation per entry).  0, or -1 if out of memory
+   (the list as it was). */
+static inline int getme__push_i32(int32_t **list, int32_t *n, int64_t *cap,
+                                  int32_t x)
+{
+    if (*n >= *cap) {
+        int64_t c = 2 * *cap + 64;
+        int32_t *p = realloc(*list, (size_t)c * sizeof *p);
+        if (!p)
+            return -1;
+        *list = p;
+        *cap = c;
+    }
+    (*list)[(*n)++] = x;
+    return 0;
 }
 
 /* Types whose mean ratio averages several corners, so that one corner can

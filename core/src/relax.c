@@ -205,16 +205,9 @@ static int keep_if_invalid(getme_run *run, int32_t e, int32_t **bad,
 {
     if (run->q[e] > 0.0 || (run->eflag[e] & 0x80))
         return 0;
-    if (*n >= *cap) {
-        int64_t c = 2 * *cap + 64;
-        int32_t *p = realloc(*bad, (size_t)c * sizeof *p);
-        if (!p)
-            return -1;
-        *bad = p;
-        *cap = c;
-    }
+    if (getme__push_i32(bad, n, cap, e))
+        return -1;
     run->eflag[e] |= 0x80;
-    (*bad)[(*n)++] = e;
     return 0;
 }
 

@@ -27,7 +27,7 @@
 #include <string.h>
 
 getme_status getme__input_keep(getme_input *in, const getme_ws *ws,
-                               const double *q, int on)
+                               double q_min_star, int on)
 {
     memset(in, 0, sizeof *in);
     if (!on)
@@ -36,11 +36,7 @@ getme_status getme__input_keep(getme_input *in, const getme_ws *ws,
     if (!in->x)
         return GETME_ERR_NOMEM;
     memcpy(in->x, ws->x, (size_t)ws->nn * 3 * sizeof *in->x);
-    double m = 1.0; /* q*_min: over elements with a free node (getme__ws_summary) */
-    for (int32_t e = 0; e < ws->ne; e++)
-        if (ws->free_elem[e] && q[e] < m)
-            m = q[e];
-    in->q_min_star = m;
+    in->q_min_star = q_min_star;
     return GETME_OK;
 }
 
@@ -50,25 +46,12 @@ void getme__input_free(getme_input *in)
     in->x = NULL;
 }
 
-/* A growing list of 32-bit indices (no allocation per entry). */
+/* A growing list of 32-bit indices (getme__push_i32). */
 typedef struct ilist {
     int32_t *v;
-    int64_t n, cap;
+    int32_t n;
+    int64_t cap;
 } ilist;
-
-static int push(ilist *l, int32_t i)
-{
-    if (l->n == l->cap) {
-        int64_t cap = l->cap ? 2 * l->cap : 256;
-        int32_t *v = realloc(l->v, (size_t)cap * sizeof *v);
-        if (!v)
-            return -1;
-        l->v = v;
-        l->cap = cap;
-    }
-    l->v[l->n++] = i;
-    return 0;
-}
 
 /* Put back the free nodes of the elements in bad not put back yet, appending
    them to nodes. */
@@ -86,7 +69,7 @@ static int put_back(const getme_input *in, getme_ws *ws, const ilist *bad,
             done[v >> 6] |= (uint64_t)1 << (v & 63);
             memcpy(ws->x + 3 * (int64_t)v, in->x + 3 * (int64_t)v,
                    3 * sizeof *ws->x);
-            if (push(nodes, v))
+            if (getme__push_i32(&nodes->v, &nodes->n, &nodes->cap, v))
                 return -1;
         }
     }
@@ -104,7 +87,8 @@ static int rescore(const getme_input *in, const getme_ws *ws, double *q,
         for (int32_t s = ws->star_ptr[v]; s < ws->star_ptr[v + 1]; s++) {
             int32_t e = ws->star[s];
             q[e] = getme__ws_quality(ws, ws->x, e);
-            if (ws->free_elem[e] && q[e] < in->q_min_star && push(bad, e))
+            if (ws->free_elem[e] && q[e] < in->q_min_star &&
+                getme__push_i32(&bad->v, &bad->n, &bad->cap, e))
                 return -1;
         }
     }
@@ -121,7 +105,8 @@ getme_status getme__input_revert(const getme_input *in, getme_ws *ws,
     uint64_t *done = NULL;
     getme_status st = GETME_ERR_NOMEM;
     for (int32_t e = 0; e < ws->ne; e++)
-        if (ws->free_elem[e] && q[e] < in->q_min_star && push(&bad, e))
+        if (ws->free_elem[e] && q[e] < in->q_min_star &&
+            getme__push_i32(&bad.v, &bad.n, &bad.cap, e))
             goto out;
     if (bad.n && !(done = calloc(((size_t)ws->nn + 63) / 64, sizeof *done)))
         goto out;

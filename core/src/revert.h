@@ -13,10 +13,11 @@ typedef struct getme_input {
     double q_min_star; /* the input's q*_min                             */
 } getme_input;
 
-/* Keep ws->x and q*_min of q (in zeroed first) if on.  GETME_OK or
+/* Keep ws->x, the input whose q*_min is q_min_star (getme_result's
+   q_min_star_initial), if on; in is zeroed first.  GETME_OK or
    GETME_ERR_NOMEM. */
 getme_status getme__input_keep(getme_input *in, const getme_ws *ws,
-                               const double *q, int on);
+                               double q_min_star, int on);
 
 /* Put back at their input positions the free nodes of every free element
    below the input's q*_min, and of every element that falls below it
