@@ -219,13 +219,17 @@ void cli_untangle_warning(const cli_log *log, const getme_untangle_result *ur)
                 before, before == 1 ? "" : "s", after,
                 after == 1 ? "s" : "", ur->sweeps, ur->sweeps == 1 ? "" : "s",
                 (int)ur->num_moved, ur->seconds);
+    /* The count is of the elements found; the repair can leave some
+       invalid (the smoothing then names them, exit 8). */
     if (ur->num_ho_moved > 0)
         cli_warning(log, "%d second-order element%s invalid only at curved "
                          "mid-nodes: %d mid-node%s pulled toward the straight "
-                         "position (docs/highorder.md)",
+                         "position, %d element%s now valid (docs/highorder.md)",
+                    (int)ur->num_ho_invalid,
+                    ur->num_ho_invalid == 1 ? " was" : "s were",
+                    (int)ur->num_ho_moved, ur->num_ho_moved == 1 ? "" : "s",
                     (int)ur->num_ho_repaired,
-                    ur->num_ho_repaired == 1 ? " was" : "s were",
-                    (int)ur->num_ho_moved, ur->num_ho_moved == 1 ? "" : "s");
+                    ur->num_ho_repaired == 1 ? "" : "s");
 }
 
 void cli_smooth_begin(cli_smooth_opts *o, getme_params *params)

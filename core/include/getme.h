@@ -909,6 +909,11 @@ typedef struct getme_untangle_result {
                                    pulling their free mid-nodes toward the
                                    straight position (docs/highorder.md)   */
     int32_t num_ho_moved;       /* dependent nodes moved to repair them     */
+    int32_t num_ho_invalid;     /* second-order elements found invalid only
+                                   at their non-corner nodes; those of them
+                                   still invalid (num_ho_invalid -
+                                   num_ho_repaired) stop the smoothing with
+                                   GETME_ERR_INVALID_MESH                   */
 } getme_untangle_result;
 
 /*

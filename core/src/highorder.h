@@ -92,10 +92,11 @@ int getme__ho_valid(const struct getme_ws *ws, const double *coords,
 /* Pull the free dependent nodes of elements that are invalid only at
    their non-corner nodes (corners valid) toward their straight positions,
    halving their offsets until those elements are valid
-   (highorder_repair.c).  num_elements: elements repaired, num_nodes: nodes
-   moved.  GETME_OK or GETME_ERR_NOMEM. */
-getme_status getme__ho_repair(struct getme_ws *ws, int32_t *num_elements,
-                              int32_t *num_nodes);
+   (highorder_repair.c).  num_found: elements found invalid that way,
+   num_elements: those of them valid afterwards, num_nodes: nodes moved.
+   GETME_OK or GETME_ERR_NOMEM. */
+getme_status getme__ho_repair(struct getme_ws *ws, int32_t *num_found,
+                              int32_t *num_elements, int32_t *num_nodes);
 
 /* Write the dependent nodes placed from ws->x into the mesh (pinned ones
    are not written). */

@@ -62,10 +62,11 @@ static int needs_repair(const getme_ws *ws, int32_t e)
            !getme__ho_valid(ws, ws->x, e);
 }
 
-getme_status getme__ho_repair(getme_ws *ws, int32_t *num_elements,
-                              int32_t *num_nodes)
+getme_status getme__ho_repair(getme_ws *ws, int32_t *num_found,
+                              int32_t *num_elements, int32_t *num_nodes)
 {
     getme_ho_ws *ho = ws->ho;
+    *num_found = 0;
     *num_elements = 0;
     *num_nodes = 0;
     if (!ho)
@@ -119,8 +120,10 @@ getme_status getme__ho_repair(getme_ws *ws, int32_t *num_elements,
     }
     for (int32_t h = 0; h < ho->nh; h++)
         *num_nodes += moved[h];
-    for (int32_t e = 0; e < ws->ne; e++)
+    for (int32_t e = 0; e < ws->ne; e++) {
+        *num_found += bad[e];
         *num_elements += bad[e] && getme__ho_valid(ws, ws->x, e);
+    }
     free(mark), free(moved), free(bad);
     return GETME_OK;
 }

@@ -791,13 +791,15 @@ getme_status getme_mesh_untangle(getme_mesh *mesh, const getme_params *params,
         getme__ws_free(&ws);
         return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
     }
-    int32_t ho_e = 0, ho_n = 0; /* second order: highorder_repair.c */
-    st = getme__ho_repair(&ws, &ho_e, &ho_n);
+    /* second order: highorder_repair.c */
+    int32_t ho_found = 0, ho_e = 0, ho_n = 0;
+    st = getme__ho_repair(&ws, &ho_found, &ho_e, &ho_n);
     if (st == GETME_OK) {
         getme__ws_qualities(&ws, q);
         st = getme__untangle(&ws, q, result);
     }
     result->num_invalid_before += ho_e;
+    result->num_ho_invalid = ho_found;
     result->num_ho_repaired = ho_e;
     result->num_ho_moved = ho_n;
     if (st == GETME_OK && (result->num_moved > 0 || ho_n > 0))

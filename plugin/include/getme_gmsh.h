@@ -215,7 +215,8 @@ GETME_GMSH_API getme_status getme_gmsh_quality(
    "untangle_invalid_after", "untangle_sweeps", "untangle_moved",
    "num_second_order", "jacobian_ratio_before", "jacobian_ratio_after",
    "jacobian_ratio_tag_before", "jacobian_ratio_tag_after",
-   "untangle_ho_repaired", "untangle_ho_moved", "reverted_nodes",
+   "untangle_ho_repaired", "untangle_ho_moved", "untangle_ho_invalid",
+   "reverted_nodes",
    "untangle_seconds", "<worst|worst_free><i>_<tag|index|type|
    quality|corner_sj|num_free|num_nodes|reason>", "<before|after>_<q_min_star|q_min|q_mean|q_max|
    num_invalid|num_below_04|num_below_01|num_elements|num_free>",

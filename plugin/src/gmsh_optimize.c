@@ -140,9 +140,11 @@ static getme_status untangle(gg_run *run)
                u->sweeps == 1 ? "" : "s", (long)u->num_moved, u->seconds);
     if (run->opt->log >= 1 && u->num_ho_moved > 0)
         gg_log("warning", "%d second-order element%s invalid only at curved "
-               "mid-nodes: %d mid-nodes pulled toward the straight position",
-               (int)u->num_ho_repaired, u->num_ho_repaired == 1 ? "" : "s",
-               (int)u->num_ho_moved);
+               "mid-nodes: %d mid-node%s pulled toward the straight "
+               "position, %d element%s now valid",
+               (int)u->num_ho_invalid, u->num_ho_invalid == 1 ? "" : "s",
+               (int)u->num_ho_moved, u->num_ho_moved == 1 ? "" : "s",
+               (int)u->num_ho_repaired, u->num_ho_repaired == 1 ? "" : "s");
     if (st == GETME_OK)
         return GETME_OK;
     char text[GG_MSG], head[128];

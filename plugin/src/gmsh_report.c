@@ -101,7 +101,8 @@ double getme_gmsh_report_value(const getme_gmsh_report *r, const char *name)
         "untangle_sweeps", "untangle_moved", "untangle_seconds",
         "num_second_order", "jacobian_ratio_before", "jacobian_ratio_after",
         "jacobian_ratio_tag_before", "jacobian_ratio_tag_after",
-        "untangle_ho_repaired", "untangle_ho_moved", "reverted_nodes"};
+        "untangle_ho_repaired", "untangle_ho_moved", "reverted_nodes",
+        "untangle_ho_invalid"};
     const getme_untangle_result *u = &r->untangle;
     const double values[] = {r->dim,
                              r->num_entities,
@@ -141,7 +142,8 @@ double getme_gmsh_report_value(const getme_gmsh_report *r, const char *name)
                              (double)r->jacobian_ratio_tag_after,
                              u->num_ho_repaired,
                              u->num_ho_moved,
-                             res->reverted_nodes};
+                             res->reverted_nodes,
+                             u->num_ho_invalid};
     for (size_t i = 0; i < sizeof names / sizeof *names; i++)
         if (strcmp(name, names[i]) == 0)
             return values[i];

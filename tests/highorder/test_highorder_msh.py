@@ -309,11 +309,13 @@ def midnode_repair_case(kind, gtype, k, a, b):
           "%s: smooth exit %d/%d %s" % (tag, r1.returncode, r2.returncode,
                                         r1.stderr[-300:]))
     m = re.search(r"(\d+) second-order elements? w(?:as|ere) invalid only at "
-                  r"curved mid-nodes: (\d+) mid-nodes? pulled",
+                  r"curved mid-nodes: (\d+) mid-nodes? pulled toward the "
+                  r"straight position, (\d+) elements? now valid",
                   r1.stdout + r1.stderr)
-    check(m is not None and int(m.group(1)) == n0 and int(m.group(2)) == 1,
-          "%s: the warning counts %d elements and 1 node (%s)" %
-          (tag, n0, m and m.groups()))
+    check(m is not None and int(m.group(1)) == n0 and int(m.group(2)) == 1
+          and int(m.group(3)) == n0,
+          "%s: the warning counts %d elements, 1 node, %d now valid (%s)" %
+          (tag, n0, n0, m and m.groups()))
     check(os.path.exists(o1) and os.path.exists(o2) and
           open(o1, "rb").read() == open(o2, "rb").read(),
           "%s: 1 and 2 threads byte-identical" % tag)
@@ -322,6 +324,57 @@ def midnode_repair_case(kind, gtype, k, a, b):
           (tag, w1))
     print("%s: input min det J %.4g in %d elements -> %.4g" %
           (tag, w0, n0, w1), flush=True)
+
+
+def pull_midnode(conn, inner, k, a, b, want_inner):
+    """Move mid-edge node k of the first element whose node k and corner a
+    are interior (or node k on the skin) to 0.2 of its edge a-b."""
+    row = next(r for r in conn
+               if ((r[k] in inner and r[a] in inner) if want_inner
+                   else r[k] not in inner))
+    pa = np.array(gmsh.model.mesh.getNode(row[a])[0])
+    pb = np.array(gmsh.model.mesh.getNode(row[b])[0])
+    gmsh.model.mesh.setNode(int(row[k]), (pa + 0.2 * (pb - pa)).tolist(), [])
+    return row
+
+
+def midnode_pinned_case():
+    """One interior mid-node pulled (repairable) and one on the skin
+    (pinned: the repair cannot move it): the warning counts every element
+    found and says how many are valid afterwards, and the smoothing stops
+    with exit 8 naming the element left invalid."""
+    tag = "mid-node pinned tet10"
+    gmsh.clear()
+    gmsh.open(path("tet10-4.1.msh"))
+    inner = set(gmsh.model.mesh.getNodes(3, -1)[0].tolist())
+    et, nt = gmsh.model.mesh.getElementsByType(11)
+    conn = np.array(nt).reshape(-1, 10)
+    pull_midnode(conn, inner, 4, 0, 1, True)
+    pull_midnode(conn, inner, 4, 0, 1, False)
+    bad = path("tet10-pinbad.msh")
+    gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+    gmsh.option.setNumber("Mesh.Binary", 0)
+    gmsh.write(bad)
+    w0, n0 = ho_check.min_node_jacobian(bad)
+    r = run("smooth", bad, "-o", path("tet10-pinout.msh"))
+    m = re.search(r"(\d+) second-order elements? w(?:as|ere) invalid only at "
+                  r"curved mid-nodes: (\d+) mid-nodes? pulled toward the "
+                  r"straight position, (\d+) elements? now valid",
+                  r.stdout + r.stderr)
+    check(m is not None and int(m.group(1)) == n0 and int(m.group(2)) >= 1
+          and 0 < int(m.group(3)) < n0,
+          "%s: the warning counts all %d elements found, the nodes moved and "
+          "fewer now valid (%s)" % (tag, n0, m and m.groups()))
+    e = re.search(r"(\d+) elements? could not be untangled .*?: ([0-9, ]+)",
+                  r.stderr)
+    check(e is not None and int(e.group(1)) == n0 - int(m.group(3)) and
+          len(e.group(2).split(",")) == int(e.group(1)),
+          "%s: the error names the %d elements left invalid (%s)" %
+          (tag, n0 - int(m.group(3)) if m else -1, r.stderr[-300:]))
+    check(r.returncode == 8 and not os.path.exists(path("tet10-pinout.msh")),
+          "%s: exit 8 and no output (%d)" % (tag, r.returncode))
+    print("%s: %s, exit %d" % (tag, m and m.groups(), r.returncode),
+          flush=True)
 
 
 gmsh.initialize()
@@ -341,6 +394,7 @@ for kind, gtype in (("tet10", 11), ("hex27", 12), ("prism18", 13)):
     curved_case(kind, gtype)
 midnode_repair_case("tet10", 11, 4, 0, 1)
 midnode_repair_case("hex20", 17, 8, 0, 1)
+midnode_pinned_case()
 gmsh.finalize()
 print("%d failure(s)" % len(FAILED))
 sys.exit(1 if FAILED else 0)

@@ -34,8 +34,9 @@ measures_before / measures_after: {type: {measure: {"min", "max", "mean",
 "num_elements", "num_negative", "histogram", ...}}} for the dihedral
 angles, scaled Jacobian, Gmsh's gamma and SICN (docs/quality.md), and
 "untangle": invalid_before / invalid_after / sweeps / nodes_moved /
-seconds / ho_repaired / ho_moved (second-order elements invalid only at
-their mid-nodes, repaired, and the mid-nodes moved) of the untangling step; "second_order": None, or for a mesh with
+seconds / ho_invalid / ho_repaired / ho_moved (second-order elements
+invalid only at their mid-nodes, those of them repaired, and the mid-nodes
+moved) of the untangling step; "second_order": None, or for a mesh with
 second-order elements {"elements", "jacobian_ratio_before",
 "jacobian_ratio_after", "element_before", "element_after"}: the worst
 ratio of the smallest to the largest det J over an element's nodes, and
@@ -130,9 +131,9 @@ def _report_dict(rep):
                 rep, after, t, m).contents)
     out["untangle"] = {k: val("untangle_" + k) for k in
                        ("invalid_before", "invalid_after", "sweeps", "moved",
-                        "seconds", "ho_repaired", "ho_moved")}
+                        "seconds", "ho_invalid", "ho_repaired", "ho_moved")}
     for k in ("invalid_before", "invalid_after", "sweeps", "moved",
-              "ho_repaired", "ho_moved"):
+              "ho_invalid", "ho_repaired", "ho_moved"):
         out["untangle"][k] = int(out["untangle"][k])
     out["untangle"]["nodes_moved"] = out["untangle"].pop("moved")
     out["second_order"] = None
