@@ -225,14 +225,29 @@ getme_status getme_mesh_worst_elements(getme_mesh *mesh, int32_t max_count,
     if (!q)
         return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
     getme_mesh_element_qualities(mesh, q);
+    getme_status st =
+        getme_mesh_worst_elements_from(mesh, q, max_count, flags, out, count);
+    free(q);
+    return st;
+}
+
+getme_status getme_mesh_worst_elements_from(getme_mesh *mesh, const double *q,
+                                            int32_t max_count, unsigned flags,
+                                            getme_worst_element *out,
+                                            int32_t *count)
+{
+    if (!mesh || max_count < 0 || (!out && max_count > 0) || !count ||
+        (!q && max_count > 0 && mesh->num_elements))
+        return GETME_ERR_ARGUMENT;
+    *count = 0;
+    if (max_count == 0 || mesh->num_elements == 0)
+        return GETME_OK;
+    if (mesh->mirror < 0)
+        getme__detect_orientation(mesh); /* the probes' patches need it */
     int32_t n = 0;
     if (worst_sweep(mesh, q, flags & GETME_WORST_FREE_ONLY, max_count, out,
-                    &n) != GETME_OK) {
-        free(q);
+                    &n) != GETME_OK)
         return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
-    }
-    free(q);
-
     getme_patch p;
     int32_t *cand = NULL, num = 0;
     if (candidates(mesh, out, n, &cand, &num) != GETME_OK ||
