@@ -125,18 +125,25 @@ int main(int argc, char **argv)
 #ifdef GETME_SHARED_Q
     {
         double *q = malloc((size_t)getme_mesh_num_elements(mesh) * sizeof *q);
-        timing ta = {0, 0};
+        timing ta = {0, 0}, t1 = {0, 0}, t2 = {0, 0}, t3 = {0, 0};
         for (int r = 0; r < reps; r++) {
             double c0 = cpu(), w0 = omp_get_wtime();
             getme_mesh_measure_all_qualities(mesh, m, q);
+            best(&t1, c0, w0, r);
+            double c1 = cpu(), w1 = omp_get_wtime();
             getme_mesh_quality_stats_from(mesh, q, -1, &s);
+            best(&t2, c1, w1, r);
+            c1 = cpu(), w1 = omp_get_wtime();
             getme_mesh_worst_elements_from(mesh, q, WORST, 0, w, &nw);
             getme_mesh_worst_elements_from(mesh, q, WORST, GETME_WORST_FREE_ONLY,
-                                        wf, &nwf);
+                                           wf, &nwf);
+            best(&t3, c1, w1, r);
             best(&ta, c0, w0, r);
         }
-        printf("threads %d: shared qualities: all four %.3f s (wall %.3f)\n",
-               omp_get_max_threads(), ta.cpu, ta.wall);
+        printf("threads %d: shared qualities: all four %.3f s (wall %.3f): "
+               "measures %.3f (%.3f), stats %.3f (%.3f), worst x2 %.3f (%.3f)\n",
+               omp_get_max_threads(), ta.cpu, ta.wall, t1.cpu, t1.wall,
+               t2.cpu, t2.wall, t3.cpu, t3.wall);
         if (f) {
             put_measures(f, m);
             put_stats(f, &s);
