@@ -730,11 +730,19 @@ KERNEL double end_lane(const dihedral_ends *d, const double (*x)[L], int k,
                   v3_lane(x, e[2], l), v3_lane(x, e[3], l), u, v);
 }
 
-/* |u x v| and u . v, angle_between's atan2 arguments */
-KERNEL void atan2_args(v3 u, v3 v, double *y, double *x)
+/* |u x v| and u . v of the lanes, angle_between's atan2 arguments (its
+   operations in its order) */
+static void atan2_args_lanes(double (*u)[L], double (*v)[L],
+                             double *y, double *x)
 {
-    *y = v3_norm(v3_cross(u, v));
-    *x = v3_dot(u, v);
+#pragma omp simd
+    for (int l = 0; l < L; l++) {
+        double cx = u[1][l] * v[2][l] - u[2][l] * v[1][l];
+        double cy = u[2][l] * v[0][l] - u[0][l] * v[2][l];
+        double cz = u[0][l] * v[1][l] - u[1][l] * v[0][l];
+        y[l] = sqrt(cx * cx + cy * cy + cz * cz);
+        x[l] = u[0][l] * v[0][l] + u[1][l] * v[1][l] + u[2][l] * v[2][l];
+    }
 }
 
 /* dihedral3 of the lanes, in degrees as measure() gives them.  The
@@ -773,13 +781,8 @@ static void dihedral_lanes(const dihedral_ends *d, const double (*x)[L],
         }
     }
     double ylo[L], xlo[L], yhi[L], xhi[L];
-#pragma omp simd
-    for (int l = 0; l < L; l++) {
-        atan2_args((v3){ua[0][l], ua[1][l], ua[2][l]},
-                   (v3){va[0][l], va[1][l], va[2][l]}, &ylo[l], &xlo[l]);
-        atan2_args((v3){ui[0][l], ui[1][l], ui[2][l]},
-                   (v3){vi[0][l], vi[1][l], vi[2][l]}, &yhi[l], &xhi[l]);
-    }
+    atan2_args_lanes(ua, va, ylo, xlo);
+    atan2_args_lanes(ui, vi, yhi, xhi);
     for (int l = 0; l < L; l++) {
         lo[l] = atan2(ylo[l], xlo[l]) * RAD2DEG;
         hi[l] = atan2(yhi[l], xhi[l]) * RAD2DEG;
