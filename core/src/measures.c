@@ -1058,6 +1058,9 @@ static void tile_measures(const getme_mesh *mesh, const getme_block *bl,
 {
     int dim3 = getme_type_dim((getme_elem_type)bl->type) == 3;
     int32_t step = dim3 ? L : 1;
+    /* also the parts of threads the runtime does not start */
+    for (int k = 0; k < nt * GETME_NUM_MEASURES; k++)
+        init_stats(&part[k], k % GETME_NUM_MEASURES);
 #pragma omp parallel num_threads(nt)
     {
         getme_measure_stats p[GETME_NUM_MEASURES];

@@ -67,7 +67,8 @@ static void hits_push(hits *h, int32_t e)
 {
     if (h->n == h->cap) {
         int32_t cap = h->cap ? 2 * h->cap : 256;
-        int32_t *grown = h->failed ? NULL : realloc(h->e, (size_t)cap * sizeof *grown);
+        int32_t *grown =
+            h->failed ? NULL : realloc(h->e, (size_t)cap * sizeof *grown);
         if (!grown) {
             h->failed = 1;
             return;
@@ -85,10 +86,11 @@ static int marked(const getme_block *bl, const uint8_t *mark, hits *part,
                   int nt, int32_t **list, int32_t *m)
 {
     int nv = getme__nv[bl->type];
+    for (int k = 0; k < nt; k++)
+        part[k].n = 0; /* also for a thread the runtime does not start */
 #pragma omp parallel num_threads(nt)
     {
         hits h = part[omp_get_thread_num()];
-        h.n = 0;
 #pragma omp for schedule(static)
         for (int32_t e = 0; e < bl->count; e++) {
             const int32_t *c = bl->conn + (int64_t)e * nv;
