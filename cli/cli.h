@@ -61,8 +61,10 @@ typedef struct cli_measures {
     getme_measure_stats stats[GETME_NUM_TYPES][GETME_NUM_MEASURES];
 } cli_measures;
 
-/* 0 on success, -1 if the library failed (out of memory). */
-int cli_measures_compute(getme_mesh *mesh, cli_measures *m);
+/* 0 on success, -1 if the library failed (out of memory).  q: NULL, or
+   num_elements doubles receiving every element's quality from the same
+   sweep (for getme_mesh_quality_stats_from and cli_worst). */
+int cli_measures_compute(getme_mesh *mesh, cli_measures *m, double *q);
 /* One line per element type: "TITLE (tet): dihedral 12.34 to 160.21 deg,
    scaled Jacobian min .. mean .., gamma ..., SICN ...". */
 void cli_print_measures(const cli_log *log, const char *title,
@@ -248,18 +250,18 @@ typedef struct cli_worst_list {
 } cli_worst_list;
 
 long long cli_element_tag(const getme_doc *doc, int32_t e);
-/* Fill w with the max_count worst elements; 0, or -1 after printing an
-   error.  Free w->items. */
-int cli_worst(getme_doc *doc, int32_t max_count, unsigned flags,
-              cli_worst_list *w);
+/* Fill w with the max_count worst elements ranked by q (the mesh's
+   element qualities); 0, or -1 after printing an error.  Free w->items. */
+int cli_worst(getme_doc *doc, const double *q, int32_t max_count,
+              unsigned flags, cli_worst_list *w);
 /* which: "" or " with a free node". */
 void cli_print_worst(const cli_log *log, const getme_doc *doc,
                      const cli_worst_list *w, const char *which);
 void cli_json_worst(FILE *f, const getme_doc *doc, const cli_worst_list *w);
 /* After smoothing: worst corner line, worst lists (-v) and the warning when
    the worst elements have no free node; 0, or -1 if out of memory. */
-int cli_log_after(const cli_log *log, getme_doc *doc, int32_t max_count,
-                  const getme_quality_stats *after,
+int cli_log_after(const cli_log *log, getme_doc *doc, const double *q,
+                  int32_t max_count, const getme_quality_stats *after,
                   const getme_result *res, cli_worst_list *worst,
                   cli_worst_list *worst_free);
 

@@ -21,10 +21,13 @@ static const char QUALITY_HELP[] =
     "a fixed interface, free nodes at a local optimum, or still improvable).\n"
     "Exit code 6 if the mesh has invalid (inverted) elements.\n";
 
-static void print_type(const cli_log *log, getme_mesh *mesh, int type)
+/* q: every element's quality (from the measures' sweep) */
+static void print_type(const cli_log *log, getme_mesh *mesh, const double *q,
+                       int type)
 {
     getme_quality_stats s;
-    if (getme_mesh_quality_stats(mesh, type, &s) != GETME_OK || !s.num_elements)
+    if (getme_mesh_quality_stats_from(mesh, q, type, &s) != GETME_OK ||
+        !s.num_elements)
         return;
     const char *name = type < 0 ? "all elements"
                                 : getme_type_name((getme_elem_type)type);
@@ -94,24 +97,30 @@ int cli_quality(int argc, char **argv)
     cli_info(&log, "%s (%s): %s", input, getme_format_name(getme_doc_format(doc)), desc);
     int types = 0;
     cli_measures measures;
-    if (cli_measures_compute(mesh, &measures) != 0) {
-        cli_error("%s: %s", input, getme_mesh_error(mesh));
+    /* one sweep evaluates every element: the measures and the qualities
+       the statistics and the worst lists use */
+    int32_t ne = getme_mesh_num_elements(mesh);
+    double *q = malloc((size_t)(ne ? ne : 1) * sizeof *q);
+    if (!q || cli_measures_compute(mesh, &measures, q) != 0) {
+        cli_error("%s: %s", input, q ? getme_mesh_error(mesh) : "out of memory");
+        free(q);
         getme_doc_close(doc);
         return CLI_EXIT_INTERNAL;
     }
     for (int t = 0; t < GETME_NUM_TYPES; t++)
         if (getme_mesh_num_elements_of_type(mesh, (getme_elem_type)t)) {
-            print_type(&log, mesh, t);
+            print_type(&log, mesh, q, t);
             cli_print_measure_histograms(&log, &measures, t);
             types++;
         }
     if (types > 1)
-        print_type(&log, mesh, -1);
+        print_type(&log, mesh, q, -1);
     cli_worst_list w = {0}, wf = {0};
-    if (worst > 0 && (cli_worst(doc, (int32_t)worst, 0, &w) != 0 ||
-                      cli_worst(doc, (int32_t)worst, GETME_WORST_FREE_ONLY,
-                                &wf) != 0))
+    if (worst > 0 &&
+        (cli_worst(doc, q, (int32_t)worst, 0, &w) != 0 ||
+         cli_worst(doc, q, (int32_t)worst, GETME_WORST_FREE_ONLY, &wf) != 0))
         st = CLI_EXIT_INTERNAL;
+    free(q);
     cli_print_worst(&log, doc, &w, "");
     cli_print_worst(&log, doc, &wf, " with a free node");
     free(w.items);

@@ -7,9 +7,12 @@
 
 #include <string.h>
 
-int cli_measures_compute(getme_mesh *mesh, cli_measures *m)
+int cli_measures_compute(getme_mesh *mesh, cli_measures *m, double *q)
 {
-    return getme_mesh_measure_all(mesh, &m->stats[0][0]) == GETME_OK ? 0 : -1;
+    return getme_mesh_measure_all_qualities(mesh, &m->stats[0][0], q) ==
+                   GETME_OK
+               ? 0
+               : -1;
 }
 
 /* "min dihedral" / "min angle" (planar), "scaled Jacobian", ... */
@@ -46,7 +49,7 @@ void cli_print_measures(const cli_log *log, const char *title,
 void cli_measures_log(const cli_log *log, getme_mesh *mesh, const char *title,
                       cli_measures *m)
 {
-    if (cli_measures_compute(mesh, m) != 0) {
+    if (cli_measures_compute(mesh, m, NULL) != 0) {
         cli_warning(log, "%s: %s", title, getme_mesh_error(mesh));
         memset(m, 0, sizeof *m);
         return;

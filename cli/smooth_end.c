@@ -57,17 +57,38 @@ int cli_smooth_end_run(const cli_smooth_opts *so, const cli_smooth_end *e,
     cli_measures mafter;
     cli_ho_ratio ho_after = {0};
     cli_smooth_done(so, res);
-    getme_mesh_quality_stats(mesh, -1, &after);
-    cli_print_stats(log, "Quality after ", &after);
-    cli_measures_log(log, mesh, "Measures after ", &mafter);
-    cli_ho_log(log, e->doc, "after", &ho_after);
     cli_worst_list worst = {0}, worst_free = {0};
     int code = 0;
-    if (cli_log_after(log, e->doc, e->worst, &after, res, &worst,
+    /* every element evaluated once: the measures' sweep also gives the
+       qualities that the statistics and the worst lists rank */
+    int32_t ne = getme_mesh_num_elements(mesh);
+    double *q = malloc((size_t)(ne ? ne : 1) * sizeof *q);
+    if (!q) {
+        cli_error("%s: out of memory", e->input);
+        return CLI_EXIT_INTERNAL;
+    }
+    int measured = cli_measures_compute(mesh, &mafter, q) == 0;
+    if (!measured) {
+        cli_warning(log, "Measures after : %s", getme_mesh_error(mesh));
+        memset(&mafter, 0, sizeof mafter);
+    }
+    if ((!measured && getme_mesh_element_qualities(mesh, q) != GETME_OK) ||
+        getme_mesh_quality_stats_from(mesh, q, -1, &after) != GETME_OK) {
+        cli_error("%s: %s", e->input, getme_mesh_error(mesh));
+        code = CLI_EXIT_INTERNAL;
+        goto out;
+    }
+    cli_print_stats(log, "Quality after ", &after);
+    if (measured)
+        cli_print_measures(log, "Measures after ", &mafter);
+    cli_ho_log(log, e->doc, "after", &ho_after);
+    if (cli_log_after(log, e->doc, q, e->worst, &after, res, &worst,
                       &worst_free) != 0) {
         code = CLI_EXIT_INTERNAL;
         goto out;
     }
+    free(q);
+    q = NULL;
     cli_guard guard = {0};
     cli_write_guard(&guard, 1);
     cli_file_stamp report_was;
@@ -85,6 +106,7 @@ int cli_smooth_end_run(const cli_smooth_opts *so, const cli_smooth_end *e,
     }
     cli_write_guard(&guard, 0);
 out:
+    free(q);
     free(worst.items);
     free(worst_free.items);
     return code;

@@ -13,8 +13,8 @@ long long cli_element_tag(const getme_doc *doc, int32_t e)
     return (long long)getme_doc_element_id(doc, e);
 }
 
-int cli_worst(getme_doc *doc, int32_t max_count, unsigned flags,
-              cli_worst_list *w)
+int cli_worst(getme_doc *doc, const double *q, int32_t max_count,
+              unsigned flags, cli_worst_list *w)
 {
     w->items = NULL;
     w->count = 0;
@@ -24,9 +24,8 @@ int cli_worst(getme_doc *doc, int32_t max_count, unsigned flags,
     if (!w->items)
         return -1;
     getme_mesh *mesh = getme_doc_mesh(doc);
-    if (getme_mesh_worst_elements(mesh, max_count, flags, w->items,
-                                  &w->count) !=
-        GETME_OK) {
+    if (getme_mesh_worst_elements_from(mesh, q, max_count, flags, w->items,
+                                       &w->count) != GETME_OK) {
         cli_error("%s: %s", getme_doc_path(doc), getme_mesh_error(mesh));
         free(w->items);
         w->items = NULL;
@@ -82,8 +81,8 @@ void cli_json_worst(FILE *f, const getme_doc *doc, const cli_worst_list *w)
    corner line, the warning when the worst elements have no free node, and
    with -v both worst lists.  The lists stay filled for the report (the
    caller frees them).  0, or -1 if out of memory. */
-int cli_log_after(const cli_log *log, getme_doc *doc, int32_t max_count,
-                  const getme_quality_stats *after,
+int cli_log_after(const cli_log *log, getme_doc *doc, const double *q,
+                  int32_t max_count, const getme_quality_stats *after,
                   const getme_result *res, cli_worst_list *worst,
                   cli_worst_list *worst_free)
 {
@@ -91,8 +90,8 @@ int cli_log_after(const cli_log *log, getme_doc *doc, int32_t max_count,
         cli_info(log, "Worst corner scaled Jacobian (hex, prism, pyramid, "
                       "quad): %.4f before, %.4f after",
                  res->corner_sj_initial, res->corner_sj);
-    if (cli_worst(doc, max_count, 0, worst) != 0 ||
-        cli_worst(doc, max_count, GETME_WORST_FREE_ONLY, worst_free) != 0)
+    if (cli_worst(doc, q, max_count, 0, worst) != 0 ||
+        cli_worst(doc, q, max_count, GETME_WORST_FREE_ONLY, worst_free) != 0)
         return -1;
     int fixed_worst = after->num_free > 0 && after->q_min < after->q_min_star;
     if (fixed_worst)

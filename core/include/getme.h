@@ -320,6 +320,20 @@ GETME_API getme_status getme_mesh_quality_stats(getme_mesh *mesh, int type,
 GETME_API getme_status getme_mesh_element_qualities(getme_mesh *mesh,
                                                     double *q);
 
+/*
+ * getme_mesh_quality_stats() from the caller's qualities q (num_elements
+ * doubles, element order, as getme_mesh_element_qualities() or
+ * getme_mesh_measure_all_qualities() give them for the mesh's current
+ * coordinates): no element is evaluated again, so one array serves the
+ * statistics of every type, the measures and the worst lists.  q values
+ * <= 0 (or NaN) count as invalid.  GETME_ERR_ARGUMENT for a NULL argument
+ * (q may be NULL for a mesh without elements) or a type outside -1..5.
+ */
+GETME_API getme_status getme_mesh_quality_stats_from(getme_mesh *mesh,
+                                                     const double *q,
+                                                     int type,
+                                                     getme_quality_stats *stats);
+
 /* ---- the worst elements and why they stay bad -------------------------- */
 
 typedef enum getme_worst_reason {
@@ -364,6 +378,18 @@ GETME_API getme_status getme_mesh_worst_elements(getme_mesh *mesh,
                                                  unsigned flags,
                                                  getme_worst_element *out,
                                                  int32_t *count);
+
+/*
+ * getme_mesh_worst_elements() ranking the caller's qualities q
+ * (num_elements doubles, as for getme_mesh_quality_stats_from()) instead of
+ * evaluating every element again; the reasons are probed for the listed
+ * elements only.  The same list and reasons when q holds the mesh's
+ * qualities.  GETME_ERR_ARGUMENT as getme_mesh_worst_elements(), or q NULL
+ * for a mesh with elements and max_count > 0.
+ */
+GETME_API getme_status getme_mesh_worst_elements_from(
+    getme_mesh *mesh, const double *q, int32_t max_count, unsigned flags,
+    getme_worst_element *out, int32_t *count);
 
 /* A static English description of a reason ("all nodes fixed", ...). */
 GETME_API const char *getme_worst_reason_string(getme_worst_reason reason);
@@ -488,10 +514,23 @@ GETME_API getme_status getme_mesh_measure_stats(getme_mesh *mesh, int type,
  * GETME_NUM_MEASURES + measure] (GETME_NUM_TYPES * GETME_NUM_MEASURES
  * entries) as getme_mesh_measure_stats(mesh, type, measure) gives them,
  * num_elements 0 for absent types and undefined measures.  One pass over
- * the elements per measure.
+ * the elements for all measures (each element's nodes gathered once);
+ * bit-identical for any thread count (the means' sums in element order).
  */
 GETME_API getme_status getme_mesh_measure_all(getme_mesh *mesh,
                                               getme_measure_stats *stats);
+
+/*
+ * getme_mesh_measure_all(), and every element's mean ratio (the
+ * MEAN_RATIO measure, bit for bit getme_mesh_element_qualities()) into q
+ * (num_elements doubles; NULL: not kept), from the same sweep: what
+ * getme_mesh_quality_stats_from() and getme_mesh_worst_elements_from()
+ * take, so a caller needing all three evaluates each element once.
+ * Bit-identical for any thread count.  GETME_ERR_ARGUMENT if mesh or stats
+ * is NULL, GETME_ERR_NOMEM.
+ */
+GETME_API getme_status getme_mesh_measure_all_qualities(
+    getme_mesh *mesh, getme_measure_stats *stats, double *q);
 
 /*
  * One line summarising the measures of one element type, for logs:

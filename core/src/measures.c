@@ -13,6 +13,7 @@
 #include "internal.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -729,38 +730,64 @@ KERNEL double end_lane(const dihedral_ends *d, const double (*x)[L], int k,
                   v3_lane(x, e[2], l), v3_lane(x, e[3], l), u, v);
 }
 
-/* dihedral3 of the lanes, in degrees as measure() gives them. */
+/* |u x v| and u . v of the lanes, angle_between's atan2 arguments (its
+   operations in its order) */
+static void atan2_args_lanes(double (*u)[L], double (*v)[L],
+                             double *y, double *x)
+{
+#pragma omp simd
+    for (int l = 0; l < L; l++) {
+        double cx = u[1][l] * v[2][l] - u[2][l] * v[1][l];
+        double cy = u[2][l] * v[0][l] - u[0][l] * v[2][l];
+        double cz = u[0][l] * v[1][l] - u[1][l] * v[0][l];
+        y[l] = sqrt(cx * cx + cy * cy + cz * cz);
+        x[l] = u[0][l] * v[0][l] + u[1][l] * v[1][l] + u[2][l] * v[2][l];
+    }
+}
+
+/* dihedral3 of the lanes, in degrees as measure() gives them.  The
+   extreme ends' u and v are kept in the lanes as they are ranked (no end
+   evaluated twice) and only the two atan2 per element are scalar. */
 static void dihedral_lanes(const dihedral_ends *d, const double (*x)[L],
                            double *lo, double *hi)
 {
     double cmin[L], cmax[L];
-    int kmin[L], kmax[L];
+    /* u, v of the largest and of the smallest cosine so far; 0 while no
+       end is ranked (NaN cosines), as dihedral3 has it */
+    double ua[3][L] = {{0}}, va[3][L] = {{0}}, ui[3][L] = {{0}},
+           vi[3][L] = {{0}};
     for (int l = 0; l < L; l++)
-        cmin[l] = INFINITY, cmax[l] = -INFINITY, kmin[l] = kmax[l] = -1;
+        cmin[l] = INFINITY, cmax[l] = -INFINITY;
     for (int k = 0; k < d->n; k++) {
 #pragma omp simd
         for (int l = 0; l < L; l++) {
             v3 u, v;
             double cs = end_lane(d, x, k, l, &u, &v);
             int up = cs > cmax[l], down = cs < cmin[l];
+            /* the selects written out: through a helper taking the
+               arrays, gcc 12 left this loop scalar (2x slower sweep) */
             cmax[l] = up ? cs : cmax[l];
-            kmax[l] = up ? k : kmax[l];
+            ua[0][l] = up ? u.x : ua[0][l];
+            ua[1][l] = up ? u.y : ua[1][l];
+            ua[2][l] = up ? u.z : ua[2][l];
+            va[0][l] = up ? v.x : va[0][l];
+            va[1][l] = up ? v.y : va[1][l];
+            va[2][l] = up ? v.z : va[2][l];
             cmin[l] = down ? cs : cmin[l];
-            kmin[l] = down ? k : kmin[l];
+            ui[0][l] = down ? u.x : ui[0][l];
+            ui[1][l] = down ? u.y : ui[1][l];
+            ui[2][l] = down ? u.z : ui[2][l];
+            vi[0][l] = down ? v.x : vi[0][l];
+            vi[1][l] = down ? v.y : vi[1][l];
+            vi[2][l] = down ? v.z : vi[2][l];
         }
     }
+    double ylo[L], xlo[L], yhi[L], xhi[L];
+    atan2_args_lanes(ua, va, ylo, xlo);
+    atan2_args_lanes(ui, vi, yhi, xhi);
     for (int l = 0; l < L; l++) {
-        /* no end ranked (NaN cosines): u = v = 0, as dihedral3 has it */
-        v3 u = {0, 0, 0}, v = {0, 0, 0};
-        if (kmax[l] >= 0)
-            end_lane(d, x, kmax[l], l, &u, &v);
-        lo[l] = angle_between((double[3]){u.x, u.y, u.z},
-                              (double[3]){v.x, v.y, v.z}) * RAD2DEG;
-        u = v = (v3){0, 0, 0};
-        if (kmin[l] >= 0)
-            end_lane(d, x, kmin[l], l, &u, &v);
-        hi[l] = angle_between((double[3]){u.x, u.y, u.z},
-                              (double[3]){v.x, v.y, v.z}) * RAD2DEG;
+        lo[l] = atan2(ylo[l], xlo[l]) * RAD2DEG;
+        hi[l] = atan2(yhi[l], xhi[l]) * RAD2DEG;
     }
 }
 
@@ -913,12 +940,17 @@ static void measure_group(const getme_mesh *mesh, const getme_block *bl,
                           int32_t e, int32_t n, double ysign,
                           const dihedral_ends *de, double *v)
 {
-    double x[3 * GETME_MAX_NV][L], xe[3 * GETME_MAX_NV];
+    double x[3 * GETME_MAX_NV][L];
     int nv = getme__nv[bl->type];
+    /* straight into the lanes (getme__gather_local's values) */
     for (int l = 0; l < L; l++) {
-        getme__gather_local(mesh, bl, e + (l < n ? l : n - 1), ysign, xe);
-        for (int i = 0; i < 3 * nv; i++)
-            x[i][l] = xe[i];
+        const int32_t *c = bl->conn + (int64_t)(e + (l < n ? l : n - 1)) * nv;
+        for (int i = 0; i < nv; i++) {
+            const double *p = mesh->coords + 3 * (int64_t)c[i];
+            x[3 * i][l] = p[0];
+            x[3 * i + 1][l] = ysign * p[1];
+            x[3 * i + 2][l] = p[2];
+        }
     }
     if (n == L) {
         measures3_lanes(bl->type, de, (const double(*)[L])x, v);
@@ -930,8 +962,10 @@ static void measure_group(const getme_mesh *mesh, const getme_block *bl,
 }
 
 /* Elements per tile of getme_mesh_measure_all: the tile's values of every
-   measure (6 doubles per element, 1.5 MiB) are computed in parallel, then
-   reduced serially in element order. */
+   measure (6 doubles per element, 1.5 MiB) are computed in parallel, each
+   thread reducing its contiguous part at once (counts, extremes,
+   histograms: exact, merged in thread order), then the sums of the means
+   are added serially in element order. */
 enum { MEASURE_TILE = 32768 };
 
 /* Every measure of element e of block bl into v[GETME_NUM_MEASURES] (NaN
@@ -957,21 +991,125 @@ static void element_measures(const getme_mesh *mesh, const getme_block *bl,
     }
 }
 
-/* All measures in one sweep over the elements instead of one per measure:
-   the gather of an element's nodes (random access into the coordinates
-   in the caller's order) is most of the cost, so it is done once.  The
-   values and their reduction, in element order per (type, measure), are
-   the same as getme_mesh_measure_stats() gives one measure at a time. */
-getme_status getme_mesh_measure_all(getme_mesh *mesh,
-                                    getme_measure_stats *stats)
+/* How many groups of GETME_LANES elements ahead the 3-D sweep prefetches
+   the nodes (the caller's element order can be unrelated to its node
+   order). */
+enum { PREFETCH_GROUPS = 2 };
+
+/* Prefetch the nodes of the GETME_LANES elements from e of block bl.  The
+   empty asm keeps the compiler from vectorising the loop, which drops
+   the prefetches (gcc 12 did, through getme__prefetch_local's loop: the
+   nodes were loaded on demand, a quarter of the sweep waiting on them). */
+static inline void prefetch_group(const getme_mesh *mesh,
+                                  const getme_block *bl, int32_t e)
+{
+#if defined(__GNUC__)
+    if (e >= bl->count)
+        return;
+    int nv = getme__nv[bl->type];
+    int32_t n = bl->count - e < L ? bl->count - e : L;
+    const int32_t *c = bl->conn + (int64_t)e * nv;
+    for (int32_t k = 0; k < n * nv; k++) {
+        __builtin_prefetch(mesh->coords + 3 * (int64_t)c[k]);
+        __asm__ volatile("" ::: "memory");
+    }
+#else
+    (void)mesh, (void)bl, (void)e;
+#endif
+}
+
+/* add_stat without the sum: what a thread's part of a tile can reduce in
+   any order of threads (count, first extreme, histogram). */
+static void add_part(getme_measure_stats *s, double v, int32_t e)
+{
+    double sum = 0.0;
+    add_stat(s, v, e, &sum);
+}
+
+/* Add p, the statistics of elements after those of s, into s (first
+   extremes win ties: the serial sweep's min_element and max_element). */
+static void merge_part(getme_measure_stats *s, const getme_measure_stats *p)
+{
+    if (!p->num_elements)
+        return;
+    if (s->num_elements == 0 || p->min < s->min) {
+        s->min = p->min;
+        s->min_element = p->min_element;
+    }
+    if (s->num_elements == 0 || p->max > s->max) {
+        s->max = p->max;
+        s->max_element = p->max_element;
+    }
+    s->num_elements += p->num_elements;
+    s->num_negative += p->num_negative;
+    s->num_below += p->num_below;
+    for (int b = 0; b < GETME_HIST_BINS; b++)
+        s->histogram[b] += p->histogram[b];
+}
+
+/* The measures of n elements from e0 of block bl into v (n *
+   GETME_NUM_MEASURES), their mean ratios into q + bl->first + e0 if q,
+   and each thread's reduction into part[thread * GETME_NUM_MEASURES...]. */
+static void tile_measures(const getme_mesh *mesh, const getme_block *bl,
+                          int32_t e0, int32_t n, double ysign,
+                          const dihedral_ends *de, const uint8_t *defined,
+                          double *v, double *q, getme_measure_stats *part,
+                          int nt)
+{
+    int dim3 = getme_type_dim((getme_elem_type)bl->type) == 3;
+    int32_t step = dim3 ? L : 1;
+    /* also the parts of threads the runtime does not start */
+    for (int k = 0; k < nt * GETME_NUM_MEASURES; k++)
+        init_stats(&part[k], k % GETME_NUM_MEASURES);
+#pragma omp parallel num_threads(nt)
+    {
+        getme_measure_stats p[GETME_NUM_MEASURES];
+        for (int m = 0; m < GETME_NUM_MEASURES; m++)
+            init_stats(&p[m], m);
+        /* static: thread k's groups come before thread k + 1's */
+#pragma omp for schedule(static)
+        for (int32_t i = 0; i < n; i += step) {
+            int32_t k = n - i < step ? n - i : step;
+            double *vi = v + (int64_t)i * GETME_NUM_MEASURES;
+            if (dim3) {
+                prefetch_group(mesh, bl, e0 + i + PREFETCH_GROUPS * L);
+                measure_group(mesh, bl, e0 + i, k, ysign, de, vi);
+            } else {
+                getme__prefetch_local(mesh, bl, e0 + i + GETME_PREFETCH_AHEAD);
+                element_measures(mesh, bl, e0 + i, ysign, de, defined, vi);
+            }
+            int32_t g = bl->first + e0 + i;
+            for (int32_t j = 0; j < k; j++) {
+                const double *vj = vi + j * GETME_NUM_MEASURES;
+                if (q)
+                    q[g + j] = vj[GETME_MEASURE_MEAN_RATIO];
+                for (int m = 0; m < GETME_NUM_MEASURES; m++)
+                    if (!isnan(vj[m]))
+                        add_part(&p[m], vj[m], g + j);
+            }
+        }
+        memcpy(part + (int64_t)omp_get_thread_num() * GETME_NUM_MEASURES, p,
+               sizeof p);
+    }
+}
+
+getme_status getme_mesh_measure_all_qualities(getme_mesh *mesh,
+                                              getme_measure_stats *stats,
+                                              double *q)
 {
     if (!mesh || !stats)
         return GETME_ERR_ARGUMENT;
     for (int k = 0; k < GETME_NUM_TYPES * GETME_NUM_MEASURES; k++)
         init_stats(&stats[k], k % GETME_NUM_MEASURES);
+    int nt = omp_get_max_threads();
     double *v = malloc((size_t)MEASURE_TILE * GETME_NUM_MEASURES * sizeof *v);
-    if (!v)
+    getme_measure_stats *part =
+        malloc((size_t)nt * GETME_NUM_MEASURES * sizeof *part);
+    if (!v || !part) {
+        free(v);
+        free(part);
         return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
+    }
     if (mesh->mirror < 0)
         getme__detect_orientation(mesh);
     double ysign = mesh->mirror == 1 ? -1.0 : 1.0;
@@ -986,37 +1124,24 @@ getme_status getme_mesh_measure_all(getme_mesh *mesh,
         for (int m = 0; m < GETME_NUM_MEASURES; m++)
             defined[m] = (uint8_t)getme_measure_defined((getme_elem_type)t,
                                                         (getme_measure)m);
+        getme_measure_stats *s = stats + t * GETME_NUM_MEASURES;
+        double *st = sum[t];
         for (int32_t e0 = 0; e0 < bl->count; e0 += MEASURE_TILE) {
             int32_t n = bl->count - e0 < MEASURE_TILE ? bl->count - e0
                                                        : MEASURE_TILE;
-            if (getme_type_dim((getme_elem_type)t) == 3) {
-#pragma omp parallel for schedule(static)
-                for (int32_t i = 0; i < n; i += L) {
-                    for (int32_t k = 0; k < L; k++)
-                        getme__prefetch_local(mesh, bl, e0 + i + L + k);
-                    measure_group(mesh, bl, e0 + i, n - i < L ? n - i : L,
-                                  ysign, &de,
-                                  v + (int64_t)i * GETME_NUM_MEASURES);
-                }
-            } else {
-#pragma omp parallel for schedule(static)
-                for (int32_t i = 0; i < n; i++) {
-                    getme__prefetch_local(mesh, bl,
-                                          e0 + i + GETME_PREFETCH_AHEAD);
-                    element_measures(mesh, bl, e0 + i, ysign, &de, defined,
-                                     v + (int64_t)i * GETME_NUM_MEASURES);
-                }
+            tile_measures(mesh, bl, e0, n, ysign, &de, defined, v, q, part,
+                          nt);
+            for (int k = 0; k < nt; k++)
+                for (int m = 0; m < GETME_NUM_MEASURES; m++)
+                    merge_part(&s[m], &part[k * GETME_NUM_MEASURES + m]);
+            /* the sums in element order, as one serial sweep adds them
+               (six independent chains) */
+            for (int32_t i = 0; i < n; i++) {
+                const double *vi = v + (int64_t)i * GETME_NUM_MEASURES;
+                for (int m = 0; m < GETME_NUM_MEASURES; m++)
+                    if (!isnan(vi[m]))
+                        st[m] += vi[m];
             }
-            /* Each measure's statistics are reduced in element order by
-               one thread: the same sums as a serial sweep. */
-            getme_measure_stats *s = stats + t * GETME_NUM_MEASURES;
-#pragma omp parallel for schedule(static, 1)
-            for (int m = 0; m < GETME_NUM_MEASURES; m++)
-                for (int32_t i = 0; i < n; i++) {
-                    double vi = v[(int64_t)i * GETME_NUM_MEASURES + m];
-                    if (!isnan(vi))
-                        add_stat(&s[m], vi, bl->first + e0 + i, &sum[t][m]);
-                }
         }
     }
     for (int t = 0; t < GETME_NUM_TYPES; t++)
@@ -1026,7 +1151,14 @@ getme_status getme_mesh_measure_all(getme_mesh *mesh,
                 s->mean = sum[t][m] / (double)s->num_elements;
         }
     free(v);
+    free(part);
     return GETME_OK;
+}
+
+getme_status getme_mesh_measure_all(getme_mesh *mesh,
+                                    getme_measure_stats *stats)
+{
+    return getme_mesh_measure_all_qualities(mesh, stats, NULL);
 }
 
 int getme_measure_summary(getme_elem_type type,

@@ -56,37 +56,68 @@ static void keep_worst(getme_worst_element *w, int32_t *n, int32_t max,
     w[i].element = e;
 }
 
-/* The elements of block bl with a marked node, in element order, at
-   list + at (count them first with list = NULL); each thread takes a
-   contiguous range (off[k]: thread k's first position, counted by the
-   first call).  Returns how many. */
-static int32_t marked(const getme_block *bl, const uint8_t *mark,
-                      int32_t *list, int32_t *off, int nt)
+/* One thread's elements with a marked node, in element order. */
+typedef struct hits {
+    int32_t *e;
+    int32_t n, cap;
+    int failed;
+} hits;
+
+static void hits_push(hits *h, int32_t e)
+{
+    if (h->n == h->cap) {
+        int32_t cap = h->cap ? 2 * h->cap : 256;
+        int32_t *grown =
+            h->failed ? NULL : realloc(h->e, (size_t)cap * sizeof *grown);
+        if (!grown) {
+            h->failed = 1;
+            return;
+        }
+        h->e = grown, h->cap = cap;
+    }
+    h->e[h->n++] = e;
+}
+
+/* The elements of block bl with a marked node, appended to *list (*m of
+   them) in element order, in one parallel scan: each thread keeps the
+   hits of its contiguous range (few: the elements around a few nodes),
+   appended in thread order.  0, or -1 if out of memory. */
+static int marked(const getme_block *bl, const uint8_t *mark, hits *part,
+                  int nt, int32_t **list, int32_t *m)
 {
     int nv = getme__nv[bl->type];
+    for (int k = 0; k < nt; k++)
+        part[k].n = 0; /* also for a thread the runtime does not start */
 #pragma omp parallel num_threads(nt)
     {
-        int k = omp_get_thread_num();
-        int32_t at = list ? off[k] : 0;
+        hits h = part[omp_get_thread_num()];
 #pragma omp for schedule(static)
         for (int32_t e = 0; e < bl->count; e++) {
             const int32_t *c = bl->conn + (int64_t)e * nv;
             int hit = 0;
             for (int i = 0; i < nv; i++)
                 hit |= mark[c[i]];
-            if (hit && list)
-                list[at] = bl->first + e;
-            at += hit;
+            if (hit)
+                hits_push(&h, bl->first + e);
         }
-        if (!list)
-            off[k + 1] = at;
+        part[omp_get_thread_num()] = h;
     }
-    if (list)
-        return off[nt];
-    off[0] = 0;
-    for (int k = 0; k < nt; k++)
-        off[k + 1] += off[k];
-    return off[nt];
+    int32_t add = 0;
+    for (int k = 0; k < nt; k++) {
+        if (part[k].failed)
+            return -1;
+        add += part[k].n;
+    }
+    int32_t *grown = realloc(*list, ((size_t)*m + add + 1) * sizeof *grown);
+    if (!grown)
+        return -1;
+    *list = grown;
+    for (int k = 0; k < nt; k++) {
+        if (part[k].n)
+            memcpy(grown + *m, part[k].e, (size_t)part[k].n * sizeof *grown);
+        *m += part[k].n;
+    }
+    return 0;
 }
 
 /* The elements around the free nodes of the n reported elements, found in
@@ -98,7 +129,7 @@ static getme_status candidates(const getme_mesh *mesh,
 {
     int nt = omp_get_max_threads();
     uint8_t *mark = calloc((size_t)mesh->num_nodes, 1);
-    int32_t *off = calloc((size_t)nt + 1, sizeof *off);
+    hits *part = calloc((size_t)nt, sizeof *part);
     int32_t *list = malloc(sizeof *list), m = 0;
     for (int32_t i = 0; mark && i < n; i++) {
         int t;
@@ -106,24 +137,17 @@ static getme_status candidates(const getme_mesh *mesh,
         for (int j = 0; j < getme__nv[t]; j++)
             mark[c[j]] = !mesh->fixed[c[j]];
     }
-    for (int b = 0; b < mesh->num_blocks && mark && off && list; b++) {
-        const getme_block *bl = &mesh->blocks[b];
-        int32_t add = marked(bl, mark, NULL, off, nt);
-        int32_t *grown = realloc(list, ((size_t)m + add + 1) * sizeof *list);
-        if (!grown) {
-            free(list);
-            list = NULL;
-            break;
-        }
-        list = grown;
-        m += marked(bl, mark, list + m, off, nt);
-    }
-    if (!mark || !off) {
+    int ok = mark && part && list;
+    for (int b = 0; b < mesh->num_blocks && ok; b++)
+        ok = marked(&mesh->blocks[b], mark, part, nt, &list, &m) == 0;
+    if (!ok) {
         free(list);
         list = NULL;
     }
+    for (int k = 0; part && k < nt; k++)
+        free(part[k].e);
     free(mark);
-    free(off);
+    free(part);
     *cand = list, *num = m;
     return list ? GETME_OK : GETME_ERR_NOMEM;
 }
@@ -196,9 +220,13 @@ static getme_status worst_sweep(const getme_mesh *mesh, const double *q,
             getme_worst_element *w = part + (int64_t)k * max;
 #pragma omp for schedule(static)
             for (int32_t e = 0; e < bl->count; e++) {
+                double qe = q[bl->first + e];
+                /* keep_worst's own test first: most elements fail it,
+                   and then need not have their nodes' flags read */
+                if (cnt[k] == max && !(qe < w[max - 1].quality))
+                    continue;
                 if (!free_only || getme__local_has_free(mesh, bl, e))
-                    keep_worst(w, &cnt[k], max, q[bl->first + e],
-                               bl->first + e);
+                    keep_worst(w, &cnt[k], max, qe, bl->first + e);
             }
         }
         for (int k = 0; k < nt; k++)
@@ -225,14 +253,29 @@ getme_status getme_mesh_worst_elements(getme_mesh *mesh, int32_t max_count,
     if (!q)
         return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
     getme_mesh_element_qualities(mesh, q);
+    getme_status st =
+        getme_mesh_worst_elements_from(mesh, q, max_count, flags, out, count);
+    free(q);
+    return st;
+}
+
+getme_status getme_mesh_worst_elements_from(getme_mesh *mesh, const double *q,
+                                            int32_t max_count, unsigned flags,
+                                            getme_worst_element *out,
+                                            int32_t *count)
+{
+    if (!mesh || max_count < 0 || (!out && max_count > 0) || !count ||
+        (!q && max_count > 0 && mesh->num_elements))
+        return GETME_ERR_ARGUMENT;
+    *count = 0;
+    if (max_count == 0 || mesh->num_elements == 0)
+        return GETME_OK;
+    if (mesh->mirror < 0)
+        getme__detect_orientation(mesh); /* the probes' patches need it */
     int32_t n = 0;
     if (worst_sweep(mesh, q, flags & GETME_WORST_FREE_ONLY, max_count, out,
-                    &n) != GETME_OK) {
-        free(q);
+                    &n) != GETME_OK)
         return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
-    }
-    free(q);
-
     getme_patch p;
     int32_t *cand = NULL, num = 0;
     if (candidates(mesh, out, n, &cand, &num) != GETME_OK ||
