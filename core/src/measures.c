@@ -597,7 +597,7 @@ static void block_values(getme_mesh *mesh, int type, int m, double *v,
                 continue;
             }
             double x[3 * GETME_MAX_NV];
-            getme__prefetch_local(mesh, bl, e + GETME_PREFETCH_AHEAD);
+            getme__prefetch_local(mesh, bl, e + GETME_PREFETCH_AHEAD, 1);
             getme__gather_local(mesh, bl, e, ysign, x);
             v[g] = measure(bl->type, m, x, &de, v_max ? v_max + g : NULL);
         }
@@ -996,28 +996,6 @@ static void element_measures(const getme_mesh *mesh, const getme_block *bl,
    order). */
 enum { PREFETCH_GROUPS = 2 };
 
-/* Prefetch the nodes of the GETME_LANES elements from e of block bl.  The
-   empty asm keeps the compiler from vectorising the loop, which drops
-   the prefetches (gcc 12 did, through getme__prefetch_local's loop: the
-   nodes were loaded on demand, a quarter of the sweep waiting on them). */
-static inline void prefetch_group(const getme_mesh *mesh,
-                                  const getme_block *bl, int32_t e)
-{
-#if defined(__GNUC__)
-    if (e >= bl->count)
-        return;
-    int nv = getme__nv[bl->type];
-    int32_t n = bl->count - e < L ? bl->count - e : L;
-    const int32_t *c = bl->conn + (int64_t)e * nv;
-    for (int32_t k = 0; k < n * nv; k++) {
-        __builtin_prefetch(mesh->coords + 3 * (int64_t)c[k]);
-        __asm__ volatile("" ::: "memory");
-    }
-#else
-    (void)mesh, (void)bl, (void)e;
-#endif
-}
-
 /* add_stat without the sum: what a thread's part of a tile can reduce in
    any order of threads (count, first extreme, histogram). */
 static void add_part(getme_measure_stats *s, double v, int32_t e)
@@ -1072,10 +1050,10 @@ static void tile_measures(const getme_mesh *mesh, const getme_block *bl,
             int32_t k = n - i < step ? n - i : step;
             double *vi = v + (int64_t)i * GETME_NUM_MEASURES;
             if (dim3) {
-                prefetch_group(mesh, bl, e0 + i + PREFETCH_GROUPS * L);
+                getme__prefetch_local(mesh, bl, e0 + i + PREFETCH_GROUPS * L, L);
                 measure_group(mesh, bl, e0 + i, k, ysign, de, vi);
             } else {
-                getme__prefetch_local(mesh, bl, e0 + i + GETME_PREFETCH_AHEAD);
+                getme__prefetch_local(mesh, bl, e0 + i + GETME_PREFETCH_AHEAD, 1);
                 element_measures(mesh, bl, e0 + i, ysign, de, defined, vi);
             }
             int32_t g = bl->first + e0 + i;

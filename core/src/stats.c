@@ -24,7 +24,7 @@ static inline double elem_quality(const getme_mesh *mesh,
                                   double ysign)
 {
     double x[3 * GETME_MAX_NV];
-    getme__prefetch_local(mesh, bl, e + GETME_PREFETCH_AHEAD);
+    getme__prefetch_local(mesh, bl, e + GETME_PREFETCH_AHEAD, 1);
     getme__gather_local(mesh, bl, e, ysign, x);
     return getme__quality(bl->type, x);
 }
