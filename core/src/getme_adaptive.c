@@ -181,13 +181,10 @@ weights_3d(int t, const getme_run *run, int32_t e0, int32_t e1,
             kind[e - c0] = (uint8_t)k;
             if (k != 1)
                 continue;
-            const int32_t *c = getme__ws_nodes(ws, t, e);
-            const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
-            for (int j = 0; j < ned; j++) {
-                int32_t id = getme__adj_edge(adj, c, t, j, slot[j]);
-                eid[e - c0][j] = id;
-                __builtin_prefetch(adj->esum + id, 0, 3);
-            }
+            getme__adj_edge_ids(adj, getme__ws_nodes(ws, t, e), t,
+                                getme__adj_slots(adj, ws, t, e), eid[e - c0]);
+            for (int j = 0; j < ned; j++)
+                __builtin_prefetch(adj->esum + eid[e - c0][j], 0, 3);
             const int32_t *f = getme__adj_faces(adj, ws, t, e);
             for (int j = 0; j < nf; j++)
                 __builtin_prefetch(q + f[j], 0, 3);
