@@ -186,14 +186,16 @@ weights_3d(int t, const getme_run *run, int32_t e0, int32_t e1,
             for (int j = 0; j < ned; j++)
                 __builtin_prefetch(adj->esum + eid[e - c0][j], 0, 3);
             const int32_t *f = getme__adj_faces(adj, ws, t, e);
-            for (int j = 0; j < nf; j++)
-                __builtin_prefetch(q + f[j], 0, 3);
+            for (int j = 0; j < nf; j++) /* no neighbour (-1): e itself */
+                __builtin_prefetch(q + (f[j] >= 0 ? f[j] : e), 0, 3);
         }
         /* the sums (loads now mostly cached), then the divisions and
-           square roots of the chunk in vector instructions */
+           square roots of the chunk in vector instructions (the same
+           correctly rounded operations as one at a time) */
         double num[WEIGHT_CHUNK], den[WEIGHT_CHUNK];
+        for (int i = 0; i < WEIGHT_CHUNK; i++)
+            num[i] = 0.0, den[i] = 1.0;
         for (int32_t e = c0; e < c1; e++) {
-            num[e - c0] = 0.0, den[e - c0] = 1.0;
             if (kind[e - c0] != 1)
                 continue;
             const uint16_t *lc = getme__blocks_lnodes(blk, ws, t, e);
@@ -268,10 +270,9 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
     /* The weights first, in a loop of loads with little arithmetic, so the
        out-of-order core keeps the scattered ones (face neighbours' q, S_e)
        of several elements in flight; -1 marks an element not transformed
-       (a weight is >= 0).  No software prefetch: since the blocks run in
-       element order (block_local.h) their data is mostly in cache, and the
-       prefetches' own address loads (eptr, fnb 8 elements ahead) cost
-       14 % of the scatter (perf, 1M tets, one thread). */
+       (a weight is >= 0).  3-D: weights_3d, which prefetches from the edge
+       ids it computes anyway (a prefetch 8 elements ahead that loaded
+       eptr and fnb again only for it cost 14 % of the scatter). */
     int64_t *wfs = scr->wf;
     if (ws->dim == 3)
         weights_3d(t, run, e0, e1, ls, wfs);
