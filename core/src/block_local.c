@@ -179,12 +179,29 @@ static getme_status build_order(getme_blocks *blk, const getme_ws *ws,
                 part[n] = part[n] == -1 || part[n] == p ? p : -2;
             }
         }
+        /* A level's parts run side by side and end together, so a part
+           with more interior blocks than the least one keeps its excess
+           (its last ones) for the next level, or the colours: the thread
+           with the smaller part would wait for it (full tets, 2 threads:
+           423 against 273 blocks at level 1). */
+        int32_t least = INT32_MAX;
         for (int p = 0; p < np; p++) {
+            int32_t k0 = m;
             for (int32_t k = 0; k < ncur; k++)
-                if (bpart[cur[k]] == p && interior(blk, part, cur[k], p)) {
+                if (bpart[cur[k]] == p && interior(blk, part, cur[k], p))
                     blk->order[m++] = cur[k];
-                    left[cur[k]] = 0;
-                }
+            least = m - k0 < least ? m - k0 : least;
+            blk->part_ptr[l * np + p + 1] = m;
+        }
+        int32_t next = blk->part_ptr[l * np];
+        m = next;
+        for (int p = 0; p < np; p++) {
+            int32_t k0 = next;
+            next = blk->part_ptr[l * np + p + 1];
+            for (int32_t k = k0; k < k0 + least; k++) {
+                blk->order[m++] = blk->order[k];
+                left[blk->order[k]] = 0;
+            }
             blk->part_ptr[l * np + p + 1] = m;
         }
         int32_t n = 0;

@@ -147,6 +147,87 @@ static inline int add_untransformed(getme_run *run, int t, int32_t e)
     return ovf;
 }
 
+/* Elements per chunk of weights_3d. */
+#define WEIGHT_CHUNK 32
+
+/* The integer Eq. 9 weights wfs[e - e0] of the elements [e0, e1) of a
+   block of 3-D elements of type t (-1: not transformed), ls the S_v of
+   the block's nodes (block-local indices): the same integers as
+   getme__adj_nsum_sv gives, in two passes over chunks of WEIGHT_CHUNK
+   elements.  The first computes each regular element's edge ids and
+   prefetches their S_e and the face neighbours' q; the second sums them.
+   perf annotate: in one pass, the loads of S_e and of the face
+   neighbours' q stalled the sums (most of the block's time went to them),
+   and prefetching them needs the edge ids, which the first pass keeps. */
+__attribute__((always_inline)) static inline void
+weights_3d(int t, const getme_run *run, int32_t e0, int32_t e1,
+           const int64_t *ls, int64_t *wfs)
+{
+    const getme_ws *ws = run->ws;
+    const getme_adj *adj = run->adj;
+    const getme_blocks *blk = &adj->blk;
+    const double *q = run->q;
+    const int nv = getme__nv[t], ned = getme__edges[t].num_edges;
+    const int nf = getme__faces[t].num_faces;
+    const double qs = adj->qscale;
+    for (int32_t c0 = e0; c0 < e1; c0 += WEIGHT_CHUNK) {
+        int32_t c1 = c0 + WEIGHT_CHUNK < e1 ? c0 + WEIGHT_CHUNK : e1;
+        int32_t eid[WEIGHT_CHUNK][12];
+        uint8_t kind[WEIGHT_CHUNK]; /* 0 none, 1 regular, 2 irregular */
+        for (int32_t e = c0; e < c1; e++) {
+            int k = !(ws->free_elem[e] && getme__owned(run, e)) ? 0
+                  : adj->irregular[e]                            ? 2
+                                                                 : 1;
+            kind[e - c0] = (uint8_t)k;
+            if (k != 1)
+                continue;
+            getme__adj_edge_ids(adj, getme__ws_nodes(ws, t, e), t,
+                                getme__adj_slots(adj, ws, t, e), eid[e - c0]);
+            for (int j = 0; j < ned; j++)
+                __builtin_prefetch(adj->esum + eid[e - c0][j], 0, 3);
+            const int32_t *f = getme__adj_faces(adj, ws, t, e);
+            for (int j = 0; j < nf; j++) /* no neighbour (-1): e itself */
+                __builtin_prefetch(q + (f[j] >= 0 ? f[j] : e), 0, 3);
+        }
+        /* the sums (loads now mostly cached), then the divisions and
+           square roots of the chunk in vector instructions (the same
+           correctly rounded operations as one at a time) */
+        double num[WEIGHT_CHUNK], den[WEIGHT_CHUNK];
+        for (int i = 0; i < WEIGHT_CHUNK; i++)
+            num[i] = 0.0, den[i] = 1.0;
+        for (int32_t e = c0; e < c1; e++) {
+            if (kind[e - c0] != 1)
+                continue;
+            const uint16_t *lc = getme__blocks_lnodes(blk, ws, t, e);
+            const int32_t *f = getme__adj_faces(adj, ws, t, e);
+            uint64_t sv = 0, se = 0, sf = 0;
+            for (int i = 0; i < nv; i++)
+                sv += (uint64_t)ls[lc[i]];
+            for (int j = 0; j < ned; j++)
+                se += (uint64_t)adj->esum[eid[e - c0][j]];
+            for (int j = 0; j < nf; j++)
+                sf += f[j] >= 0 ? (uint64_t)getme__fx64(q[f[j]], qs) : 0;
+            uint64_t qe = (uint64_t)getme__fx64(q[e], qs);
+            /* getme__adj_nsum_sv's wrapping sum, term for term */
+            num[e - c0] = (double)(sv - se + (uint64_t)(nf - 1) * qe + sf) *
+                          adj->qinv;
+            den[e - c0] = (double)adj->count[e] * q[e];
+        }
+        int64_t wv[WEIGHT_CHUNK];
+        const double wscale = run->wscale;
+#pragma omp simd
+        for (int i = 0; i < WEIGHT_CHUNK; i++)
+            wv[i] = getme__fx64(sqrt(num[i] / den[i]), wscale);
+        for (int32_t e = c0; e < c1; e++) {
+            int k = kind[e - c0];
+            wfs[e - e0] = k == 1 ? wv[e - c0]
+                        : k == 2 ? getme__fx64(getme__weight_union(run, t, e),
+                                               run->wscale)
+                                 : -1;
+        }
+    }
+}
+
 /* The free elements of block b (all of type t, a constant in each copy,
    GETME_FOR_TYPE) transformed, in three steps on the block's own node
    list (block_local.h): copy its nodes' coordinates, S_v and fixed flags
@@ -189,29 +270,31 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
     /* The weights first, in a loop of loads with little arithmetic, so the
        out-of-order core keeps the scattered ones (face neighbours' q, S_e)
        of several elements in flight; -1 marks an element not transformed
-       (a weight is >= 0).  No software prefetch: since the blocks run in
-       element order (block_local.h) their data is mostly in cache, and the
-       prefetches' own address loads (eptr, fnb 8 elements ahead) cost
-       14 % of the scatter (perf, 1M tets, one thread). */
+       (a weight is >= 0).  3-D: weights_3d, which prefetches from the edge
+       ids it computes anyway (a prefetch 8 elements ahead that loaded
+       eptr and fnb again only for it cost 14 % of the scatter). */
     int64_t *wfs = scr->wf;
-    for (int32_t e = e0; e < e1; e++) {
-        int64_t wf = -1;
-        if (ws->free_elem[e] && getme__owned(run, e)) {
-            double w;
-            if (adj->irregular[e]) {
-                w = getme__weight_union(run, t, e);
-            } else {
-                const uint16_t *lc = getme__blocks_lnodes(blk, ws, t, e);
-                uint64_t sv = 0;
-                for (int i = 0; i < nv; i++)
-                    sv += (uint64_t)ls[lc[i]];
-                w = sqrt(getme__adj_nsum_sv(adj, ws, run->q, t, e, sv) /
-                         ((double)adj->count[e] * run->q[e]));
+    if (ws->dim == 3)
+        weights_3d(t, run, e0, e1, ls, wfs);
+    else
+        for (int32_t e = e0; e < e1; e++) {
+            int64_t wf = -1;
+            if (ws->free_elem[e] && getme__owned(run, e)) {
+                double w;
+                if (adj->irregular[e]) {
+                    w = getme__weight_union(run, t, e);
+                } else {
+                    const uint16_t *lc = getme__blocks_lnodes(blk, ws, t, e);
+                    uint64_t sv = 0;
+                    for (int i = 0; i < nv; i++)
+                        sv += (uint64_t)ls[lc[i]];
+                    w = sqrt(getme__adj_nsum_sv(adj, ws, run->q, t, e, sv) /
+                             ((double)adj->count[e] * run->q[e]));
+                }
+                wf = getme__fx64(w, run->wscale);
             }
-            wf = getme__fx64(w, run->wscale);
+            wfs[e - e0] = wf;
         }
-        wfs[e - e0] = wf;
-    }
     int o = 0;
     int32_t n = 0;
     if (t == GETME_TET || t == GETME_HEX) { /* GETME_LANES at a time */

@@ -60,6 +60,7 @@ static inline double trial_quality(const getme_run *run, int32_t e)
 /* run->q[e] = v, and in the q_mean stage (run->live) the element's S_v
    and S_e moved by the difference of its fixed-point qualities: exact
    integers, so the sums stay the bits a recomputation at run->q gives. */
+__attribute__((always_inline)) /* as getme__adj_add: LTO outlined it */
 static inline void set_q(getme_run *run, int t, int32_t e, double v)
 {
     getme_adj *adj = run->live;
