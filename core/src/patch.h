@@ -54,6 +54,17 @@ typedef struct getme_patch {
     double *qt;      /* scratch: trial qualities                          */
     const struct getme_ws *ws; /* finishing step: x is ws->x and ids are
                         workspace elements, checked at second-order nodes */
+    /* Trials move only the moving nodes, so during one climb or toward
+       call the other coordinates of every lane group are gathered once
+       (patch.c, lane_cache) and each trial writes just the moving ones:
+       per group of GETME_LANES elements its lane-major coordinates
+       (3 GETME_MAX_NV rows of GETME_LANES), NULL without memory. */
+    double *lx;
+    int8_t *lok;     /* per group: 1 if lx holds it (one type with lanes) */
+    int32_t *mpos;   /* the moving nodes' places in lx (their x row) ...  */
+    uint8_t *midx;   /* ... and which moving node each is                 */
+    int32_t nmpos;
+    int cached;      /* lx is current (inside a climb or toward call)     */
 } getme_patch;
 
 /* Room for cap elements; GETME_OK or GETME_ERR_NOMEM. */
