@@ -70,6 +70,8 @@ typedef struct getme_run {
     uint8_t *tflag;     /* ne: element is in tlist                          */
     double *qold;       /* q*_min stage: qualities of run->elems before the
                            relaxation step (NULL: sums are recomputed)      */
+    struct getme_tally *tally; /* q*_min stage: q_mean's exact sum, which
+                           update_after keeps (tally.h), or NULL            */
     int64_t cap_qold;
     /* GETMe's node sums in exact fixed point (exact.h, getme_adaptive.c):
        per node sum w x' (3) and sum w, zero between iterations. */

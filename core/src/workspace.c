@@ -4,6 +4,7 @@
  */
 #include "exact.h"
 #include "workspace.h"
+#include "tally.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -619,7 +620,7 @@ void getme__ws_qualities(const getme_ws *ws, double *q)
 
 /* Exact fixed-point sum (exact.h): the same bits for any thread count and
    any split of the elements; values in [-2, 2], n < 2^31 (its bound). */
-double getme__det_sum(const double *v, int32_t n, int nt)
+getme_ufx getme__det_sum_fx(const double *v, int32_t n, int nt)
 {
     getme_ufx s = 0;
     int32_t nb = (n + 4095) / 4096; /* getme__fx_q_sum over 4096 at a time */
@@ -634,7 +635,13 @@ double getme__det_sum(const double *v, int32_t n, int nt)
 #pragma omp critical(getme_det_sum)
         s += part;
     }
-    return getme__fx_double((getme_fx)s, GETME_FX_QINV);
+    return s;
+}
+
+double getme__det_sum(const double *v, int32_t n, int nt)
+{
+    return getme__fx_double((getme_fx)getme__det_sum_fx(v, n, nt),
+                            GETME_FX_QINV);
 }
 
 void getme__ws_summary(const getme_ws *ws, const double *q, double *q_mean,
