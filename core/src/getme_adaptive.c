@@ -677,8 +677,7 @@ static inline void order2(double *a, double *b)
     }
 }
 
-/* The k-th smallest of v[0..n) (v is permuted); deterministic. */
-static double select_kth(double *v, int32_t n, int32_t k)
+double getme__select_kth(double *v, int32_t n, int32_t k)
 {
     int32_t lo = 0, hi = n - 1;
     while (hi > lo) {
@@ -808,7 +807,7 @@ double getme__threshold(getme_run *run, double fraction, int32_t min_count)
     for (int32_t e = 0; e < ws->ne; e++)
         if (ws->free_elem[e] && (bits_of(run->q[e]) & mask) == prefix)
             cand[m++] = run->q[e];
-    double qt = select_kth(cand, m, (int32_t)k);
+    double qt = getme__select_kth(cand, m, (int32_t)k);
     free(cand);
     return qt;
 }

@@ -208,6 +208,10 @@ static inline int64_t getme__quantile_pos(int64_t n, double fraction,
     return pos >= (double)(n - 1) ? n - 1 : pos <= 0.0 ? 0 : (int64_t)pos;
 }
 
+/* The k-th smallest of v[0..n) (v is permuted); deterministic
+   (getme_adaptive.c). */
+double getme__select_kth(double *v, int32_t n, int32_t k);
+
 /* The quality at position fraction * n (at least min_count - 1, at most
    n - 1) of the sorted qualities of the free elements; 0 without free
    elements, -1 if out of memory (getme_adaptive.c). */
