@@ -359,7 +359,19 @@ static getme_status fill(getme_run *run, getme_patch *p, const int32_t *mv,
         }
     for (int32_t i = 0; i < p->n; i++)
         run->eflag[p->id[i]] &= (uint8_t)~1;
+    /* run->q is current (the smoothing keeps it so, store() too): no need
+       to evaluate the elements again */
+    getme__patch_eval_known(p, run->q);
+#ifdef GETME_CHECK_SUMS
+    double *q = malloc((size_t)(p->n ? p->n : 1) * sizeof *q);
+    if (!q)
+        return GETME_ERR_NOMEM;
+    memcpy(q, p->q, (size_t)p->n * sizeof *q);
     getme__patch_eval(p);
+    if (st == GETME_OK && memcmp(q, p->q, (size_t)p->n * sizeof *q) != 0)
+        st = GETME_ERR_STATE;
+    free(q);
+#endif
     return st;
 }
 

@@ -240,6 +240,29 @@ double getme__patch_eval(getme_patch *p)
     return m;
 }
 
+double getme__patch_eval_known(getme_patch *p, const double *known)
+{
+    if (p->ws && p->ws->ho)
+        return getme__patch_eval(p);
+    double m = INFINITY;
+    for (int32_t i0 = 0; i0 < p->n; i0 += GETME_LANES) {
+        int32_t n = p->n - i0 < GETME_LANES ? p->n - i0 : GETME_LANES;
+        int corners = 0;
+        for (int32_t l = 0; l < n; l++) {
+            p->sj[i0 + l] = 1.0;
+            corners |= p->guard && getme__has_corners(p->type[i0 + l]);
+        }
+        if (corners)
+            group_q(p, i0, n, p->q + i0, p->sj + i0);
+        else
+            for (int32_t l = 0; l < n; l++)
+                p->q[i0 + l] = known[p->id[i0 + l]];
+    }
+    for (int32_t i = 0; i < p->n; i++)
+        m = fmin(m, p->q[i]);
+    return m;
+}
+
 /* Trial qualities into p->qt at the moved coordinates.  Returns 1 if the
  * move is acceptable:
  *  - every element ends above cur, the patch's minimum, so the minimum
@@ -272,7 +295,7 @@ static int trial(getme_patch *p, double cur, const int32_t *mv)
             if (sj[l] < p->sj[i] && sj[l] < p->floor && p->guard)
                 return 0;
             p->qt[i] = q;
-            m = fmin(m, q);
+            m = q < m ? q : m; /* q > cur: not NaN (fmin was a call) */
             sum_new += q;
             sum_old += p->q[i];
         }
@@ -333,7 +356,7 @@ static double edge_scale(const getme_patch *p, const int32_t *mv, int k)
                 double v = *coord(p, a, d) - *coord(p, b, d);
                 s += v * v;
             }
-            l2 = fmin(l2, s);
+            l2 = s < l2 ? s : l2; /* fmin, inlined: l2 never NaN */
         }
     }
     return sqrt(l2);

@@ -83,6 +83,11 @@ getme_status getme__patch_add(getme_patch *p, int type, const int32_t *conn,
    patch's minimum quality. */
 double getme__patch_eval(getme_patch *p);
 
+/* The same, but the quality of an element of a first-order patch that
+   needs no corner is known[its id] (the finishing step: run->q holds those
+   bits already); lane groups with a guarded corner are computed. */
+double getme__patch_eval_known(getme_patch *p, const double *known);
+
 /*
  * Raise the patch minimum by moving the k nodes mv[] (free nodes the
  * caller chose; every patch element must contain at least one of them):
