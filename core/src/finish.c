@@ -656,6 +656,7 @@ getme_status getme__finish(getme_run *run)
     p.ws = ws;
     p.guard = run->guard;
     p.floor = run->corner_floor;
+    memcpy(p.skip_q, run->guard_skip_q, sizeof p.skip_q);
     /* no memo for second-order elements: their validity also reads the
        mid-edge nodes */
     climb_memo memo_store, *memo = NULL;

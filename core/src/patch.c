@@ -56,6 +56,8 @@ static getme_status grow(getme_patch *p, int32_t cap)
 getme_status getme__patch_init(getme_patch *p, int32_t cap)
 {
     memset(p, 0, sizeof *p);
+    for (int t = 0; t < GETME_NUM_TYPES; t++)
+        p->skip_q[t] = 2.0;
     return grow(p, cap > 64 ? cap : 64);
 }
 
@@ -90,7 +92,10 @@ static double elem_finish(const getme_patch *p, int32_t i, const double *x,
                           double q, double *sj)
 {
     int t = p->type[i];
-    if (p->guard && getme__has_corners(t))
+    /* a skipped corner stays 1: above the floor, like the true one, it
+       rejects nothing as a new corner, and as an old one the test is the
+       same (sj < floor implies sj < any old corner >= floor) */
+    if (p->guard && getme__has_corners(t) && !(q >= p->skip_q[t]))
         *sj = getme__corner_sj(t, x);
     if (q > 0.0 && p->ws && p->ws->ho && !getme__ho_valid(p->ws, p->x, p->id[i]))
         return 0.0; /* second order: det J > 0 at every node */
@@ -212,7 +217,9 @@ static void group_q(const getme_patch *p, int32_t i0, int32_t n, double *q,
             continue;
         }
         int t = p->type[i0 + l];
-        int more = (p->guard && getme__has_corners(t)) || (p->ws && p->ws->ho);
+        int more = (p->guard && getme__has_corners(t) &&
+                    !(ql[l] >= p->skip_q[t])) ||
+                   (p->ws && p->ws->ho);
         if (!more) {
             q[l] = ql[l];
             continue;
@@ -250,7 +257,9 @@ double getme__patch_eval_known(getme_patch *p, const double *known)
         int corners = 0;
         for (int32_t l = 0; l < n; l++) {
             p->sj[i0 + l] = 1.0;
-            corners |= p->guard && getme__has_corners(p->type[i0 + l]);
+            int t = p->type[i0 + l];
+            corners |= p->guard && getme__has_corners(t) &&
+                       !(known[p->id[i0 + l]] >= p->skip_q[t]);
         }
         if (corners)
             group_q(p, i0, n, p->q + i0, p->sj + i0);

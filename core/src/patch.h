@@ -35,6 +35,10 @@ typedef struct getme_patch {
     int guard;       /* corner guard on: a corner (getme__corner_sj) may
                         not end below min(its old value, floor)           */
     double floor;
+    double skip_q[GETME_NUM_TYPES]; /* per type, a quality from which on the
+                        worst corner is provably >= floor (getme_run's
+                        guard_skip_q), so it is not computed: it could
+                        not reject a move (2: always computed)            */
     double loss;     /* a move may lower the patch's total quality by at
                         most loss times the rise of its minimum ...        */
     double budget;   /* ... and by at most this: the total quality that
