@@ -103,15 +103,51 @@ getme_status getme__best_note(getme_best *b, const getme_run *run)
     return GETME_OK;
 }
 
-void getme__best_restore(getme_best *b, getme_ws *ws)
+/* After a log: the qualities of the elements around the nodes put back,
+   each once (run->eflag marks them). */
+static void rescore(const getme_best *b, getme_run *run)
 {
+    const getme_ws *ws = run->ws;
+    int32_t *done = run->elems; /* scratch here: the iterations are over */
+    int32_t m = 0;
+    for (int64_t k = 0; k < b->n; k++) {
+        int32_t v = b->node[k];
+        for (int32_t s = ws->star_ptr[v]; s < ws->star_ptr[v + 1]; s++) {
+            int32_t e = ws->star[s];
+            if (run->eflag[e])
+                continue;
+            run->eflag[e] = 1;
+            done[m++] = e;
+            run->q[e] = getme__ws_quality(ws, ws->x, e);
+        }
+    }
+    for (int32_t k = 0; k < m; k++)
+        run->eflag[done[k]] = 0;
+}
+
+getme_status getme__best_restore(getme_best *b, getme_run *run)
+{
+    getme_ws *ws = run->ws;
     if (b->whole) {
         memcpy(ws->x, b->whole, (size_t)ws->nn * 3 * sizeof *ws->x);
-        return;
+        getme__ws_qualities(ws, run->q);
+        return GETME_OK;
     }
     for (int64_t k = 0; k < b->n; k++)
         memcpy(ws->x + 3 * (int64_t)b->node[k], b->x + 3 * k,
                3 * sizeof *b->x);
+    rescore(b, run);
+#ifdef GETME_CHECK_SUMS
+    double *q = malloc((size_t)(ws->ne ? ws->ne : 1) * sizeof *q);
+    if (!q)
+        return GETME_ERR_NOMEM;
+    getme__ws_qualities(ws, q);
+    int same = memcmp(q, run->q, (size_t)ws->ne * sizeof *q) == 0;
+    free(q);
+    if (!same)
+        return GETME_ERR_STATE;
+#endif
+    return GETME_OK;
 }
 
 void getme__best_free(getme_best *b)

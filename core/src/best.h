@@ -42,8 +42,13 @@ void getme__best_take(getme_best *b, const getme_ws *ws);
    run->tlist's elements) not logged yet.  GETME_OK or GETME_ERR_NOMEM. */
 getme_status getme__best_note(getme_best *b, const getme_run *run);
 
-/* ws->x becomes the best coordinates. */
-void getme__best_restore(getme_best *b, getme_ws *ws);
+/* run->ws->x becomes the best coordinates and run->q their qualities:
+   after a log, those of the stars of the nodes put back (no other element
+   changed since the best iteration's qualities, which were current then),
+   after a whole copy every element's.  GETME_OK; GETME_CHECK_SUMS builds
+   compare with a recomputation of every element (GETME_ERR_STATE if they
+   differ, or GETME_ERR_NOMEM without room for the check). */
+getme_status getme__best_restore(getme_best *b, getme_run *run);
 
 void getme__best_free(getme_best *b);
 

@@ -31,6 +31,7 @@
  */
 #include "patch.h"
 #include "smooth_internal.h"
+#include "tally.h"
 
 #include <math.h>
 #include <omp.h>
@@ -186,6 +187,159 @@ static void forget_if(climb_memo **memo, int c)
     }
 }
 
+/*
+ * The pass's candidates without a sweep per pass.  A pass works on the few
+ * thousand free elements below the quality at position finish_fraction,
+ * but finding that bound (getme__threshold), the list and the summary took
+ * about seven sweeps over every element per pass (4M tets: ~25 ms on two
+ * threads, each pass).  Instead one sweep at the start keeps a pool: every
+ * free element with q <= top, top the quality at four times that position,
+ * and every element a kept move brings to q <= top later (store()).  So
+ * every free element outside the pool is above top, and as long as more
+ * than k + 1 pool elements are at or below it, the k-th smallest quality
+ * of the whole mesh is the k-th smallest of theirs, the pass's list is
+ * theirs below the bound, and q*_min is their minimum, all exactly what
+ * the sweeps give (GETME_CHECK_SUMS builds compare).  Otherwise the pool
+ * is built again.  q_mean comes from the exact running sum (tally.h).
+ * Membership is bit POOLED of run->eflag (fill() uses bit 0).
+ */
+#define POOLED 0x40
+
+typedef struct pool {
+    int32_t *e;
+    int32_t n;
+    int64_t cap;
+    double top;   /* every free element outside e has q > top */
+    int lost;     /* an element could not be added: build again */
+    double *v;    /* scratch: the pool's qualities */
+    int64_t cap_v;
+    getme_tally tally;
+} pool;
+
+static void pool_clear(getme_run *run, pool *pl)
+{
+    for (int32_t k = 0; k < pl->n; k++)
+        run->eflag[pl->e[k]] &= (uint8_t)~POOLED;
+    pl->n = 0;
+}
+
+static void pool_free(getme_run *run, pool *pl)
+{
+    pool_clear(run, pl);
+    free(pl->e);
+    free(pl->v);
+}
+
+/* Element e's quality became new (from old): the sum follows, and e joins
+   the pool if it is now at or below top. */
+static void pool_change(getme_run *run, pool *pl, int32_t e, double old,
+                        double new)
+{
+    getme__tally_change(&pl->tally, old, new);
+    if (new <= pl->top && !(run->eflag[e] & POOLED) && run->ws->free_elem[e]) {
+        if (getme__push_i32(&pl->e, &pl->n, &pl->cap, e))
+            pl->lost = 1;
+        else
+            run->eflag[e] |= POOLED;
+    }
+}
+
+/* The pool of the free elements with q <= top, top at position
+   4 fraction n (at least 4 min_count - 1).  GETME_OK or GETME_ERR_NOMEM. */
+static getme_status pool_build(getme_run *run, pool *pl, double fraction,
+                               int32_t min_count)
+{
+    const getme_ws *ws = run->ws;
+    pool_clear(run, pl);
+    pl->lost = 0;
+    pl->top = getme__threshold(run, fmin(1.0, 4.0 * fraction), 4 * min_count);
+    if (pl->top < 0.0)
+        return GETME_ERR_NOMEM;
+    for (int32_t e = 0; e < ws->ne; e++)
+        if (ws->free_elem[e] && run->q[e] <= pl->top) {
+            if (getme__push_i32(&pl->e, &pl->n, &pl->cap, e))
+                return GETME_ERR_NOMEM;
+            run->eflag[e] |= POOLED;
+        }
+    return GETME_OK;
+}
+
+/* The qualities of the pool at or below top into pl->v; their count, or
+   -1 if out of memory. */
+static int32_t pool_values(pool *pl, const double *q)
+{
+    if (pl->n > pl->cap_v) {
+        double *v = realloc(pl->v, (size_t)pl->n * 2 * sizeof *v);
+        if (!v)
+            return -1;
+        pl->v = v, pl->cap_v = 2 * (int64_t)pl->n;
+    }
+    int32_t m = 0;
+    for (int32_t k = 0; k < pl->n; k++)
+        if (q[pl->e[k]] <= pl->top)
+            pl->v[m++] = q[pl->e[k]];
+    return m;
+}
+
+/* getme__threshold(run, fraction, min_count) from the pool (built again
+   when it no longer holds the position); -1 if out of memory. */
+static double pool_bound(getme_run *run, pool *pl, double fraction,
+                         int32_t min_count)
+{
+    int64_t n = run->ws->num_free_elem;
+    if (n == 0)
+        return 0.0;
+    int64_t k = getme__quantile_pos(n, fraction, min_count);
+    for (int again = 0; again < 2; again++) {
+        if (pl->lost && pool_build(run, pl, fraction, min_count) != GETME_OK)
+            return -1.0;
+        int32_t m = pool_values(pl, run->q);
+        if (m < 0)
+            return -1.0;
+        if (m > k)
+            return getme__select_kth(pl->v, m, (int32_t)k);
+        pl->lost = 1; /* too few left at or below top */
+    }
+    return getme__threshold(run, fraction, min_count); /* not reached */
+}
+
+/* The pass's elements from the pool: free ones with q <= bound (<= top),
+   worst first; NULL if out of memory. */
+static getme_ranked *pool_list(const getme_run *run, const pool *pl,
+                               double bound, int32_t *count)
+{
+    getme_ranked *r = malloc((size_t)(pl->n ? pl->n : 1) * sizeof *r);
+    if (!r)
+        return NULL;
+    int32_t n = 0;
+    for (int32_t k = 0; k < pl->n; k++) {
+        int32_t e = pl->e[k];
+        if (run->q[e] <= bound)
+            r[n].q = run->q[e], r[n++].e = e;
+    }
+    qsort(r, (size_t)n, sizeof *r, getme__cmp_ranked);
+    *count = n;
+    return r;
+}
+
+/* q_mean and q*_min from the pool (a sweep for q*_min only if no pool
+   element is at or below top). */
+static void pool_summary(getme_run *run, const pool *pl, double *q_mean,
+                         double *q_min)
+{
+    const getme_ws *ws = run->ws;
+    *q_mean = getme__tally_mean(&pl->tally, ws->ne);
+    double m = INFINITY;
+    for (int32_t k = 0; k < pl->n; k++)
+        m = run->q[pl->e[k]] < m ? run->q[pl->e[k]] : m;
+    if (m <= pl->top) {
+        *q_min = m < 1.0 ? m : 1.0;
+    } else {
+        double mean;
+        getme__ws_summary(ws, run->q, &mean, q_min, NULL);
+    }
+}
+
 /* Put the elements around the k nodes mv into the patch (each once). */
 static getme_status fill(getme_run *run, getme_patch *p, const int32_t *mv,
                          int k)
@@ -197,28 +351,44 @@ static getme_status fill(getme_run *run, getme_patch *p, const int32_t *mv,
         for (int64_t s = ws->star_ptr[mv[j]];
              s < ws->star_ptr[mv[j] + 1] && st == GETME_OK; s++) {
             int32_t e = ws->star[s];
-            if (run->eflag[e])
+            if (run->eflag[e] & 1)
                 continue;
-            run->eflag[e] = 1;
+            run->eflag[e] |= 1;
             int t = getme__ws_type(ws, e);
             st = getme__patch_add(p, t, getme__ws_nodes(ws, t, e), e);
         }
     for (int32_t i = 0; i < p->n; i++)
-        run->eflag[p->id[i]] = 0;
+        run->eflag[p->id[i]] &= (uint8_t)~1;
+    /* run->q is current (the smoothing keeps it so, store() too): no need
+       to evaluate the elements again */
+    getme__patch_eval_known(p, run->q);
+#ifdef GETME_CHECK_SUMS
+    double *q = malloc((size_t)(p->n ? p->n : 1) * sizeof *q);
+    if (!q)
+        return GETME_ERR_NOMEM;
+    memcpy(q, p->q, (size_t)p->n * sizeof *q);
     getme__patch_eval(p);
+    if (st == GETME_OK && memcmp(q, p->q, (size_t)p->n * sizeof *q) != 0)
+        st = GETME_ERR_STATE;
+    free(q);
+#endif
     return st;
 }
 
-/* Copy the patch's qualities back to run->q. */
-static void store(getme_run *run, const getme_patch *p)
+/* Copy the patch's qualities back to run->q (pl: the pool follows, or
+   NULL). */
+static void store(getme_run *run, const getme_patch *p, pool *pl)
 {
-    for (int32_t i = 0; i < p->n; i++)
+    for (int32_t i = 0; i < p->n; i++) {
+        if (pl)
+            pool_change(run, pl, p->id[i], run->q[p->id[i]], p->q[i]);
         run->q[p->id[i]] = p->q[i];
+    }
 }
 
 /* Work on element e (*memo: failed climbs, or NULL). */
 static getme_status improve(getme_run *run, getme_patch *p,
-                            climb_memo **memo, int32_t e)
+                            climb_memo **memo, pool *pl, int32_t e)
 {
     const getme_ws *ws = run->ws;
     int t = getme__ws_type(ws, e);
@@ -237,7 +407,7 @@ static getme_status improve(getme_run *run, getme_patch *p,
             return st;
         p->allowed_max = -INFINITY;
         if (getme__patch_climb(p, &mv[j], 1, 8, 1)) {
-            store(run, p);
+            store(run, p, pl);
             forget_if(memo, *memo && memo_moved(*memo, &mv[j], 1) != 0);
         } else if (*memo) {
             memo_failed(*memo, p, mv[j]);
@@ -258,7 +428,7 @@ static getme_status improve(getme_run *run, getme_patch *p,
         int moved = getme__patch_toward(p, mv, k, tg);
         moved += getme__patch_climb(p, mv, k, 4, 1);
         if (moved) {
-            store(run, p);
+            store(run, p, pl);
             forget_if(memo, *memo && memo_moved(*memo, mv, k) != 0);
         }
     }
@@ -392,65 +562,139 @@ static getme_ranked *pass_list(const getme_run *run, double bound,
     return r;
 }
 
+#ifdef GETME_CHECK_SUMS
+/* Test builds: is the pass's bound, list and summary from the pool what
+   the sweeps give? */
+static int pool_checks(getme_run *run, double fraction, double bound,
+                       const getme_ranked *list, int32_t n)
+{
+    int32_t m;
+    int same = bound == getme__threshold(run, fraction, 64);
+    getme_ranked *r = pass_list(run, bound, &m);
+    same = same && r && m == n;
+    for (int32_t i = 0; same && i < n; i++) /* not memcmp: padding */
+        same = r[i].q == list[i].q && r[i].e == list[i].e;
+    free(r);
+    return same;
+}
+
+static int summary_checks(getme_run *run, double q_mean, double q_min)
+{
+    double m, mn;
+    getme__ws_summary(run->ws, run->q, &m, &mn, NULL);
+    return m == q_mean && mn == q_min;
+}
+#endif
+
+/* The pass's bound and list: from the pool, or on a sub-mesh by sweeps
+   (sub_bound, pass_list).  NULL if out of memory or incomplete (st). */
+static getme_ranked *pass_bound_list(getme_run *run, pool *pl, double *bound,
+                                     int32_t *n, getme_status *st)
+{
+    const getme_params *prm = run->params;
+    int incomplete = 0;
+    getme_ranked *list = NULL;
+    *st = GETME_ERR_NOMEM;
+    if (run->sub) {
+        *bound = sub_bound(run, prm->finish_fraction, 64, &incomplete);
+        if (incomplete) {
+            run->sub->need = *bound;
+            *st = GETME_ERR_INCOMPLETE;
+            return NULL;
+        }
+        list = *bound < 0.0 ? NULL : pass_list(run, *bound, n);
+        if (list && !stars_inside(run, list, *n)) {
+            run->sub->need = *bound;
+            free(list);
+            *st = GETME_ERR_INCOMPLETE;
+            return NULL;
+        }
+    } else {
+        *bound = pool_bound(run, pl, prm->finish_fraction, 64);
+        list = *bound < 0.0 ? NULL : pool_list(run, pl, *bound, n);
+#ifdef GETME_CHECK_SUMS
+        if (list && !pool_checks(run, prm->finish_fraction, *bound, list, *n)) {
+            free(list);
+            *st = GETME_ERR_STATE;
+            return NULL;
+        }
+#endif
+    }
+    if (list)
+        *st = GETME_OK;
+    return list;
+}
+
+/* q_mean and q*_min after a pass (from the pool, or on a sub-mesh by a
+   sweep); GETME_OK or, in GETME_CHECK_SUMS builds, GETME_ERR_STATE. */
+static getme_status pass_summary(getme_run *run, const pool *pl,
+                                 double *q_mean, double *q_min)
+{
+    if (run->sub) {
+        getme__finish_summary(run, q_mean, q_min, NULL);
+        return GETME_OK;
+    }
+    pool_summary(run, pl, q_mean, q_min);
+#ifdef GETME_CHECK_SUMS
+    if (!summary_checks(run, *q_mean, *q_min))
+        return GETME_ERR_STATE;
+#endif
+    return GETME_OK;
+}
+
 getme_status getme__finish(getme_run *run)
 {
     getme_ws *ws = run->ws;
     const getme_params *prm = run->params;
     getme_result *res = run->result;
     getme_patch p;
+    pool pl;
+    memset(&pl, 0, sizeof pl);
     if (getme__patch_init(&p, 8 * ws->max_star) != GETME_OK)
         return GETME_ERR_NOMEM;
     p.x = ws->x;
     p.ws = ws;
     p.guard = run->guard;
     p.floor = run->corner_floor;
+    memcpy(p.skip_q, run->guard_skip_q, sizeof p.skip_q);
     /* no memo for second-order elements: their validity also reads the
        mid-edge nodes */
     climb_memo memo_store, *memo = NULL;
     if (!ws->ho && memo_init(&memo_store) == 0)
         memo = &memo_store;
-    double q_mean, q_min;
-    getme__finish_summary(run, &q_mean, &q_min, NULL);
     getme_status st = GETME_OK;
-    for (int pass = 1; pass <= prm->finish_max_passes; pass++) {
-        int incomplete = 0;
-        double bound =
-            run->sub ? sub_bound(run, prm->finish_fraction, 64, &incomplete)
-                     : getme__threshold(run, prm->finish_fraction, 64);
-        if (incomplete) {
-            run->sub->need = bound;
-            st = GETME_ERR_INCOMPLETE;
-            break;
-        }
+    if (!run->sub) {
+        getme__tally_start(&pl.tally, ws, run->q);
+        st = pool_build(run, &pl, prm->finish_fraction, 64);
+    }
+    double q_mean, q_min;
+    if (st == GETME_OK)
+        st = pass_summary(run, &pl, &q_mean, &q_min);
+    for (int pass = 1; pass <= prm->finish_max_passes && st == GETME_OK;
+         pass++) {
+        double bound;
         int32_t n, raised = 0;
-        getme_ranked *list = bound < 0.0 ? NULL : pass_list(run, bound, &n);
-        if (!list) {
-            st = GETME_ERR_NOMEM;
+        getme_ranked *list = pass_bound_list(run, &pl, &bound, &n, &st);
+        if (!list)
             break;
-        }
-        if (run->sub && !stars_inside(run, list, n)) {
-            run->sub->need = bound;
-            free(list);
-            st = GETME_ERR_INCOMPLETE;
-            break;
-        }
         /* Two sweeps: the first takes only moves that lose no total
            quality (and so earns budget), the second may spend it. */
+        pool *track = run->sub ? NULL : &pl;
         for (int sweep = 0; sweep < 2; sweep++) {
             p.loss = sweep ? GETME_PATCH_LOSS : 0.0;
             for (int32_t i = 0; i < n && st == GETME_OK; i++)
                 if (run->q[list[i].e] <= bound)
-                    st = improve(run, &p, &memo, list[i].e);
+                    st = improve(run, &p, &memo, track, list[i].e);
         }
         /* Raised over the pass, whichever sweep did it (the list keeps
            each element's quality at the pass's start). */
         for (int32_t i = 0; i < n; i++)
             raised += run->q[list[i].e] > list[i].q;
         free(list);
-        if (st != GETME_OK)
-            break;
         double prev = q_min;
-        getme__finish_summary(run, &q_mean, &q_min, NULL);
+        if (st != GETME_OK ||
+            (st = pass_summary(run, &pl, &q_mean, &q_min)) != GETME_OK)
+            break;
         res->passes_finish = pass;
         res->moved_finish += raised;
         if (report(run, pass, q_min, q_mean, bound, n, raised)) {
@@ -461,6 +705,7 @@ getme_status getme__finish(getme_run *run)
         if (!(q_min > prev + prm->min_tol))
             break;
     }
+    pool_free(run, &pl);
     getme__patch_free(&p);
     if (memo)
         memo_free(memo);

@@ -27,6 +27,7 @@
 #include "best.h"
 #include "revert.h"
 #include "smooth_internal.h"
+#include "tally.h"
 
 #include <math.h>
 #include <omp.h>
@@ -503,6 +504,8 @@ static getme_status update_after(getme_run *run, double qt)
         int32_t e = run->elems[k];
         if (run->q[e] == run->qold[k])
             continue;
+        if (run->tally)
+            getme__tally_change(run->tally, run->qold[k], run->q[e]);
         uint64_t d = (uint64_t)getme__fx64(run->q[e], adj->qscale) -
                      (uint64_t)getme__fx64(run->qold[k], adj->qscale);
         int t = getme__ws_type(ws, e);
@@ -757,8 +760,7 @@ static inline void order2(double *a, double *b)
     }
 }
 
-/* The k-th smallest of v[0..n) (v is permuted); deterministic. */
-static double select_kth(double *v, int32_t n, int32_t k)
+double getme__select_kth(double *v, int32_t n, int32_t k)
 {
     int32_t lo = 0, hi = n - 1;
     while (hi > lo) {
@@ -888,7 +890,7 @@ double getme__threshold(getme_run *run, double fraction, int32_t min_count)
     for (int32_t e = 0; e < ws->ne; e++)
         if (ws->free_elem[e] && (bits_of(run->q[e]) & mask) == prefix)
             cand[m++] = run->q[e];
-    double qt = select_kth(cand, m, (int32_t)k);
+    double qt = getme__select_kth(cand, m, (int32_t)k);
     free(cand);
     return qt;
 }
@@ -950,6 +952,34 @@ static void set_corner_floor(getme_run *run, double floor)
     run->guard_skip_q[GETME_QUAD] = (3.0 + f) / 4.0 + 1e-12;
 }
 
+/* q_mean and q*_min after an iteration of the q*_min stage, without a
+   sweep: q_mean from run->tally; q*_min over run->tlist, which holds
+   exactly the free elements with q <= q_t (start_tlist, update_after), so
+   every other one is above its minimum (a sweep only when it is empty).
+   GETME_CHECK_SUMS builds compare both with the sweep (GETME_ERR_STATE if
+   they differ: the bookkeeping missed a change). */
+static getme_status min_summary(getme_run *run, double *q_mean,
+                                double *q_min)
+{
+    const getme_ws *ws = run->ws;
+    if (!run->qold) /* update_after had no room to follow the changes */
+        getme__tally_start(run->tally, ws, run->q);
+    *q_mean = getme__tally_mean(run->tally, ws->ne);
+    if (run->num_t > 0) {
+        *q_min = getme__tally_min(run->q, run->tlist, run->num_t);
+    } else {
+        double m;
+        getme__summary(run, &m, q_min, NULL);
+    }
+#ifdef GETME_CHECK_SUMS
+    double m, mn;
+    getme__summary(run, &m, &mn, NULL);
+    if (m != *q_mean || mn != *q_min)
+        return GETME_ERR_STATE;
+#endif
+    return GETME_OK;
+}
+
 getme_status getme__adaptive(getme_run *run)
 {
     getme_ws *ws = run->ws;
@@ -957,6 +987,7 @@ getme_status getme__adaptive(getme_run *run)
     getme_result *res = run->result;
     getme_best best; /* best.h: an undo log, not a copy */
     getme_input input; /* revert.h: never below the input's q*_min */
+    getme_tally tally; /* the q*_min stage's q_mean (run->tally) */
     getme_status st = alloc_adaptive(run);
     if (getme__best_init(&best, run, p->keep_best) != GETME_OK)
         st = GETME_ERR_NOMEM;
@@ -1002,7 +1033,12 @@ getme_status getme__adaptive(getme_run *run)
                           &ntrans, &nrelax)) != GETME_OK)
             break;
         double prev_mean = q_mean, prev_min = q_min;
-        getme__summary(run, &q_mean, &q_min, NULL);
+        if (stage == GETME_STAGE_MIN && run->tally)
+            st = min_summary(run, &q_mean, &q_min);
+        else
+            getme__summary(run, &q_mean, &q_min, NULL);
+        if (st != GETME_OK)
+            break;
         if (run->comm_failed) {
             st = GETME_ERR_COMM;
             break;
@@ -1030,6 +1066,10 @@ getme_status getme__adaptive(getme_run *run)
             nR = p->num_relax_min;
             best_min = q_min; /* the end of stage 1 is the first candidate */
             getme__best_take(&best, ws);
+            if (!run->comm) { /* distributed: summed over processes */
+                getme__tally_start(&tally, ws, run->q);
+                run->tally = &tally;
+            }
             /* Only the q_mean stage's scatter_all uses the block kernel's
                node lists and local connectivity: freed before the q*_min
                stage's lists grow (10 B per tet, 18 B per hex less at the
@@ -1073,10 +1113,11 @@ getme_status getme__adaptive(getme_run *run)
         }
     }
 
+    run->tally = NULL;
     if (best.on && best_min > q_min) {
         /* Fixed nodes never move, so this keeps them exact. */
-        getme__best_restore(&best, ws);
-        getme__ws_qualities(ws, run->q);
+        getme_status rs = getme__best_restore(&best, run);
+        st = st == GETME_OK ? rs : st;
         getme__summary(run, &q_mean, &q_min, NULL);
     }
     if (st == GETME_OK && q_min < input.q_min_star) {
@@ -1093,6 +1134,7 @@ getme_status getme__adaptive(getme_run *run)
         st = GETME_ERR_COMM;
     res->threshold = qt;
 done:
+    run->tally = NULL;
     getme__input_free(&input);
     getme__best_free(&best);
     free_adaptive(run);

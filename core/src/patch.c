@@ -10,6 +10,9 @@
 
 #define D_MAX (3 * GETME_PATCH_MAX_MOVE)
 
+/* Doubles of one lane group in getme_patch.lx. */
+#define LX_GROUP (3 * GETME_MAX_NV * GETME_LANES)
+
 void getme__patch_free(getme_patch *p)
 {
     free(p->type);
@@ -18,6 +21,10 @@ void getme__patch_free(getme_patch *p)
     free(p->q);
     free(p->sj);
     free(p->qt);
+    free(p->lx);
+    free(p->lok);
+    free(p->mpos);
+    free(p->midx);
     memset(p, 0, sizeof *p);
 }
 
@@ -36,12 +43,21 @@ static getme_status grow(getme_patch *p, int32_t cap)
         RESIZE(sj, n) || RESIZE(qt, n * D_MAX))
         return GETME_ERR_NOMEM;
     p->cap = cap;
+    /* the lane cache is optional: without it trials gather as before */
+    size_t ng = (n + GETME_LANES - 1) / GETME_LANES;
+    if (RESIZE(lx, ng * LX_GROUP) || RESIZE(lok, ng) ||
+        RESIZE(mpos, n * GETME_MAX_NV) || RESIZE(midx, n * GETME_MAX_NV)) {
+        free(p->lx), free(p->lok), free(p->mpos), free(p->midx);
+        p->lx = NULL, p->lok = NULL, p->mpos = NULL, p->midx = NULL;
+    }
     return GETME_OK;
 }
 
 getme_status getme__patch_init(getme_patch *p, int32_t cap)
 {
     memset(p, 0, sizeof *p);
+    for (int t = 0; t < GETME_NUM_TYPES; t++)
+        p->skip_q[t] = 2.0;
     return grow(p, cap > 64 ? cap : 64);
 }
 
@@ -76,7 +92,10 @@ static double elem_finish(const getme_patch *p, int32_t i, const double *x,
                           double q, double *sj)
 {
     int t = p->type[i];
-    if (p->guard && getme__has_corners(t))
+    /* a skipped corner stays 1: above the floor, like the true one, it
+       rejects nothing as a new corner, and as an old one the test is the
+       same (sj < floor implies sj < any old corner >= floor) */
+    if (p->guard && getme__has_corners(t) && !(q >= p->skip_q[t]))
         *sj = getme__corner_sj(t, x);
     if (q > 0.0 && p->ws && p->ws->ho && !getme__ho_valid(p->ws, p->x, p->id[i]))
         return 0.0; /* second order: det J > 0 at every node */
@@ -92,6 +111,9 @@ static double elem_q(const getme_patch *p, int32_t i, double *sj)
     return elem_finish(p, i, x, getme__quality(p->type[i], x), sj);
 }
 
+static void lanes_x(const getme_patch *p, int32_t i0, int32_t n, int t,
+                    double (*x)[GETME_LANES]);
+
 /* The mean ratios of the n <= GETME_LANES patch elements from i0 into q
    by one lane kernel (quality.c: the same bits as getme__quality, several
    times faster; trials evaluate every patch element, which is most of the
@@ -106,6 +128,15 @@ static int lanes_q(const getme_patch *p, int32_t i0, int32_t n, double *q)
     if (t != GETME_TET && t != GETME_HEX)
         return 0;
     double x[3 * GETME_MAX_NV][GETME_LANES];
+    lanes_x(p, i0, n, t, x);
+    return getme__quality_lanes(t, (const double(*)[GETME_LANES])x, q);
+}
+
+/* The lane-major coordinates of the n <= GETME_LANES patch elements from
+   i0 (all of type t) into x, as lanes_q gathers them. */
+static void lanes_x(const getme_patch *p, int32_t i0, int32_t n, int t,
+                    double (*x)[GETME_LANES])
+{
     for (int32_t l = 0; l < GETME_LANES; l++) {
         /* unused lanes repeat the last element: finite, and ignored */
         const int32_t *c = p->conn[i0 + (l < n ? l : n - 1)];
@@ -116,26 +147,89 @@ static int lanes_q(const getme_patch *p, int32_t i0, int32_t n, double *q)
             x[3 * j + 2][l] = s[2];
         }
     }
-    return getme__quality_lanes(t, (const double(*)[GETME_LANES])x, q);
+}
+
+/* Fill the lane cache for trials that move the k nodes mv: every group of
+   one type with a lane kernel gathered, and where the moving nodes sit in
+   it (a node occurs once per element; repeated lanes are filled too).
+   Nothing is cached without the arrays (then trials gather). */
+static void lane_cache(getme_patch *p, const int32_t *mv, int k)
+{
+    p->cached = 0;
+    if (!p->lx)
+        return;
+    int32_t m = 0;
+    for (int32_t i0 = 0, g = 0; i0 < p->n; i0 += GETME_LANES, g++) {
+        int32_t n = p->n - i0 < GETME_LANES ? p->n - i0 : GETME_LANES;
+        int t = p->type[i0], ok = t == GETME_TET || t == GETME_HEX;
+        for (int32_t l = 1; l < n; l++)
+            ok &= p->type[i0 + l] == t;
+        p->lok[g] = (int8_t)ok;
+        if (!ok)
+            continue;
+        double(*x)[GETME_LANES] = (double(*)[GETME_LANES])(p->lx + (int64_t)g * LX_GROUP);
+        lanes_x(p, i0, n, t, x);
+        for (int32_t l = 0; l < GETME_LANES; l++) {
+            const int32_t *c = p->conn[i0 + (l < n ? l : n - 1)];
+            for (int j = 0; j < getme__nv[t]; j++)
+                for (int a = 0; a < k; a++)
+                    if (c[j] == mv[a]) {
+                        p->mpos[m] = (int32_t)((int64_t)g * LX_GROUP +
+                                               3 * j * GETME_LANES + l);
+                        p->midx[m++] = (uint8_t)a;
+                    }
+        }
+    }
+    p->nmpos = m;
+    p->cached = 1;
+}
+
+/* Bring the lane cache to the moving nodes' current coordinates. */
+static void lane_cache_move(getme_patch *p, const int32_t *mv)
+{
+    for (int32_t m = 0; m < p->nmpos; m++) {
+        double *r = p->lx + p->mpos[m];
+        const double *s = p->x + 3 * (int64_t)mv[p->midx[m]];
+        r[0] = s[0];
+        r[GETME_LANES] = p->mirror ? -s[1] : s[1];
+        r[2 * GETME_LANES] = s[2];
+    }
 }
 
 /* elem_q of the n <= GETME_LANES patch elements from i0 into q (and into
-   sj where elem_q sets it). */
+   sj where elem_q sets it); from the lane cache where it holds them. */
 static void group_q(const getme_patch *p, int32_t i0, int32_t n, double *q,
                     double *sj)
 {
     double ql[GETME_LANES], x[3 * GETME_MAX_NV];
-    int lanes = lanes_q(p, i0, n, ql);
+    const double(*cx)[GETME_LANES] = NULL;
+    int lanes;
+    if (p->cached && p->lok[i0 / GETME_LANES]) {
+        cx = (const double(*)[GETME_LANES])(p->lx +
+                                            (int64_t)(i0 / GETME_LANES) * LX_GROUP);
+        lanes = getme__quality_lanes(p->type[i0], cx, ql);
+    } else {
+        lanes = lanes_q(p, i0, n, ql);
+    }
     for (int32_t l = 0; l < n; l++) {
         if (!lanes) {
             q[l] = elem_q(p, i0 + l, &sj[l]);
             continue;
         }
         int t = p->type[i0 + l];
-        int more = (p->guard && getme__has_corners(t)) || (p->ws && p->ws->ho);
-        if (more)
+        int more = (p->guard && getme__has_corners(t) &&
+                    !(ql[l] >= p->skip_q[t])) ||
+                   (p->ws && p->ws->ho);
+        if (!more) {
+            q[l] = ql[l];
+            continue;
+        }
+        if (cx) /* elem_x's values, from the cache */
+            for (int j = 0; j < 3 * getme__nv[t]; j++)
+                x[j] = cx[j][l];
+        else
             elem_x(p, i0 + l, x);
-        q[l] = more ? elem_finish(p, i0 + l, x, ql[l], &sj[l]) : ql[l];
+        q[l] = elem_finish(p, i0 + l, x, ql[l], &sj[l]);
     }
 }
 
@@ -147,6 +241,31 @@ double getme__patch_eval(getme_patch *p)
     for (int32_t i0 = 0; i0 < p->n; i0 += GETME_LANES) {
         int32_t n = p->n - i0 < GETME_LANES ? p->n - i0 : GETME_LANES;
         group_q(p, i0, n, p->q + i0, p->sj + i0);
+    }
+    for (int32_t i = 0; i < p->n; i++)
+        m = fmin(m, p->q[i]);
+    return m;
+}
+
+double getme__patch_eval_known(getme_patch *p, const double *known)
+{
+    if (p->ws && p->ws->ho)
+        return getme__patch_eval(p);
+    double m = INFINITY;
+    for (int32_t i0 = 0; i0 < p->n; i0 += GETME_LANES) {
+        int32_t n = p->n - i0 < GETME_LANES ? p->n - i0 : GETME_LANES;
+        int corners = 0;
+        for (int32_t l = 0; l < n; l++) {
+            p->sj[i0 + l] = 1.0;
+            int t = p->type[i0 + l];
+            corners |= p->guard && getme__has_corners(t) &&
+                       !(known[p->id[i0 + l]] >= p->skip_q[t]);
+        }
+        if (corners)
+            group_q(p, i0, n, p->q + i0, p->sj + i0);
+        else
+            for (int32_t l = 0; l < n; l++)
+                p->q[i0 + l] = known[p->id[i0 + l]];
     }
     for (int32_t i = 0; i < p->n; i++)
         m = fmin(m, p->q[i]);
@@ -166,9 +285,11 @@ double getme__patch_eval(getme_patch *p)
  *    the optimisation started;
  *  - with the corner guard, no corner of a hex, prism, pyramid or quad
  *    falls below min(its old value, floor). */
-static int trial(getme_patch *p, double cur)
+static int trial(getme_patch *p, double cur, const int32_t *mv)
 {
     double m = INFINITY, sum_new = 0.0, sum_old = 0.0;
+    if (p->cached)
+        lane_cache_move(p, mv);
     for (int32_t i0 = 0; i0 < p->n; i0 += GETME_LANES) {
         int32_t n = p->n - i0 < GETME_LANES ? p->n - i0 : GETME_LANES;
         double qg[GETME_LANES], sj[GETME_LANES];
@@ -183,7 +304,7 @@ static int trial(getme_patch *p, double cur)
             if (sj[l] < p->sj[i] && sj[l] < p->floor && p->guard)
                 return 0;
             p->qt[i] = q;
-            m = fmin(m, q);
+            m = q < m ? q : m; /* q > cur: not NaN (fmin was a call) */
             sum_new += q;
             sum_old += p->q[i];
         }
@@ -244,7 +365,7 @@ static double edge_scale(const getme_patch *p, const int32_t *mv, int k)
                 double v = *coord(p, a, d) - *coord(p, b, d);
                 s += v * v;
             }
-            l2 = fmin(l2, s);
+            l2 = s < l2 ? s : l2; /* fmin, inlined: l2 never NaN */
         }
     }
     return sqrt(l2);
@@ -355,7 +476,7 @@ static int step(getme_patch *p, const int32_t *mv, int k, double L,
     for (int h = 1; h <= 24; h++) {
         double s = L * ldexp(1.0, -h);
         place(p, mv, k, base, s, u);
-        if (trial(p, cur)) {
+        if (trial(p, cur, mv)) {
             if (!apply) {
                 restore(p, mv, k, base);
                 return 1;
@@ -377,11 +498,13 @@ int getme__patch_climb(getme_patch *p, const int32_t *mv, int k,
     if (!(L > 0.0) || !isfinite(L))
         return 0;
     int done = 0;
+    lane_cache(p, mv, k);
     while (done < max_steps && step(p, mv, k, L, apply)) {
         done++;
         if (!apply)
             break;
     }
+    p->cached = 0; /* the caller may move other nodes next */
     return done;
 }
 
@@ -398,13 +521,17 @@ int getme__patch_toward(getme_patch *p, const int32_t *mv, int k,
             base[3 * j + d] = *coord(p, mv[j], d);
             u[3 * j + d] = tg[3 * j + d] - base[3 * j + d];
         }
-    for (int h = 1; h <= 6; h++) {
+    lane_cache(p, mv, k);
+    int kept = 0;
+    for (int h = 1; h <= 6 && !kept; h++) {
         place(p, mv, k, base, ldexp(1.0, -h), u);
-        if (trial(p, cur)) {
+        if (trial(p, cur, mv)) {
             accept(p);
-            return 1;
+            kept = 1;
         }
     }
-    restore(p, mv, k, base);
-    return 0;
+    p->cached = 0; /* the caller may move other nodes next */
+    if (!kept)
+        restore(p, mv, k, base);
+    return kept;
 }

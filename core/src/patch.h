@@ -35,6 +35,10 @@ typedef struct getme_patch {
     int guard;       /* corner guard on: a corner (getme__corner_sj) may
                         not end below min(its old value, floor)           */
     double floor;
+    double skip_q[GETME_NUM_TYPES]; /* per type, a quality from which on the
+                        worst corner is provably >= floor (getme_run's
+                        guard_skip_q), so it is not computed: it could
+                        not reject a move (2: always computed)            */
     double loss;     /* a move may lower the patch's total quality by at
                         most loss times the rise of its minimum ...        */
     double budget;   /* ... and by at most this: the total quality that
@@ -54,6 +58,17 @@ typedef struct getme_patch {
     double *qt;      /* scratch: trial qualities                          */
     const struct getme_ws *ws; /* finishing step: x is ws->x and ids are
                         workspace elements, checked at second-order nodes */
+    /* Trials move only the moving nodes, so during one climb or toward
+       call the other coordinates of every lane group are gathered once
+       (patch.c, lane_cache) and each trial writes just the moving ones:
+       per group of GETME_LANES elements its lane-major coordinates
+       (3 GETME_MAX_NV rows of GETME_LANES), NULL without memory. */
+    double *lx;
+    int8_t *lok;     /* per group: 1 if lx holds it (one type with lanes) */
+    int32_t *mpos;   /* the moving nodes' places in lx (their x row) ...  */
+    uint8_t *midx;   /* ... and which moving node each is                 */
+    int32_t nmpos;
+    int cached;      /* lx is current (inside a climb or toward call)     */
 } getme_patch;
 
 /* Room for cap elements; GETME_OK or GETME_ERR_NOMEM. */
@@ -71,6 +86,11 @@ getme_status getme__patch_add(getme_patch *p, int type, const int32_t *conn,
 /* Quality and worst corner of every patch element at p->x; returns the
    patch's minimum quality. */
 double getme__patch_eval(getme_patch *p);
+
+/* The same, but the quality of an element of a first-order patch that
+   needs no corner is known[its id] (the finishing step: run->q holds those
+   bits already); lane groups with a guarded corner are computed. */
+double getme__patch_eval_known(getme_patch *p, const double *known);
 
 /*
  * Raise the patch minimum by moving the k nodes mv[] (free nodes the

@@ -38,6 +38,8 @@ void getme__run_free(getme_run *run)
     free(run->nodes);
     free(run->elems);
     free(run->list);
+    run->q = NULL, run->in_t = run->flag = run->ridx = run->eflag = NULL;
+    run->nodes = run->elems = run->list = NULL;
 }
 
 /* Chunked, order-preserving compaction: the same list for any thread
@@ -278,6 +280,11 @@ getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
     st = params->method == GETME_METHOD_SMART_LAPLACE ? getme__laplace(&run)
                                                       : getme__adaptive(&run);
     getme__ws_unpack_map(&ws); /* into the stars' array: no allocation */
+    /* The run's and the sums' arrays are done with: freed before the
+       coordinates and the connectivity go back (permuted out of place, so
+       below the peak they leave). */
+    getme__run_free(&run);
+    getme__adj_free(&adj);
     if (st == GETME_OK || st == GETME_ERR_CANCELLED) {
         result->corner_sj = getme__ws_corner_min(&ws);
         getme__ws_store(&ws, mesh);

@@ -70,6 +70,8 @@ typedef struct getme_run {
     uint8_t *tflag;     /* ne: element is in tlist                          */
     double *qold;       /* q*_min stage: qualities of run->elems before the
                            relaxation step (NULL: sums are recomputed)      */
+    struct getme_tally *tally; /* q*_min stage: q_mean's exact sum, which
+                           update_after keeps (tally.h), or NULL            */
     int64_t cap_qold;
     /* GETMe's node sums in exact fixed point (exact.h, getme_adaptive.c):
        per node sum w x' (3) and sum w, zero between iterations. */
@@ -205,6 +207,10 @@ static inline int64_t getme__quantile_pos(int64_t n, double fraction,
         pos = (double)min_count - 1.0;
     return pos >= (double)(n - 1) ? n - 1 : pos <= 0.0 ? 0 : (int64_t)pos;
 }
+
+/* The k-th smallest of v[0..n) (v is permuted); deterministic
+   (getme_adaptive.c). */
+double getme__select_kth(double *v, int32_t n, int32_t k);
 
 /* The quality at position fraction * n (at least min_count - 1, at most
    n - 1) of the sorted qualities of the free elements; 0 without free

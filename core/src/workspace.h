@@ -85,16 +85,18 @@ void getme__ws_keep(getme_ws *ws, getme_mesh *mesh);
 
 /* While the smoother runs, the connectivity of a one-block first-order
    mesh is the workspace's in another order: the mesh frees its array
-   (16 B per tet, 32 B per hex) and getme__ws_return_conn rebuilds it in
-   place from ws->conn, which it hands over (no allocation, so it cannot
-   fail).  Nothing may read the mesh's elements in between. */
+   (16 B per tet, 32 B per hex) and getme__ws_return_conn rebuilds it
+   from ws->conn, which it hands over: permuted into a new array when there
+   is memory (in parallel; callers free their larger arrays first), in
+   place otherwise, so it cannot fail.  Nothing may read the mesh's
+   elements in between. */
 void getme__ws_lend_conn(getme_ws *ws, getme_mesh *mesh);
 void getme__ws_return_conn(getme_ws *ws, getme_mesh *mesh);
 
 /* The same for the coordinates, if the caller allowed it
    (getme_mesh_lend_coords; first-order meshes): the mesh frees its array
    (24 B per node) and getme__ws_return_x makes ws->x, put back in the
-   caller's order (in place), the mesh's array.  The smoother calls it once
+   caller's order (like getme__ws_return_conn), the mesh's array.  The smoother calls it once
    the input is checked, so only a failure in the loop itself (out of
    memory) leaves the mesh partly smoothed. */
 void getme__ws_lend_x(getme_ws *ws, getme_mesh *mesh);

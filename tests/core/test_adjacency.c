@@ -353,6 +353,71 @@ static void check_live_sums(void)
     free_gen(&g);
 }
 
+/* What the end of the smoothing keeps by changes instead of sweeps
+   (tally.h, best.c, finish.c): q_mean's exact sum and q*_min after each
+   q*_min iteration, the qualities after keep_best puts the best mesh back
+   (only the stars of the nodes it puts back are rescored), and each
+   finishing pass's list, bound and summary.  This test is built with
+   GETME_CHECK_SUMS, where each of them is compared with a sweep and a
+   difference fails the run with GETME_ERR_STATE (dropping the
+   getme__tally_change in update_after, or one star from best.c's rescore,
+   makes these runs return it).  Several distortions, so that some runs end
+   the q*_min stage below their best (keep_best restores) and all run
+   finishing passes; 1 and 2 threads give the same result. */
+typedef struct tail_seen {
+    double best_min, last_min; /* over the q*_min stage */
+    int finish_passes;
+} tail_seen;
+
+static int see_tail(const getme_progress *pr, void *data)
+{
+    tail_seen *s = data;
+    if (pr->stage == GETME_STAGE_MIN) {
+        s->best_min = pr->q_min_star > s->best_min ? pr->q_min_star : s->best_min;
+        s->last_min = pr->q_min_star;
+    } else if (pr->stage == GETME_STAGE_FINISH) {
+        s->finish_passes++;
+    }
+    return 0;
+}
+
+static void check_tail_bookkeeping(void)
+{
+    N = 12;
+    gen g = make("tet");
+    N = 5;
+    int restored = 0, finished = 0;
+    for (uint64_t seed = 1; seed <= 4; seed++) {
+        double q[3];
+        for (int nt = 1; nt <= 2; nt++) {
+            getme_mesh *mesh = to_mesh(&g);
+            CHECK(getme_mesh_fix_boundary(mesh, GETME_FIX_SKIN, NULL) == GETME_OK);
+            CHECK(getme_mesh_distort(mesh, seed, 0.5, 0.45, 200) == GETME_OK);
+            getme_params p;
+            getme_params_init(&p);
+            p.num_threads = nt;
+            tail_seen seen = {-1.0, -1.0, 0};
+            p.progress = see_tail;
+            p.progress_data = &seen;
+            getme_result r;
+            CHECK_EQ_INT(getme_smooth(mesh, &p, &r), GETME_OK);
+            CHECK(r.iterations_min >= 1);
+            restored += nt == 1 && seen.best_min > seen.last_min;
+            finished += nt == 1 && seen.finish_passes > 0;
+            /* the result's statistics are those of the output mesh */
+            getme_quality_stats st;
+            CHECK(getme_mesh_quality_stats(mesh, -1, &st) == GETME_OK);
+            CHECK(st.q_mean == r.q_mean && st.q_min_star == r.q_min_star);
+            q[nt] = r.q_mean;
+            getme_mesh_free(mesh);
+        }
+        CHECK(q[1] == q[2]);
+    }
+    CHECK(restored > 0);
+    CHECK(finished > 0);
+    free_gen(&g);
+}
+
 /* Build ws + adj for g with nt threads; check every regular element's
    formula sum and count against the brute force; return the irregular
    flags (caller frees) in ws element order, and the ws (caller frees). */
@@ -589,6 +654,7 @@ int main(void)
     check_nonconforming();
     check_block_order();
     check_live_sums();
+    check_tail_bookkeeping();
     for (size_t i = 0; i < sizeof kinds / sizeof *kinds; i++) {
         check_threads(kinds[i], 0);
         check_threads(kinds[i], 1);
