@@ -21,3 +21,10 @@ if SANITIZED:
     # Open MPI's own start-up allocations are never freed.
     ENV["ASAN_OPTIONS"] = "detect_leaks=0"
 c = Checks(GETME)
+
+
+def why(p, tail=400):
+    """What a failed run said: its "Error" lines (Open MPI's abort notice
+    after them would push them out of a plain tail), then the tail."""
+    errs = [ln for ln in p.stderr.splitlines() if ln.startswith("Error")]
+    return "\n".join(errs[:5]) + ("\n" if errs else "") + p.stderr[-tail:]

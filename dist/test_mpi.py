@@ -24,7 +24,7 @@ import sys
 import tempfile
 
 import meshes
-from mpi_checks import GETME_MPI, MPIEXEC, SANITIZED, ENV, c
+from mpi_checks import GETME_MPI, MPIEXEC, SANITIZED, ENV, c, why
 
 
 def mpirun(np, *args, env=ENV):
@@ -70,7 +70,7 @@ with tempfile.TemporaryDirectory() as tmp:
                 p = mpirun(np, "smooth", inp, "-o", out, "--threads",
                            str(threads), "-v")
                 c.check(p.returncode == 0,
-                        f"{case}: -np {np}: exit {p.returncode}: {p.stderr[-500:]}")
+                        f"{case}: -np {np}: exit {p.returncode}: {why(p)}")
                 same = os.path.exists(out) and open(out, "rb").read() == ref_bytes
                 c.check(same, f"{case}: -np {np} --threads {threads}: the same "
                               f"bytes as getme smooth")
