@@ -27,6 +27,9 @@ void getme__blocks_free(getme_blocks *blk)
     free(blk->order);
     free(blk->part_ptr);
     free(blk->col_ptr);
+    free(blk->group.ptr);
+    free(blk->group.cnt);
+    free(blk->group.pos);
     memset(blk, 0, sizeof *blk);
 }
 
@@ -251,6 +254,7 @@ int64_t getme__blocks_run(const getme_blocks *blk, const getme_ws *ws,
 getme_status getme__blocks_build(getme_blocks *blk, const getme_ws *ws)
 {
     memset(blk, 0, sizeof *blk);
+    blk->group.n = -1;
     int nt = ws->nt;
     int64_t nconn = ws->coff[GETME_NUM_TYPES - 1] +
                     (int64_t)(ws->tstart[GETME_NUM_TYPES] -
@@ -281,6 +285,11 @@ getme_status getme__blocks_build(getme_blocks *blk, const getme_ws *ws)
     }
     blk->max_nodes = big;
     blk->max_elems = bige;
+    blk->bsize = bige > 0 ? bige : 1;
+    for (int t = 0, nb = 0; t < GETME_NUM_TYPES; t++) {
+        blk->tblock[t] = nb;
+        nb += (ws->tstart[t + 1] - ws->tstart[t] + blk->bsize - 1) / blk->bsize;
+    }
     if (big > UINT16_MAX + 1) { /* not with the workspace's 512-element
                                    blocks; refuse rather than wrap */
         st = GETME_ERR_NOMEM;
@@ -306,4 +315,62 @@ done:
     if (st != GETME_OK)
         getme__blocks_free(blk);
     return st;
+}
+
+getme_status getme__blocks_group(getme_blocks *blk, const getme_ws *ws,
+                                 const int32_t *list, int32_t n)
+{
+    struct getme_block_group *g = &blk->group;
+    size_t nb = (size_t)ws->num_blocks;
+    if (!g->ptr)
+        g->ptr = malloc((nb + 1) * sizeof *g->ptr);
+    if (!g->cnt)
+        g->cnt = malloc((size_t)ws->nt * (nb ? nb : 1) * sizeof *g->cnt);
+    if (n > g->cap) {
+        free(g->pos);
+        g->cap = 2 * (int64_t)n + 64;
+        g->pos = malloc((size_t)g->cap * sizeof *g->pos);
+    }
+    g->n = -1;
+    if (!g->ptr || !g->cnt || !g->pos) {
+        g->cap = 0;
+        return GETME_ERR_NOMEM;
+    }
+    int32_t *ptr = g->ptr, *pos = g->pos;
+#pragma omp parallel num_threads(ws->nt)
+    {
+        /* thread p counts and places the entries [k0, k1): the same
+           share in both passes, and within a block thread p's entries
+           follow thread p - 1's, so every block lists its entries in
+           ascending order for any number of threads */
+        int np = omp_get_num_threads(), p = omp_get_thread_num();
+        int32_t k0 = (int32_t)((int64_t)n * p / np);
+        int32_t k1 = (int32_t)((int64_t)n * (p + 1) / np);
+        int32_t *cnt = g->cnt + (size_t)p * nb;
+        memset(cnt, 0, nb * sizeof *cnt);
+        for (int32_t k = k0; k < k1; k++) {
+            int32_t e = list[k];
+            cnt[getme__blocks_of(blk, ws, getme__ws_type(ws, e), e)]++;
+        }
+#pragma omp barrier
+#pragma omp single
+        {
+            int32_t at = 0;
+            for (size_t b = 0; b < nb; b++) {
+                ptr[b] = at;
+                for (int q = 0; q < np; q++) {
+                    int32_t c = g->cnt[(size_t)q * nb + b];
+                    g->cnt[(size_t)q * nb + b] = at;
+                    at += c;
+                }
+            }
+            ptr[nb] = at;
+        } /* implicit barrier */
+        for (int32_t k = k0; k < k1; k++) {
+            int32_t e = list[k];
+            pos[cnt[getme__blocks_of(blk, ws, getme__ws_type(ws, e), e)]++] = k;
+        }
+    }
+    g->n = n;
+    return GETME_OK;
 }

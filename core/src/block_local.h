@@ -69,6 +69,24 @@ typedef struct getme_blocks {
     int32_t *order;     /* num_blocks                                     */
     int32_t *part_ptr;  /* GETME_ORDER_LEVELS np + 1                      */
     int32_t *col_ptr;   /* num_colours + 1                                */
+    /* Element e of type t is in block tblock[t] + (e - ws->tstart[t]) /
+       bsize (getme__blocks_of): the workspace cuts each type's range into
+       blocks of one size, and bsize, the largest block's element count,
+       is that size (or, with no full block, above every type's count). */
+    int32_t tblock[GETME_NUM_TYPES];
+    int32_t bsize;
+    /* A list of elements grouped by block (getme__blocks_group), so the
+       q*_min stage's scatters over a few elements can run in the race-free
+       order too: block b's entries are the positions in the list
+       pos[ptr[b] .. ptr[b + 1]), ascending. */
+    struct getme_block_group {
+        int32_t *ptr;   /* num_blocks + 1                                 */
+        int32_t *cnt;   /* ws->nt num_blocks: per-thread counts, scratch  */
+        int32_t *pos;   /* cap                                            */
+        int64_t cap;
+        int32_t n;      /* the list's length, -1 if not grouped (the
+                           caller sets it when its list changes)         */
+    } group;
 } getme_blocks;
 
 /* Build it for ws (parallel over blocks, deterministic).  GETME_OK or
@@ -86,6 +104,20 @@ void getme__blocks_free_local(getme_blocks *blk);
    the sum of f's results. */
 int64_t getme__blocks_run(const getme_blocks *blk, const getme_ws *ws,
                           int64_t (*f)(void *ctx, int32_t b), void *ctx);
+
+/* The block of element e (type t). */
+static inline int32_t getme__blocks_of(const getme_blocks *blk,
+                                       const getme_ws *ws, int t, int32_t e)
+{
+    return blk->tblock[t] + (e - ws->tstart[t]) / blk->bsize;
+}
+
+/* blk->group for the elements list[0..n): in parallel on ws->nt threads,
+   each counting, then placing, the entries of its share of the list; the
+   result does not depend on the threads.  GETME_OK or GETME_ERR_NOMEM
+   (the group is then empty and the caller goes without it). */
+getme_status getme__blocks_group(getme_blocks *blk, const getme_ws *ws,
+                                 const int32_t *list, int32_t n);
 
 /* The local node indices of element e (type t). */
 static inline const uint16_t *getme__blocks_lnodes(const getme_blocks *blk,

@@ -127,8 +127,7 @@ static inline int add_transformed(getme_run *run, int t, int32_t e,
         int32_t n = c[i];
         if (ws->fixed[n])
             continue;
-        ovf |= add_node(run, n, w, y + 3 * i);
-        run->in_t[n] = 1;
+        ovf |= add_node(run, n, w, y + 3 * i); /* n is in I_T already */
     }
     return ovf;
 }
@@ -416,10 +415,53 @@ static void lists_all(getme_run *run)
     run->num_elems = (int32_t)ws->num_free_elem;
 }
 
+/* Below this many elements around I_T, scatter_some and update_after's
+   sums run on one thread: grouping the list by block and the block sweep's
+   parallel regions would cost more than they save. */
+#ifdef GETME_CHECK_SUMS /* test builds: the grouped path on any mesh */
+#define SOME_PAR_MIN 1
+#else
+#define SOME_PAR_MIN 4096
+#endif
+
+/* What a block of scatter_some's or update_after's parallel sweep needs. */
+struct some_ctx {
+    getme_run *run;
+    double qt, sigma;
+    getme_ufx *tally; /* update_after: per thread, 4 apart (a cache line) */
+};
+
+/* The contributions of the elements of block b that are in run->elems
+   (grouped: getme__blocks_group): those in run->tlist (tflag) transformed,
+   those above q_t with their nodes in I_T untransformed, as scatter_some
+   adds them serially.  Returns 1 on a bound overflow (add_node). */
+static int64_t scatter_some_block(void *ctx, int32_t b)
+{
+    const struct some_ctx *s = ctx;
+    getme_run *run = s->run;
+    const struct getme_block_group *g = &run->adj->blk.group;
+    if (g->ptr[b] == g->ptr[b + 1])
+        return 0;
+    int t = getme__ws_type(run->ws, run->ws->block_start[b]);
+    int ovf = 0;
+    for (int32_t j = g->ptr[b]; j < g->ptr[b + 1]; j++) {
+        int32_t e = run->elems[g->pos[j]];
+        if (run->tflag[e])
+            ovf |= add_transformed(run, t, e, s->sigma);
+        if (run->q[e] > s->qt && getme__owned(run, e))
+            ovf |= add_untransformed(run, t, e);
+    }
+    return ovf;
+}
+
 /* q*_min stage: only the elements in run->tlist (q <= q_t) are transformed,
    and the untransformed ones around their moving nodes add their nodes.
-   The lists are small, so this runs on one thread in list order, which
-   also fixes the order of the sums. */
+   I_T and the elements around it are listed on one thread, in list order.
+   The sums are exact integers (exact.h), so their order does not matter:
+   with enough elements the contributions are added block by block in the
+   blocks' race-free order (block_local.h; blocks running at the same time
+   share no node, so no atomics), else in list order on one thread; the
+   same bits either way. */
 static int32_t scatter_some(getme_run *run, double qt, double sigma)
 {
     const getme_ws *ws = run->ws;
@@ -454,6 +496,15 @@ static int32_t scatter_some(getme_run *run, double qt, double sigma)
         run->eflag[run->elems[k]] = 0;
     run->num_nodes = nn;
     run->num_elems = ne;
+    run->adj->blk.group.n = -1; /* run->elems changed */
+    if (ws->nt > 1 && ne >= SOME_PAR_MIN &&
+        getme__blocks_group(&run->adj->blk, ws, run->elems, ne) == GETME_OK) {
+        /* update_after's sums use the same grouping (run->elems stays) */
+        struct some_ctx s = {run, qt, sigma, NULL};
+        run->overflow |= getme__blocks_run(&run->adj->blk, ws,
+                                           scatter_some_block, &s) != 0;
+        return run->num_t;
+    }
     int ovf = 0;
     for (int32_t k = 0; k < run->num_t; k++) {
         int32_t e = run->tlist[k];
@@ -494,22 +545,65 @@ static int tlist_reserve(getme_run *run, int64_t n)
    (only those elements can have entered or left it).  The sums are exact
    fixed point (exact.h): an update by the difference of the old and new
    fixed-point qualities gives the same bits as a recomputation. */
+/* Element run->elems[k] (type t), its quality changed from run->qold[k]:
+   its move of the Eq. 9 sums (getme__adj_add) and of q_mean's sum (*tsum
+   when there is a tally). */
+static inline void sum_change(getme_run *run, int t, int32_t k,
+                              getme_ufx *tsum)
+{
+    getme_adj *adj = run->adj;
+    int32_t e = run->elems[k];
+    double qo = run->qold[k], qn = run->q[e];
+    if (qn == qo)
+        return;
+    if (run->tally)
+        *tsum += getme__tally_diff(qo, qn);
+    uint64_t d = (uint64_t)getme__fx64(qn, adj->qscale) -
+                 (uint64_t)getme__fx64(qo, adj->qscale);
+    getme__adj_add(adj, run->ws, t, e, getme__ws_nodes(run->ws, t, e), d);
+}
+
+/* update_after's sums for the elements of block b in run->elems (as
+   scatter_some grouped them): a block's elements' nodes and edges are no
+   other block's running at the same time; q_mean's sum moves by the
+   thread's total. */
+static int64_t update_block(void *ctx, int32_t b)
+{
+    const struct some_ctx *s = ctx;
+    getme_run *run = s->run;
+    const struct getme_block_group *g = &run->adj->blk.group;
+    if (g->ptr[b] == g->ptr[b + 1])
+        return 0;
+    int t = getme__ws_type(run->ws, run->ws->block_start[b]);
+    getme_ufx *tsum = s->tally + 4 * omp_get_thread_num();
+    for (int32_t j = g->ptr[b]; j < g->ptr[b + 1]; j++)
+        sum_change(run, t, g->pos[j], tsum);
+    return 0;
+}
+
 static getme_status update_after(getme_run *run, double qt)
 {
     const getme_ws *ws = run->ws;
     getme_adj *adj = run->adj;
     if (!run->qold) /* no room for the old qualities: recompute all sums */
         getme__adj_sums_all(adj, ws, run->q);
-    for (int32_t k = 0; run->qold && k < run->num_elems; k++) {
-        int32_t e = run->elems[k];
-        if (run->q[e] == run->qold[k])
-            continue;
+    getme_ufx *tsum = NULL;
+    if (run->qold && adj->blk.group.n == run->num_elems)
+        tsum = aligned_alloc(64, (size_t)ws->nt * 4 * sizeof *tsum);
+    if (tsum) { /* in the blocks' race-free order, as scatter_some */
+        for (int p = 0; p < ws->nt; p++)
+            tsum[4 * p] = 0;
+        struct some_ctx s = {run, qt, 0.0, tsum};
+        getme__blocks_run(&adj->blk, ws, update_block, &s);
+        for (int p = 0; run->tally && p < ws->nt; p++)
+            run->tally->sum += tsum[4 * p];
+        free(tsum);
+    } else {
+        getme_ufx d = 0;
+        for (int32_t k = 0; run->qold && k < run->num_elems; k++)
+            sum_change(run, getme__ws_type(ws, run->elems[k]), k, &d);
         if (run->tally)
-            getme__tally_change(run->tally, run->qold[k], run->q[e]);
-        uint64_t d = (uint64_t)getme__fx64(run->q[e], adj->qscale) -
-                     (uint64_t)getme__fx64(run->qold[k], adj->qscale);
-        int t = getme__ws_type(ws, e);
-        getme__adj_add(adj, ws, t, e, getme__ws_nodes(ws, t, e), d);
+            run->tally->sum += d;
     }
 
     /* distributed: every process stops if one has no room (else the

@@ -32,10 +32,18 @@ static inline void getme__tally_start(getme_tally *t, const getme_ws *ws,
     t->sum = getme__det_sum_fx(q, ws->ne, ws->nt);
 }
 
+/* What the sum moves by when an element's quality old becomes new
+   (wrapping: a parallel caller adds these up per thread, then adds the
+   threads' totals to the sum, the same integer in any order). */
+static inline getme_ufx getme__tally_diff(double old, double new)
+{
+    return (getme_ufx)getme__fx_q(new) - (getme_ufx)getme__fx_q(old);
+}
+
 /* Element quality old became new. */
 static inline void getme__tally_change(getme_tally *t, double old, double new)
 {
-    t->sum += (getme_ufx)getme__fx_q(new) - (getme_ufx)getme__fx_q(old);
+    t->sum += getme__tally_diff(old, new);
 }
 
 /* q_mean of ne elements, the bits getme__ws_summary gives. */

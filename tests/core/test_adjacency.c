@@ -268,6 +268,48 @@ static int32_t check_order(const getme_blocks *blk, const getme_ws *ws)
     return blk->part_ptr[GETME_ORDER_LEVELS * np];
 }
 
+/* getme__blocks_of and getme__blocks_group (block_local.h): every
+   element's block holds it; a list of every third element, backwards,
+   grouped by block: each block lists exactly the positions of its
+   elements, ascending.  Returns the group's positions (caller frees), to
+   compare across thread counts. */
+static int32_t *check_group(getme_blocks *blk, const getme_ws *ws)
+{
+    int ok = 1;
+    for (int32_t b = 0; b < ws->num_blocks; b++)
+        for (int32_t e = ws->block_start[b]; e < ws->block_start[b + 1]; e++)
+            ok &= getme__blocks_of(blk, ws, getme__ws_type(ws, e), e) == b;
+    CHECK(ok);
+    int32_t n = 0;
+    int32_t *list = malloc((size_t)(ws->ne / 3 + 1) * sizeof *list);
+    for (int32_t e = ws->ne - 1; e >= 0; e -= 3)
+        list[n++] = e;
+    CHECK(getme__blocks_group(blk, ws, list, n) == GETME_OK);
+    const struct getme_block_group *g = &blk->group;
+    CHECK_EQ_INT(g->n, n);
+    CHECK_EQ_INT(g->ptr[0], 0);
+    CHECK_EQ_INT(g->ptr[ws->num_blocks], n);
+    uint8_t *seen = calloc((size_t)n + 1, 1);
+    for (int32_t b = 0; b < ws->num_blocks; b++) {
+        int32_t expect = 0; /* list entries in block b */
+        for (int32_t k = 0; k < n; k++)
+            expect += list[k] >= ws->block_start[b] && list[k] < ws->block_start[b + 1];
+        ok &= g->ptr[b + 1] - g->ptr[b] == expect;
+        for (int32_t j = g->ptr[b]; j < g->ptr[b + 1]; j++) {
+            int32_t k = g->pos[j];
+            ok &= k >= 0 && k < n && !seen[k];
+            ok &= j == g->ptr[b] || g->pos[j - 1] < k;
+            ok &= list[k] >= ws->block_start[b] && list[k] < ws->block_start[b + 1];
+            seen[k] = 1;
+        }
+    }
+    CHECK(ok);
+    int32_t *pos = malloc((size_t)n * sizeof *pos + 1);
+    memcpy(pos, g->pos, (size_t)n * sizeof *pos);
+    free(seen), free(list);
+    return pos;
+}
+
 /* A 24^3 Kuhn grid (162 blocks) for 1-4 threads: the order is race-free,
    the parts take the blocks they should, and the Eq. 9 sums built in it
    are the same integers for every thread count. */
@@ -278,6 +320,7 @@ static void check_block_order(void)
     N = 5;
     getme_mesh *mesh = to_mesh(&g);
     int64_t *ref = NULL;
+    int32_t *gref = NULL;
     for (int nt = 1; nt <= 4; nt++) {
         getme_ws ws;
         getme_adj adj;
@@ -291,6 +334,13 @@ static void check_block_order(void)
            wide, so the interfaces hold many of them */
         static const int32_t expect[5] = {0, 162, 86, 18, 20};
         CHECK_EQ_INT(in_parts, expect[nt]);
+        int32_t *pos = check_group(&adj.blk, &ws);
+        if (!gref) { /* the same grouping for every nt */
+            gref = pos;
+        } else {
+            CHECK(memcmp(gref, pos, (size_t)((ws.ne + 2) / 3) * sizeof *pos) == 0);
+            free(pos);
+        }
         double *q = malloc((size_t)ws.ne * sizeof *q);
         for (int32_t e = 0; e < ws.ne; e++)
             q[e] = 0.05 + 0.9 * (double)((ws.elem_orig[e] * 7919) % 1000) / 1000.0;
@@ -305,7 +355,7 @@ static void check_block_order(void)
         getme__adj_free(&adj);
         getme__ws_free(&ws);
     }
-    free(ref);
+    free(ref), free(gref);
     getme_mesh_free(mesh);
     free_gen(&g);
 }
@@ -363,7 +413,9 @@ static void check_live_sums(void)
    getme__tally_change in update_after, or one star from best.c's rescore,
    makes these runs return it).  Several distortions, so that some runs end
    the q*_min stage below their best (keep_best restores) and all run
-   finishing passes; 1 and 2 threads give the same result. */
+   finishing passes; 1 and 2 threads give the same result (with 2, test
+   builds run scatter_some and update_after's sums block by block, in
+   parallel: getme_adaptive.c's SOME_PAR_MIN). */
 typedef struct tail_seen {
     double best_min, last_min; /* over the q*_min stage */
     int finish_passes;
@@ -449,6 +501,7 @@ static uint8_t *check_formula(const gen *g, int nt, getme_ws *ws,
     }
     CHECK(exact);
     check_blocks(&adj.blk, ws);
+    free(check_group(&adj.blk, ws));
     uint8_t *irr = malloc((size_t)ws->ne);
     memcpy(irr, adj.irregular, (size_t)ws->ne);
     getme__adj_free(&adj);
