@@ -270,6 +270,37 @@ static void ho_ratio(gg_run *run, double *ratio, size_t *tag)
         *tag = run->model->elem_tags[e];
 }
 
+/* The mesh's statistics and measures from one sweep over its elements
+   (each evaluated once), and its qualities into *q (the caller frees
+   them) when q is not NULL, for the worst lists.  GETME_ERR_NOMEM when
+   the qualities get no room (the mesh's message is then not set). */
+static getme_status sweep(getme_mesh *mesh, getme_quality_stats *stats,
+                          getme_measure_stats *measures, double **q)
+{
+    int32_t ne = getme_mesh_num_elements(mesh);
+    double *v = malloc((size_t)(ne ? ne : 1) * sizeof *v);
+    if (q)
+        *q = NULL;
+    if (!v)
+        return GETME_ERR_NOMEM;
+    getme_status st = getme_mesh_measure_all_qualities(mesh, measures, v);
+    if (st == GETME_OK)
+        st = getme_mesh_quality_stats_from(mesh, v, -1, stats);
+    if (st == GETME_OK && q)
+        *q = v;
+    else
+        free(v);
+    return st;
+}
+
+/* fail() for a sweep() that failed. */
+static getme_status sweep_failed(gg_run *run, getme_status st)
+{
+    getme_mesh *mesh = getme_gmsh_model_mesh(run->model);
+    return fail(run, st, st == GETME_ERR_NOMEM ? "out of memory"
+                                                : getme_mesh_error(mesh));
+}
+
 /* Sizes and quality of run->model into the report; refuse invalid ones. */
 static getme_status check_model(gg_run *run)
 {
@@ -281,11 +312,9 @@ static getme_status check_model(gg_run *run)
     r->num_nodes = getme_mesh_num_nodes(mesh);
     r->num_elements = getme_mesh_num_elements(mesh);
     r->num_fixed = getme_mesh_num_fixed(mesh);
-    st = getme_mesh_quality_stats(mesh, -1, &r->before);
-    if (st == GETME_OK)
-        st = getme_mesh_measure_all(mesh, &r->measures_before[0][0]);
+    st = sweep(mesh, &r->before, &r->measures_before[0][0], NULL);
     if (st != GETME_OK)
-        return fail(run, st, getme_mesh_error(mesh));
+        return sweep_failed(run, st);
     ho_ratio(run, &r->jacobian_ratio_before, &r->jacobian_ratio_tag_before);
     r->jacobian_ratio_after = r->jacobian_ratio_before;
     r->jacobian_ratio_tag_after = r->jacobian_ratio_tag_before;
@@ -293,18 +322,19 @@ static getme_status check_model(gg_run *run)
 }
 
 /* The worst elements of the smoothed mesh into the report, with their
-   Gmsh tags. */
-static getme_status fill_worst(gg_run *run)
+   Gmsh tags; q: the mesh's qualities (sweep()). */
+static getme_status fill_worst(gg_run *run, const double *q)
 {
     getme_mesh *mesh = getme_gmsh_model_mesh(run->model);
     getme_gmsh_report *r = run->rep;
     const size_t *tags = run->model->elem_tags;
-    getme_status st = getme_mesh_worst_elements(mesh, run->opt->worst, 0,
-                                                r->worst, &r->num_worst);
+    getme_status st = getme_mesh_worst_elements_from(
+        mesh, q, run->opt->worst, 0, r->worst, &r->num_worst);
     if (st == GETME_OK)
-        st = getme_mesh_worst_elements(mesh, run->opt->worst,
-                                       GETME_WORST_FREE_ONLY, r->worst_free,
-                                       &r->num_worst_free);
+        st = getme_mesh_worst_elements_from(mesh, q, run->opt->worst,
+                                            GETME_WORST_FREE_ONLY,
+                                            r->worst_free,
+                                            &r->num_worst_free);
     for (int32_t i = 0; st == GETME_OK && i < r->num_worst; i++)
         r->worst_tag[i] = tags[r->worst[i].element];
     for (int32_t i = 0; st == GETME_OK && i < r->num_worst_free; i++)
@@ -327,11 +357,13 @@ static getme_status smooth_and_apply(gg_run *run, int niter)
     if (st != GETME_OK && st != GETME_ERR_CANCELLED)
         return fail(run, st, getme_mesh_error(mesh));
     /* A cancelled run still leaves a valid, partly smoothed mesh. */
-    getme_status st2 = getme_mesh_quality_stats(mesh, -1, &run->rep->after);
-    if (st2 == GETME_OK)
-        st2 = fill_worst(run);
-    if (st2 == GETME_OK)
-        st2 = getme_mesh_measure_all(mesh, &run->rep->measures_after[0][0]);
+    double *q;
+    getme_status st2 = sweep(mesh, &run->rep->after,
+                             &run->rep->measures_after[0][0], &q);
+    if (st2 != GETME_OK)
+        return sweep_failed(run, st2);
+    st2 = fill_worst(run, q);
+    free(q);
     if (st2 == GETME_OK)
         ho_ratio(run, &run->rep->jacobian_ratio_after,
                  &run->rep->jacobian_ratio_tag_after);
@@ -498,15 +530,14 @@ getme_status getme_gmsh_quality(const int *dim_tags, size_t dim_tags_n,
     run.rep->num_nodes = getme_mesh_num_nodes(mesh);
     run.rep->num_elements = getme_mesh_num_elements(mesh);
     run.rep->num_fixed = getme_mesh_num_fixed(mesh);
-    st = getme_mesh_quality_stats(mesh, -1, &run.rep->before);
-    if (st == GETME_OK)
-        st = getme_mesh_measure_all(mesh, &run.rep->measures_before[0][0]);
+    st = sweep(mesh, &run.rep->before, &run.rep->measures_before[0][0], NULL);
     run.rep->after = run.rep->before;
     memcpy(run.rep->measures_after, run.rep->measures_before,
            sizeof run.rep->measures_after);
     if (st != GETME_OK)
         snprintf(run.rep->message, sizeof run.rep->message, "%s",
-                 getme_mesh_error(mesh));
+                 st == GETME_ERR_NOMEM ? "out of memory"
+                                       : getme_mesh_error(mesh));
     getme_gmsh_model_free(run.model);
     return st;
 }
