@@ -147,6 +147,28 @@ static inline void getme__adj_add(getme_adj *adj, const getme_ws *ws, int t,
         }
 }
 
+/* The fixed-point qualities of the nf face neighbours f (-1: none) of an
+   element, summed in wrapping uint64 arithmetic (getme__adj_nsum_sv). */
+static inline uint64_t getme__adj_face_q(const getme_adj *adj,
+                                         const double *q, const int32_t *f,
+                                         int nf)
+{
+    uint64_t sf = 0;
+    for (int k = 0; k < nf; k++)
+        sf += f[k] >= 0 ? (uint64_t)getme__fx64(q[f[k]], adj->qscale) : 0;
+    return sf;
+}
+
+/* The sum over N(e) of a regular 3-D element with nf faces from its
+   pieces (getme__adj_nsum_sv): the S_v of its nodes sv, the S_e of its
+   edges se, the face neighbours' qualities sf and its own qe. */
+static inline double getme__adj_nsum_3d(const getme_adj *adj, uint64_t sv,
+                                        uint64_t se, uint64_t sf, uint64_t qe,
+                                        int nf)
+{
+    return (double)(sv - se + (uint64_t)(nf - 1) * qe + sf) * adj->qinv;
+}
+
 /* Sum of q over N(e) for a regular element e of type t (see above), as
    the nearest double to the exact sum of the fixed-point qualities: the
    inclusion-exclusion is exact in integers, so it equals the union walk's
@@ -165,18 +187,14 @@ static inline double getme__adj_nsum_sv(const getme_adj *adj,
        below 2^(61 - b), over fewer than nv 2^b elements (N(e) is inside
        the union of nv stars), so below nv 2^61 <= 2^64: the true value is
        what the wrapped uint64 holds, whatever the partial sums did. */
-    const double qs = adj->qscale;
-    uint64_t sf = 0, se = 0;
-    for (int k = 0; k < ft->num_faces; k++)
-        sf += f[k] >= 0 ? (uint64_t)getme__fx64(q[f[k]], qs) : 0;
-    uint64_t qe = (uint64_t)getme__fx64(q[e], qs);
+    uint64_t se = 0, sf = getme__adj_face_q(adj, q, f, ft->num_faces);
+    uint64_t qe = (uint64_t)getme__fx64(q[e], adj->qscale);
     if (ws->dim == 2) /* sum_e S_e = nv q_E + sf, plus q_E once */
         return (double)(sv - (uint64_t)(nv - 1) * qe - sf) * adj->qinv;
     const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
     for (int k = 0; k < getme__edges[t].num_edges; k++)
         se += (uint64_t)adj->esum[getme__adj_edge(adj, c, t, k, slot[k])];
-    return (double)(sv - se + (uint64_t)(ft->num_faces - 1) * qe + sf) *
-           adj->qinv;
+    return getme__adj_nsum_3d(adj, sv, se, sf, qe, ft->num_faces);
 }
 
 /* The same, with S_v read from the global sums. */

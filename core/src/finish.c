@@ -329,11 +329,11 @@ static void pool_summary(getme_run *run, const pool *pl, double *q_mean,
 {
     const getme_ws *ws = run->ws;
     *q_mean = getme__tally_mean(&pl->tally, ws->ne);
-    double m = INFINITY;
-    for (int32_t k = 0; k < pl->n; k++)
-        m = run->q[pl->e[k]] < m ? run->q[pl->e[k]] : m;
+    /* getme__ws_summary's minimum starts at 1.0 too: when the capped
+       minimum is above top, so is every pool element's */
+    double m = getme__tally_min(run->q, pl->e, pl->n);
     if (m <= pl->top) {
-        *q_min = m < 1.0 ? m : 1.0;
+        *q_min = m;
     } else {
         double mean;
         getme__ws_summary(ws, run->q, &mean, q_min, NULL);

@@ -200,17 +200,15 @@ weights_3d(int t, const getme_run *run, int32_t e0, int32_t e1,
                 continue;
             const uint16_t *lc = getme__blocks_lnodes(blk, ws, t, e);
             const int32_t *f = getme__adj_faces(adj, ws, t, e);
-            uint64_t sv = 0, se = 0, sf = 0;
+            uint64_t sv = 0, se = 0;
             for (int i = 0; i < nv; i++)
                 sv += (uint64_t)ls[lc[i]];
             for (int j = 0; j < ned; j++)
                 se += (uint64_t)adj->esum[eid[e - c0][j]];
-            for (int j = 0; j < nf; j++)
-                sf += f[j] >= 0 ? (uint64_t)getme__fx64(q[f[j]], qs) : 0;
-            uint64_t qe = (uint64_t)getme__fx64(q[e], qs);
-            /* getme__adj_nsum_sv's wrapping sum, term for term */
-            num[e - c0] = (double)(sv - se + (uint64_t)(nf - 1) * qe + sf) *
-                          adj->qinv;
+            /* getme__adj_nsum_sv's wrapping sum, from the same pieces */
+            num[e - c0] = getme__adj_nsum_3d(
+                adj, sv, se, getme__adj_face_q(adj, q, f, nf),
+                (uint64_t)getme__fx64(q[e], qs), nf);
             den[e - c0] = (double)adj->count[e] * q[e];
         }
         int64_t wv[WEIGHT_CHUNK];
@@ -539,12 +537,6 @@ static int tlist_reserve(getme_run *run, int64_t n)
     return 0;
 }
 
-/* After an iteration of the q*_min stage: bring the Eq. 9 sums up to date
-   by the quality changes of the elements that moved (run->elems; their old
-   qualities are in run->qold), and the list of elements with q <= q_t
-   (only those elements can have entered or left it).  The sums are exact
-   fixed point (exact.h): an update by the difference of the old and new
-   fixed-point qualities gives the same bits as a recomputation. */
 /* Element run->elems[k] (type t), its quality changed from run->qold[k]:
    its move of the Eq. 9 sums (getme__adj_add) and of q_mean's sum (*tsum
    when there is a tally). */
@@ -581,6 +573,12 @@ static int64_t update_block(void *ctx, int32_t b)
     return 0;
 }
 
+/* After an iteration of the q*_min stage: bring the Eq. 9 sums up to date
+   by the quality changes of the elements that moved (run->elems; their old
+   qualities are in run->qold), and the list of elements with q <= q_t
+   (only those elements can have entered or left it).  The sums are exact
+   fixed point (exact.h): an update by the difference of the old and new
+   fixed-point qualities gives the same bits as a recomputation. */
 static getme_status update_after(getme_run *run, double qt)
 {
     const getme_ws *ws = run->ws;

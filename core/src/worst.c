@@ -59,23 +59,15 @@ static void keep_worst(getme_worst_element *w, int32_t *n, int32_t max,
 /* One thread's elements with a marked node, in element order. */
 typedef struct hits {
     int32_t *e;
-    int32_t n, cap;
-    int failed;
+    int32_t n;
+    int64_t cap;
+    int failed; /* a push found no room: the scan's result is lost */
 } hits;
 
 static void hits_push(hits *h, int32_t e)
 {
-    if (h->n == h->cap) {
-        int32_t cap = h->cap ? 2 * h->cap : 256;
-        int32_t *grown =
-            h->failed ? NULL : realloc(h->e, (size_t)cap * sizeof *grown);
-        if (!grown) {
-            h->failed = 1;
-            return;
-        }
-        h->e = grown, h->cap = cap;
-    }
-    h->e[h->n++] = e;
+    if (!h->failed && getme__push_i32(&h->e, &h->n, &h->cap, e))
+        h->failed = 1;
 }
 
 /* The elements of block bl with a marked node, appended to *list (*m of
