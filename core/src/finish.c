@@ -29,6 +29,7 @@
  * constant rest of the mesh, and each pass first checks that everything
  * it can touch is inside (else GETME_ERR_INCOMPLETE).
  */
+#include "finish_levels.h"
 #include "patch.h"
 #include "smooth_internal.h"
 #include "tally.h"
@@ -96,14 +97,29 @@ static int memo_init(climb_memo *m)
     return memo_alloc(m, 4096);
 }
 
-/* The entry of node, created if add (NULL if absent, or no memory). */
-static memo_slot *memo_at(climb_memo *m, int32_t node, int add)
+/* Where node's entry is, or the empty slot where it would go. */
+static uint32_t memo_probe(const climb_memo *m, int32_t node)
 {
     uint32_t mask = m->cap - 1, i = ((uint32_t)node * 2654435761u) & mask;
     while (m->slot[i].node >= 0 && m->slot[i].node != node)
         i = (i + 1) & mask;
-    if (m->slot[i].node == node || !add)
-        return m->slot[i].node == node ? &m->slot[i] : NULL;
+    return i;
+}
+
+/* The entry of node, or NULL (read only: a levelled sweep's threads share
+   the memo while no one writes it). */
+static const memo_slot *memo_find(const climb_memo *m, int32_t node)
+{
+    const memo_slot *s = &m->slot[memo_probe(m, node)];
+    return s->node == node ? s : NULL;
+}
+
+/* The entry of node, created if absent (NULL if no memory). */
+static memo_slot *memo_at(climb_memo *m, int32_t node)
+{
+    uint32_t i = memo_probe(m, node);
+    if (m->slot[i].node == node)
+        return &m->slot[i];
     if (2 * (m->used + 1) > m->cap) { /* grow: rehash into twice the room */
         climb_memo old = *m;
         if (memo_alloc(m, 2 * old.cap) != 0) {
@@ -112,9 +128,9 @@ static memo_slot *memo_at(climb_memo *m, int32_t node, int add)
         }
         for (uint32_t k = 0; k < old.cap; k++)
             if (old.slot[k].node >= 0)
-                *memo_at(m, old.slot[k].node, 1) = old.slot[k];
+                *memo_at(m, old.slot[k].node) = old.slot[k];
         free(old.slot);
-        return memo_at(m, node, 1);
+        return memo_at(m, node);
     }
     m->used++;
     m->slot[i] = (memo_slot){node, 0, 0};
@@ -127,7 +143,7 @@ static int memo_moved(climb_memo *m, const int32_t *mv, int k)
 {
     m->stamp++;
     for (int j = 0; j < k; j++) {
-        memo_slot *s = memo_at(m, mv[j], 1);
+        memo_slot *s = memo_at(m, mv[j]);
         if (!s)
             return -1;
         s->moved = m->stamp;
@@ -135,9 +151,11 @@ static int memo_moved(climb_memo *m, const int32_t *mv, int k)
     return 0;
 }
 
-static void memo_failed(climb_memo *m, const getme_patch *p, int32_t node)
+/* A failed climb of node with the patch's loss, budget and allowed_max
+   (f.stamp is ignored: it failed after every move kept so far). */
+static void memo_failed(climb_memo *m, int32_t node, fail_record f)
 {
-    memo_slot *s = memo_at(m, node, 1);
+    memo_slot *s = memo_at(m, node);
     if (!s)
         return; /* not remembered: it is climbed again */
     if (!s->rec) {
@@ -150,15 +168,18 @@ static void memo_failed(climb_memo *m, const getme_patch *p, int32_t node)
         }
         s->rec = ++m->num_rec;
     }
-    m->rec[s->rec - 1] =
-        (fail_record){m->stamp, p->loss, p->budget, p->allowed_max};
+    f.stamp = m->stamp;
+    m->rec[s->rec - 1] = f;
 }
 
-/* 1 if climbing node alone is known to keep no step (see above). */
-static int memo_fails(climb_memo *m, const getme_ws *ws, const getme_patch *p,
-                      int32_t node)
+/* 1 if climbing node alone is known to keep no step (see above); the nl
+   nodes local moved since the memo last heard of moves (a levelled sweep's
+   element, whose moves reach the memo after its level) count as moved. */
+static int memo_fails(const climb_memo *m, const getme_ws *ws,
+                      const getme_patch *p, int32_t node,
+                      const int32_t *local, int nl)
 {
-    const memo_slot *s = m ? memo_at(m, node, 0) : NULL;
+    const memo_slot *s = m ? memo_find(m, node) : NULL;
     if (!s || !s->rec)
         return 0;
     const fail_record *r = &m->rec[s->rec - 1];
@@ -170,9 +191,12 @@ static int memo_fails(climb_memo *m, const getme_ws *ws, const getme_patch *p,
         int t = getme__ws_type(ws, e);
         const int32_t *c = getme__ws_nodes(ws, t, e);
         for (int i = 0; i < getme__nv[t]; i++) {
-            const memo_slot *o = memo_at(m, c[i], 0);
+            const memo_slot *o = memo_find(m, c[i]);
             if (o && o->moved > r->stamp)
                 return 0;
+            for (int a = 0; a < nl; a++)
+                if (local[a] == c[i])
+                    return 0;
         }
     }
     return 1;
@@ -230,18 +254,32 @@ static void pool_free(getme_run *run, pool *pl)
     free(pl->v);
 }
 
+/* 1 if element e, whose quality became new, joins the pool (it is not
+   in yet and now at or below top). */
+static int pool_wants(const getme_run *run, const pool *pl, int32_t e,
+                      double new)
+{
+    return new <= pl->top && !(run->eflag[e] & POOLED) &&
+           run->ws->free_elem[e];
+}
+
+/* e joins the pool (or the pool is marked lost). */
+static void pool_add(getme_run *run, pool *pl, int32_t e)
+{
+    if (getme__push_i32(&pl->e, &pl->n, &pl->cap, e))
+        pl->lost = 1;
+    else
+        run->eflag[e] |= POOLED;
+}
+
 /* Element e's quality became new (from old): the sum follows, and e joins
    the pool if it is now at or below top. */
 static void pool_change(getme_run *run, pool *pl, int32_t e, double old,
                         double new)
 {
     getme__tally_change(&pl->tally, old, new);
-    if (new <= pl->top && !(run->eflag[e] & POOLED) && run->ws->free_elem[e]) {
-        if (getme__push_i32(&pl->e, &pl->n, &pl->cap, e))
-            pl->lost = 1;
-        else
-            run->eflag[e] |= POOLED;
-    }
+    if (pool_wants(run, pl, e, new))
+        pool_add(run, pl, e);
 }
 
 /* The pool of the free elements with q <= top, top at position
@@ -340,13 +378,78 @@ static void pool_summary(getme_run *run, const pool *pl, double *q_mean,
     }
 }
 
-/* Put the elements around the k nodes mv into the patch (each once). */
+/*
+ * One thread's state.  A serial sweep (one thread, second order, a
+ * sub-mesh, or a short list) uses one worker, which writes the memo and
+ * the pool as it goes.  In a levelled sweep (see "Levelled sweeps" below)
+ * every thread has its own, and what would be written to shared state is
+ * logged instead and merged after each level: the memo's events, the
+ * pool's sum (an exact integer difference) and candidates, each accepted
+ * move's change of the total quality, and the coordinates needed to take
+ * a sweep back.
+ */
+typedef struct memo_event {
+    int32_t node;  /* -1: a kept move starts (the memo's stamp counts it) */
+    int32_t failed; /* node's climb failed (else node moved in that move) */
+    fail_record f;
+} memo_event;
+
+typedef struct undo_rec {
+    int32_t node;
+    double x[3]; /* its coordinates before the element's improve() */
+} undo_rec;
+
+/* Accepted moves of one improve() at most: 8 steps per single-node climb
+   of up to 8 nodes, one toward move and 4 steps of the joint climb. */
+#define LOG_CAP (8 * GETME_PATCH_MAX_MOVE + 8)
+
+typedef struct worker {
+    getme_patch p;
+    int levelled;
+    int32_t mvd[GETME_PATCH_MAX_MOVE]; /* nodes this element moved so far */
+    int nmvd;
+    memo_event *ev; /* levelled: memo events of this level */
+    int64_t nev, cap_ev;
+    int memo_lost;  /* an event could not be logged: drop the memo */
+    double *cg;     /* levelled: accepted moves' changes, this sweep */
+    int64_t ncg, cap_cg;
+    undo_rec *un;   /* levelled, second sweep: coordinates to take back */
+    int64_t nun, cap_un;
+    int32_t *padd;  /* levelled: elements for the pool (repeats allowed) */
+    int32_t npadd;
+    int64_t cap_padd;
+    int lost;       /* one could not be logged: the pool is built again */
+    getme_ufx dtally; /* levelled: the pool sum's change */
+    getme_status st;
+    double log[LOG_CAP];
+} worker;
+
+/* Room for need entries of size bytes in *buf (room *cap, doubled); 0 or
+   -1 without memory. */
+static int reserve(void **buf, int64_t *cap, int64_t need, size_t size)
+{
+    if (need <= *cap)
+        return 0;
+    int64_t c = *cap ? 2 * *cap : 256;
+    c = c < need ? need : c;
+    void *b = realloc(*buf, (size_t)c * size);
+    if (!b)
+        return -1;
+    *buf = b, *cap = c;
+    return 0;
+}
+
+/* Put the elements around the k nodes mv into the patch (each once), with
+   their qualities from run->q if known (else evaluated). */
 static getme_status fill(getme_run *run, getme_patch *p, const int32_t *mv,
-                         int k)
+                         int k, int known)
 {
     const getme_ws *ws = run->ws;
     getme__patch_clear(p);
     getme_status st = GETME_OK;
+    /* bit 0 of eflag: in this patch.  In a levelled sweep the patches of
+       one level are disjoint (two that shared an element would conflict:
+       it holds a node one of them moves and the other reads) */
     for (int j = 0; j < k && st == GETME_OK; j++)
         for (int64_t s = ws->star_ptr[mv[j]];
              s < ws->star_ptr[mv[j] + 1] && st == GETME_OK; s++) {
@@ -359,6 +462,10 @@ static getme_status fill(getme_run *run, getme_patch *p, const int32_t *mv,
         }
     for (int32_t i = 0; i < p->n; i++)
         run->eflag[p->id[i]] &= (uint8_t)~1;
+    if (!known) {
+        getme__patch_eval(p);
+        return st;
+    }
     /* run->q is current (the smoothing keeps it so, store() too): no need
        to evaluate the elements again */
     getme__patch_eval_known(p, run->q);
@@ -376,21 +483,72 @@ static getme_status fill(getme_run *run, getme_patch *p, const int32_t *mv,
 }
 
 /* Copy the patch's qualities back to run->q (pl: the pool follows, or
-   NULL). */
-static void store(getme_run *run, const getme_patch *p, pool *pl)
+   NULL; in a levelled sweep through the worker's log). */
+static void store(getme_run *run, worker *w, pool *pl)
 {
+    const getme_patch *p = &w->p;
     for (int32_t i = 0; i < p->n; i++) {
-        if (pl)
-            pool_change(run, pl, p->id[i], run->q[p->id[i]], p->q[i]);
-        run->q[p->id[i]] = p->q[i];
+        int32_t e = p->id[i];
+        if (pl && !w->levelled) {
+            pool_change(run, pl, e, run->q[e], p->q[i]);
+        } else if (pl) {
+            w->dtally += getme__tally_diff(run->q[e], p->q[i]);
+            if (pool_wants(run, pl, e, p->q[i]) &&
+                getme__push_i32(&w->padd, &w->npadd, &w->cap_padd, e))
+                w->lost = 1;
+        }
+        run->q[e] = p->q[i];
     }
 }
 
-/* Work on element e (*memo: failed climbs, or NULL). */
-static getme_status improve(getme_run *run, getme_patch *p,
-                            climb_memo **memo, pool *pl, int32_t e)
+/* Log one memo event (or mark the memo lost). */
+static void log_event(worker *w, memo_event ev)
+{
+    if (reserve((void **)&w->ev, &w->cap_ev, w->nev + 1, sizeof *w->ev))
+        w->memo_lost = 1;
+    else
+        w->ev[w->nev++] = ev;
+}
+
+/* The k nodes mv moved in a kept move. */
+static void kept(worker *w, climb_memo **memo, const int32_t *mv, int k)
+{
+    if (!w->levelled) {
+        forget_if(memo, *memo && memo_moved(*memo, mv, k) != 0);
+        return;
+    }
+    for (int j = 0; j < k; j++) {
+        int a = 0;
+        while (a < w->nmvd && w->mvd[a] != mv[j])
+            a++;
+        if (a == w->nmvd) /* the element's free nodes: at most 8 */
+            w->mvd[w->nmvd++] = mv[j];
+    }
+    if (!*memo)
+        return;
+    log_event(w, (memo_event){-1, 0, {0, 0, 0, 0}});
+    for (int j = 0; j < k; j++)
+        log_event(w, (memo_event){mv[j], 0, {0, 0, 0, 0}});
+}
+
+/* Climbing node alone kept no step. */
+static void failed(worker *w, climb_memo *memo, int32_t node)
+{
+    const getme_patch *p = &w->p;
+    fail_record f = {0, p->loss, p->budget, p->allowed_max};
+    if (w->levelled)
+        log_event(w, (memo_event){node, 1, f});
+    else
+        memo_failed(memo, node, f);
+}
+
+/* Work on element e (*memo: failed climbs, or NULL; in a levelled sweep
+   read only). */
+static getme_status improve(getme_run *run, worker *w, climb_memo **memo,
+                            pool *pl, int32_t e)
 {
     const getme_ws *ws = run->ws;
+    getme_patch *p = &w->p;
     int t = getme__ws_type(ws, e);
     const int32_t *c = getme__ws_nodes(ws, t, e);
     int32_t mv[GETME_PATCH_MAX_MOVE];
@@ -400,21 +558,22 @@ static getme_status improve(getme_run *run, getme_patch *p,
             mv[k++] = c[i];
     double q0 = run->q[e];
     getme_status st;
+    w->nmvd = 0;
     for (int j = 0; j < k; j++) {
-        if (memo_fails(*memo, ws, p, mv[j]))
+        if (memo_fails(*memo, ws, p, mv[j], w->mvd, w->nmvd))
             continue;
-        if ((st = fill(run, p, &mv[j], 1)) != GETME_OK)
+        if ((st = fill(run, p, &mv[j], 1, 1)) != GETME_OK)
             return st;
         p->allowed_max = -INFINITY;
         if (getme__patch_climb(p, &mv[j], 1, 8, 1)) {
-            store(run, p, pl);
-            forget_if(memo, *memo && memo_moved(*memo, &mv[j], 1) != 0);
+            store(run, w, pl);
+            kept(w, memo, &mv[j], 1);
         } else if (*memo) {
-            memo_failed(*memo, p, mv[j]);
+            failed(w, *memo, mv[j]);
         }
     }
     if (k >= 2 && !(run->q[e] > q0)) {
-        if ((st = fill(run, p, mv, k)) != GETME_OK)
+        if ((st = fill(run, p, mv, k, 1)) != GETME_OK)
             return st;
         double x[3 * GETME_MAX_NV], y[3 * GETME_MAX_NV];
         double tg[3 * GETME_PATCH_MAX_MOVE];
@@ -428,8 +587,8 @@ static getme_status improve(getme_run *run, getme_patch *p,
         int moved = getme__patch_toward(p, mv, k, tg);
         moved += getme__patch_climb(p, mv, k, 4, 1);
         if (moved) {
-            store(run, p, pl);
-            forget_if(memo, *memo && memo_moved(*memo, mv, k) != 0);
+            store(run, w, pl);
+            kept(w, memo, mv, k);
         }
     }
     return GETME_OK;
@@ -642,32 +801,372 @@ static getme_status pass_summary(getme_run *run, const pool *pl,
     return GETME_OK;
 }
 
+/*
+ * Levelled sweeps.  A sweep worked on its list one element after the
+ * other, ~50 us per element (climbs of up to 8 steps over a node's star),
+ * on one thread.  Elements far apart commute, so on several threads a
+ * sweep runs level by level (finish_levels.h): the elements of one level
+ * share no node one of them writes, so each sees exactly the coordinates
+ * and qualities the serial order gives it, whatever the other threads do.
+ * What they would share is made per thread and merged after each level:
+ * the pool's sum (exact integers) and candidates, and the memo (read only
+ * during a level; each thread logs its moves and failures, and the nodes
+ * an element moved count as moved for its own later look-ups).
+ *
+ * One thing is serial by nature: the budget (getme_patch.budget), the
+ * total quality kept moves gained less what they spent, which carries
+ * from element to element in list order.  A levelled sweep runs with an
+ * unbounded budget and logs every accepted move's change.  With the
+ * serial budget b a trial it accepted (change >= -allowed) is accepted
+ * too exactly when change >= -b, and one it rejected is rejected either
+ * way.  So replaying the changes in list order against the serial budget
+ * (b += change, the serial sum's order) proves every move the serial
+ * sweep makes, up to the first that the budget would have refused.  In
+ * the first sweep of a pass (loss 0: only moves that lose nothing) that
+ * never happens.  In the second it needs a budget smaller than one move's
+ * loss; then the sweep is taken back from that element on (coordinates
+ * restored in reverse level order, qualities evaluated again, the memo
+ * told those nodes moved) and finished serially.  The output is the
+ * serial one, bit for bit, for any thread count.
+ */
+
+/* Lists shorter than this run serially (a level costs a barrier; test
+   builds level any list). */
+#ifdef GETME_FINISH_TEST
+#define LEVELLED_MIN 2
+#else
+#define LEVELLED_MIN 256
+#endif
+
+typedef struct sweep_rec {
+    int32_t worker;      /* which worker's logs hold its entries */
+    int32_t ncg, nun;
+    int64_t cg, un;      /* first entries */
+} sweep_rec;
+
+typedef struct sweep_ctx {
+    getme_run *run;
+    worker *w;
+    int nw;
+    climb_memo **memo;
+    pool *pl;
+    const getme_ranked *list;
+    int32_t n;
+    double bound;
+    getme_levels lv;
+    sweep_rec *rec;
+    int64_t cap_rec;
+} sweep_ctx;
+
+/* Replay a worker's memo events into the memo (merge after a level). */
+static void memo_merge(climb_memo **memo, worker *w)
+{
+    for (int64_t i = 0; i < w->nev && *memo; i++) {
+        const memo_event *ev = &w->ev[i];
+        if (ev->node < 0) {
+            (*memo)->stamp++;
+        } else if (ev->failed) {
+            memo_failed(*memo, ev->node, ev->f);
+        } else {
+            memo_slot *sl = memo_at(*memo, ev->node);
+            forget_if(memo, !sl);
+            if (sl)
+                sl->moved = (*memo)->stamp;
+        }
+    }
+    forget_if(memo, *memo && w->memo_lost);
+    w->nev = 0, w->memo_lost = 0;
+}
+
+/* After a level: the workers' pool changes and memo events. */
+static void merge(sweep_ctx *c)
+{
+    pool *pl = c->pl;
+    for (int t = 0; t < c->nw; t++) {
+        worker *w = &c->w[t];
+        pl->tally.sum += w->dtally;
+        w->dtally = 0;
+        for (int32_t i = 0; i < w->npadd; i++)
+            if (!(c->run->eflag[w->padd[i]] & POOLED))
+                pool_add(c->run, pl, w->padd[i]);
+        pl->lost |= w->lost;
+        w->npadd = 0, w->lost = 0;
+        memo_merge(c->memo, w);
+    }
+}
+
+/* List position i in a levelled sweep, on worker w (undo: log what taking
+   it back needs). */
+static void process(sweep_ctx *c, worker *w, int32_t i, int undo)
+{
+    getme_run *run = c->run;
+    const getme_ws *ws = run->ws;
+    sweep_rec *r = &c->rec[i];
+    int32_t e = c->list[i].e;
+    r->worker = (int32_t)(w - c->w);
+    r->cg = w->ncg, r->un = w->nun;
+    r->ncg = r->nun = 0;
+    if (w->st != GETME_OK || !(run->q[e] <= c->bound))
+        return;
+    int t = getme__ws_type(ws, e);
+    const int32_t *cn = getme__ws_nodes(ws, t, e);
+    undo_rec u[GETME_MAX_NV];
+    int k = 0;
+    for (int j = 0; j < getme__nv[t]; j++)
+        if (!ws->fixed[cn[j]]) {
+            u[k].node = cn[j];
+            memcpy(u[k++].x, ws->x + 3 * (int64_t)cn[j], sizeof u[0].x);
+        }
+    w->p.nlog = 0;
+    getme_status st = improve(run, w, c->memo, c->pl, e);
+    int32_t nl = w->p.nlog;
+    if (st == GETME_OK && nl > LOG_CAP)
+        st = GETME_ERR_STATE; /* not reached: LOG_CAP bounds improve() */
+    if (st == GETME_OK &&
+        (reserve((void **)&w->cg, &w->cap_cg, w->ncg + nl, sizeof *w->cg) ||
+         (undo && nl &&
+          reserve((void **)&w->un, &w->cap_un, w->nun + k, sizeof *w->un))))
+        st = GETME_ERR_NOMEM;
+    if (st != GETME_OK) {
+        w->st = st;
+        return;
+    }
+    memcpy(w->cg + w->ncg, w->log, (size_t)nl * sizeof *w->cg);
+    w->ncg += nl, r->ncg = nl;
+    if (undo && nl) {
+        memcpy(w->un + w->nun, u, (size_t)k * sizeof *u);
+        w->nun += k, r->nun = k;
+    }
+}
+
+/* The serial sweep from list position from on, budget *budget. */
+static getme_status sweep_serial(sweep_ctx *c, int32_t from, double *budget)
+{
+    worker *w = &c->w[0];
+    getme_status st = GETME_OK;
+    w->levelled = 0;
+    w->p.log = NULL;
+    w->p.budget = *budget;
+    for (int32_t i = from; i < c->n && st == GETME_OK; i++)
+        if (c->run->q[c->list[i].e] <= c->bound)
+            st = improve(c->run, w, c->memo, c->pl, c->list[i].e);
+    *budget = w->p.budget;
+    return st;
+}
+
+/* Take the levelled sweep back from list position from on (in reverse
+   level order, so each node gets the value it had before from). */
+static getme_status take_back(sweep_ctx *c, int32_t from)
+{
+    getme_run *run = c->run;
+    const getme_levels *lv = &c->lv;
+    for (int32_t L = lv->num - 1; L >= 0; L--)
+        for (int32_t x = lv->ptr[L]; x < lv->ptr[L + 1]; x++) {
+            const sweep_rec *r = &c->rec[lv->order[x]];
+            if (lv->order[x] < from)
+                continue;
+            for (int32_t j = 0; j < r->nun; j++) {
+                const undo_rec *u = &c->w[r->worker].un[r->un + j];
+                memcpy(run->ws->x + 3 * (int64_t)u->node, u->x, sizeof u->x);
+            }
+        }
+    /* their stars' qualities at the restored coordinates (the same bits
+       fill() checks run->q against), and the memo hears they moved */
+    worker *w = &c->w[0];
+    w->levelled = 0;
+    for (int32_t i = from; i < c->n; i++) {
+        const sweep_rec *r = &c->rec[i];
+        int32_t mv[GETME_MAX_NV];
+        for (int32_t j = 0; j < r->nun; j++)
+            mv[j] = c->w[r->worker].un[r->un + j].node;
+        if (!r->nun)
+            continue;
+        getme_status st = fill(run, &w->p, mv, r->nun, 0);
+        if (st != GETME_OK)
+            return st;
+        store(run, w, c->pl);
+        kept(w, c->memo, mv, r->nun);
+    }
+    return GETME_OK;
+}
+
+/* One levelled sweep (see above); *budget is the serial budget. */
+static getme_status sweep_levelled(sweep_ctx *c, int undo, double *budget)
+{
+    const getme_levels *lv = &c->lv;
+    for (int t = 0; t < c->nw; t++) {
+        worker *w = &c->w[t];
+        w->levelled = 1;
+        w->p.log = w->log, w->p.cap_log = LOG_CAP;
+        w->p.budget = INFINITY;
+        w->p.loss = c->w[0].p.loss;
+        w->ncg = w->nun = 0;
+        w->st = GETME_OK;
+    }
+#ifdef GETME_FINISH_TEST
+    /* test builds: each level backwards on one thread, a schedule as good
+       as any for right levels, and a sure way to expose wrong ones */
+    int reverse = getenv("GETME_FINISH_REVERSE") != NULL;
+#else
+    const int reverse = 0;
+#endif
+#pragma omp parallel num_threads(c->nw)
+    {
+        worker *w = &c->w[omp_get_thread_num()];
+        for (int32_t L = 0; L < lv->num; L++) {
+            int32_t a = lv->ptr[L], b = lv->ptr[L + 1];
+            if (reverse) {
+#pragma omp single
+                {
+                    for (int32_t x = b - 1; x >= a; x--)
+                        process(c, w, lv->order[x], undo);
+                    merge(c);
+                }
+            } else if (b - a > 1) {
+#pragma omp for schedule(dynamic, 1)
+                for (int32_t x = a; x < b; x++)
+                    process(c, w, lv->order[x], undo);
+#pragma omp single
+                merge(c);
+            } else {
+#pragma omp single
+                {
+                    process(c, w, lv->order[a], undo);
+                    merge(c);
+                }
+            }
+        }
+    }
+    for (int t = 0; t < c->nw; t++)
+        if (c->w[t].st != GETME_OK)
+            return c->w[t].st;
+    /* the serial budget, element by element in list order */
+    double b = *budget;
+    int32_t from = c->n;
+#ifdef GETME_FINISH_TEST /* test builds: take the second sweep back */
+    int32_t stop =
+        undo && getenv("GETME_FINISH_TAKE_BACK") && c->n >= 3 ? c->n / 3 : c->n;
+#else
+    int32_t stop = c->n;
+#endif
+    for (int32_t i = 0; i < c->n && from == c->n; i++) {
+        const sweep_rec *r = &c->rec[i];
+        const double *cg = c->w[r->worker].cg + r->cg;
+        for (int32_t j = 0; j < r->ncg && from == c->n; j++) {
+            if (!(cg[j] >= -b))
+                from = i; /* the serial budget refuses this move */
+            else
+                b += cg[j];
+        }
+        if (i + 1 == stop && from == c->n)
+            from = stop;
+        if (from == i) { /* b is the budget at i's start: again */
+            b = *budget;
+            for (int32_t h = 0; h < i; h++)
+                for (int32_t j = 0; j < c->rec[h].ncg; j++)
+                    b += c->w[c->rec[h].worker].cg[c->rec[h].cg + j];
+        }
+    }
+    *budget = b;
+    if (from == c->n)
+        return GETME_OK;
+    getme_status st = take_back(c, from);
+    return st == GETME_OK ? sweep_serial(c, from, budget) : st;
+}
+
+/* Workers for nw threads; GETME_OK or GETME_ERR_NOMEM. */
+static getme_status workers_init(sweep_ctx *c, int nw)
+{
+    const getme_run *run = c->run;
+    c->w = calloc((size_t)nw, sizeof *c->w);
+    if (!c->w)
+        return GETME_ERR_NOMEM;
+    c->nw = nw;
+    for (int t = 0; t < nw; t++) {
+        getme_patch *p = &c->w[t].p;
+        if (getme__patch_init(p, 8 * run->ws->max_star) != GETME_OK)
+            return GETME_ERR_NOMEM;
+        p->x = run->ws->x;
+        p->ws = run->ws;
+        p->guard = run->guard;
+        p->floor = run->corner_floor;
+        memcpy(p->skip_q, run->guard_skip_q, sizeof p->skip_q);
+    }
+    return GETME_OK;
+}
+
+static void workers_free(sweep_ctx *c)
+{
+    for (int t = 0; t < c->nw; t++) {
+        worker *w = &c->w[t];
+        getme__patch_free(&w->p);
+        free(w->ev), free(w->cg), free(w->un), free(w->padd);
+    }
+    free(c->w);
+    free(c->rec);
+    getme__levels_free(&c->lv);
+}
+
+/* The pass's two sweeps over list[0..n): the first takes only moves that
+   lose no total quality (and so earns budget), the second may spend it.
+   Levelled on several threads when the list is long and not one chain. */
+static getme_status pass_sweeps(sweep_ctx *c, double *budget)
+{
+    int levelled = c->nw > 1 && c->n >= LEVELLED_MIN;
+    if (levelled) {
+        if (c->n > c->cap_rec) {
+            free(c->rec);
+            c->rec = malloc((size_t)c->n * sizeof *c->rec);
+            c->cap_rec = c->rec ? c->n : 0;
+            if (!c->rec)
+                return GETME_ERR_NOMEM;
+        }
+        getme_status st = getme__levels_build(&c->lv, c->run->ws, c->list, c->n);
+        if (st != GETME_OK)
+            return st;
+#ifndef GETME_FINISH_TEST
+        levelled = 4 * c->lv.num <= c->n; /* else mostly barriers */
+#endif
+    }
+    getme_status st = GETME_OK;
+    for (int sweep = 0; sweep < 2 && st == GETME_OK; sweep++) {
+        c->w[0].p.loss = sweep ? GETME_PATCH_LOSS : 0.0;
+        st = levelled ? sweep_levelled(c, sweep, budget)
+                      : sweep_serial(c, 0, budget);
+    }
+    return st;
+}
+
 getme_status getme__finish(getme_run *run)
 {
     getme_ws *ws = run->ws;
     const getme_params *prm = run->params;
     getme_result *res = run->result;
-    getme_patch p;
     pool pl;
     memset(&pl, 0, sizeof pl);
-    if (getme__patch_init(&p, 8 * ws->max_star) != GETME_OK)
-        return GETME_ERR_NOMEM;
-    p.x = ws->x;
-    p.ws = ws;
-    p.guard = run->guard;
-    p.floor = run->corner_floor;
-    memcpy(p.skip_q, run->guard_skip_q, sizeof p.skip_q);
+    sweep_ctx c;
+    memset(&c, 0, sizeof c);
+    c.run = run;
+    c.pl = run->sub ? NULL : &pl;
     /* no memo for second-order elements: their validity also reads the
-       mid-edge nodes */
+       mid-edge nodes; and no levels (the same reason) or on a sub-mesh */
     climb_memo memo_store, *memo = NULL;
     if (!ws->ho && memo_init(&memo_store) == 0)
         memo = &memo_store;
-    getme_status st = GETME_OK;
-    if (!run->sub) {
+#ifdef GETME_FINISH_TEST /* test builds: the same moves without it */
+    if (memo && getenv("GETME_FINISH_NO_MEMO")) {
+        memo_free(memo);
+        memo = NULL;
+    }
+#endif
+    c.memo = &memo;
+    getme_status st =
+        workers_init(&c, ws->nt > 1 && !ws->ho && !run->sub ? ws->nt : 1);
+    if (st == GETME_OK && !run->sub) {
         getme__tally_start(&pl.tally, ws, run->q);
         st = pool_build(run, &pl, prm->finish_fraction, 64);
     }
-    double q_mean, q_min;
+    double q_mean, q_min, budget = 0.0;
     if (st == GETME_OK)
         st = pass_summary(run, &pl, &q_mean, &q_min);
     for (int pass = 1; pass <= prm->finish_max_passes && st == GETME_OK;
@@ -677,15 +1176,8 @@ getme_status getme__finish(getme_run *run)
         getme_ranked *list = pass_bound_list(run, &pl, &bound, &n, &st);
         if (!list)
             break;
-        /* Two sweeps: the first takes only moves that lose no total
-           quality (and so earns budget), the second may spend it. */
-        pool *track = run->sub ? NULL : &pl;
-        for (int sweep = 0; sweep < 2; sweep++) {
-            p.loss = sweep ? GETME_PATCH_LOSS : 0.0;
-            for (int32_t i = 0; i < n && st == GETME_OK; i++)
-                if (run->q[list[i].e] <= bound)
-                    st = improve(run, &p, &memo, track, list[i].e);
-        }
+        c.list = list, c.n = n, c.bound = bound;
+        st = pass_sweeps(&c, &budget);
         /* Raised over the pass, whichever sweep did it (the list keeps
            each element's quality at the pass's start). */
         for (int32_t i = 0; i < n; i++)
@@ -706,7 +1198,7 @@ getme_status getme__finish(getme_run *run)
             break;
     }
     pool_free(run, &pl);
-    getme__patch_free(&p);
+    workers_free(&c);
     if (memo)
         memo_free(memo);
     return st;

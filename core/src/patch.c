@@ -321,6 +321,11 @@ static void accept(getme_patch *p)
 {
     memcpy(p->q, p->qt, (size_t)p->n * sizeof *p->q);
     p->budget += p->change;
+    if (p->log) {
+        if (p->nlog < p->cap_log)
+            p->log[p->nlog] = p->change;
+        p->nlog++;
+    }
 }
 
 static inline double *coord(const getme_patch *p, int32_t node, int d)

@@ -48,6 +48,12 @@ typedef struct getme_patch {
     double allowed_max; /* the largest loss * gain of a trial that got as
                         far as the total's test (the caller resets it);
                         the finishing step's memo of failed climbs uses it */
+    double *log;     /* the change of every accepted move, in order, while
+                        nlog < cap_log (nlog counts on beyond it), or
+                        NULL: a levelled finishing sweep (finish.c) runs
+                        with an unbounded budget and replays these in the
+                        list's order against the serial budget           */
+    int32_t nlog, cap_log;
     /* the elements (filled by the caller with getme__patch_add) */
     int32_t n, cap;
     int8_t *type;

@@ -1,0 +1,48 @@
+/*
+ * finish_levels.h -- conflict levels of a finishing pass's list, so that
+ * the list's elements can be worked on in parallel with exactly the
+ * serial result (finish.c, "Levelled sweeps"; docs/method.md).
+ *
+ * improve() on list element i writes the coordinates of its free nodes
+ * W_i and the qualities of its patch P_i, the elements around W_i, and it
+ * reads the coordinates of every node of P_i (an element without free
+ * nodes only reads its own quality: P_i is that element).  Elements i < j
+ * conflict when one writes what the other reads.  That is exactly when
+ * P_i and P_j share an element: a node a of W_i among P_j's nodes lies in
+ * an element E of P_j, and E holds a, so E is in P_i; conversely a shared
+ * E holds a free node of i, which j reads.  So a mark per element is
+ * enough: level(j) is one more than the highest level of an earlier
+ * element whose patch holds an element of P_j, the elements of one level
+ * share nothing, and running the levels in order, each level's elements
+ * in any order or at once, gives every element exactly the state the
+ * serial order gives it.
+ */
+#ifndef GETME_FINISH_LEVELS_H
+#define GETME_FINISH_LEVELS_H
+
+#include "workspace.h"
+
+typedef struct getme_levels {
+    int32_t *level;  /* n: the level of list position i                   */
+    int32_t *order;  /* n: list positions by level, ascending within one  */
+    int32_t *ptr;    /* num + 1: level L is order[ptr[L] .. ptr[L + 1])    */
+    int32_t num;
+    int64_t cap, cap_ptr;
+    /* Per element in some patch, 1 + the highest level whose patch held
+       it: open addressing over the few elements a pass touches (no array
+       over all elements: the step runs at the mesh's peak memory). */
+    int32_t *key;    /* -1: empty */
+    int32_t *mark;
+    uint32_t mcap, used;
+    uint32_t *slot;  /* scratch: one patch's slots (repeats allowed) */
+    int64_t cap_s;
+} getme_levels;
+
+/* The levels of list[0..n) on ws (free nodes: !ws->fixed).  GETME_OK or
+   GETME_ERR_NOMEM.  lv starts zeroed and is reused across passes. */
+getme_status getme__levels_build(getme_levels *lv, const getme_ws *ws,
+                                 const getme_ranked *list, int32_t n);
+
+void getme__levels_free(getme_levels *lv);
+
+#endif /* GETME_FINISH_LEVELS_H */
