@@ -824,10 +824,13 @@ static getme_status pass_summary(getme_run *run, const pool *pl,
  * sweep makes, up to the first that the budget would have refused.  In
  * the first sweep of a pass (loss 0: only moves that lose nothing) that
  * never happens.  In the second it needs a budget smaller than one move's
- * loss; then the sweep is taken back from that element on (coordinates
- * restored in reverse level order, qualities evaluated again, the memo
- * told those nodes moved) and finished serially.  The output is the
- * serial one, bit for bit, for any thread count.
+ * loss (the medium tets' second pass: once).  The levels come in chunks
+ * of consecutive list positions (finish_levels.h), and the replay runs
+ * after each chunk; from a refused move on, the chunk is taken back
+ * (coordinates restored in reverse level order, qualities evaluated
+ * again, the memo told those nodes moved) and finished serially, and the
+ * next chunk starts from the serial budget.  The output is the serial
+ * one, bit for bit, for any thread count.
  */
 
 /* Lists shorter than this run serially (a level costs a barrier; test
@@ -836,6 +839,15 @@ static getme_status pass_summary(getme_run *run, const pool *pl,
 #define LEVELLED_MIN 2
 #else
 #define LEVELLED_MIN 256
+#endif
+
+/* A levelled sweep checks the budget after every chunk of this many list
+   positions, so a move the budget refuses costs at most a chunk's work
+   taken back (test builds: small chunks, so tests have several). */
+#ifdef GETME_FINISH_TEST
+#define LEVELLED_CHUNK 97
+#else
+#define LEVELLED_CHUNK 256
 #endif
 
 typedef struct sweep_rec {
@@ -939,28 +951,39 @@ static void process(sweep_ctx *c, worker *w, int32_t i, int undo)
     }
 }
 
-/* The serial sweep from list position from on, budget *budget. */
-static getme_status sweep_serial(sweep_ctx *c, int32_t from, double *budget)
+/* The serial sweep over list positions [from, to), budget *budget. */
+static getme_status sweep_serial(sweep_ctx *c, int32_t from, int32_t to,
+                                 double *budget)
 {
     worker *w = &c->w[0];
     getme_status st = GETME_OK;
     w->levelled = 0;
     w->p.log = NULL;
     w->p.budget = *budget;
-    for (int32_t i = from; i < c->n && st == GETME_OK; i++)
+    for (int32_t i = from; i < to && st == GETME_OK; i++)
         if (c->run->q[c->list[i].e] <= c->bound)
             st = improve(c->run, w, c->memo, c->pl, c->list[i].e);
     *budget = w->p.budget;
     return st;
 }
 
-/* Take the levelled sweep back from list position from on (in reverse
-   level order, so each node gets the value it had before from). */
-static getme_status take_back(sweep_ctx *c, int32_t from)
+/* Worker w as a levelled sweep uses it. */
+static void levelled_mode(worker *w, double loss)
+{
+    w->levelled = 1;
+    w->p.log = w->log, w->p.cap_log = LOG_CAP;
+    w->p.budget = INFINITY;
+    w->p.loss = loss;
+}
+
+/* Take chunk h of the levelled sweep back from list position from on (in
+   reverse level order, so each node gets the value it had before from). */
+static getme_status take_back(sweep_ctx *c, int32_t h, int32_t from,
+                              int32_t to)
 {
     getme_run *run = c->run;
     const getme_levels *lv = &c->lv;
-    for (int32_t L = lv->num - 1; L >= 0; L--)
+    for (int32_t L = lv->cfirst[h + 1] - 1; L >= lv->cfirst[h]; L--)
         for (int32_t x = lv->ptr[L]; x < lv->ptr[L + 1]; x++) {
             const sweep_rec *r = &c->rec[lv->order[x]];
             if (lv->order[x] < from)
@@ -974,13 +997,13 @@ static getme_status take_back(sweep_ctx *c, int32_t from)
        fill() checks run->q against), and the memo hears they moved */
     worker *w = &c->w[0];
     w->levelled = 0;
-    for (int32_t i = from; i < c->n; i++) {
+    for (int32_t i = from; i < to; i++) {
         const sweep_rec *r = &c->rec[i];
         int32_t mv[GETME_MAX_NV];
-        for (int32_t j = 0; j < r->nun; j++)
-            mv[j] = c->w[r->worker].un[r->un + j].node;
         if (!r->nun)
             continue;
+        for (int32_t j = 0; j < r->nun; j++)
+            mv[j] = c->w[r->worker].un[r->un + j].node;
         getme_status st = fill(run, &w->p, mv, r->nun, 0);
         if (st != GETME_OK)
             return st;
@@ -990,18 +1013,66 @@ static getme_status take_back(sweep_ctx *c, int32_t from)
     return GETME_OK;
 }
 
+/* After chunk h of a levelled sweep: its moves replayed in list order
+   against the serial budget *budget (b += change, the serial sum's
+   order); from the first move it refuses on, the chunk is taken back and
+   redone serially.  Then *budget is the serial budget after the chunk. */
+static getme_status chunk_check(sweep_ctx *c, int32_t h, int undo,
+                                double *budget)
+{
+    const getme_levels *lv = &c->lv;
+    int32_t c0 = h * lv->chunk;
+    int32_t c1 = c0 + lv->chunk < c->n ? c0 + lv->chunk : c->n;
+    for (int t = 0; t < c->nw; t++)
+        if (c->w[t].st != GETME_OK)
+            return c->w[t].st;
+    int32_t stop = c1;
+    (void)undo;
+#ifdef GETME_FINISH_TEST /* test builds: take a second sweep back */
+    if (undo && getenv("GETME_FINISH_TAKE_BACK") && c->n / 3 >= c0 &&
+        c->n / 3 < c1)
+        stop = c->n / 3;
+#endif
+    double b = *budget;
+    int32_t from = c1;
+    for (int32_t i = c0; i < c1 && from == c1; i++) {
+        const sweep_rec *r = &c->rec[i];
+        const double *cg = c->w[r->worker].cg + r->cg;
+        if (i == stop)
+            from = i;
+        for (int32_t j = 0; j < r->ncg && from == c1; j++) {
+            if (!(cg[j] >= -b))
+                from = i; /* the serial budget refuses this move */
+            else
+                b += cg[j];
+        }
+    }
+    getme_status st = GETME_OK;
+    if (from < c1) { /* the budget at from's start, then serially */
+        b = *budget;
+        for (int32_t i = c0; i < from; i++)
+            for (int32_t j = 0; j < c->rec[i].ncg; j++)
+                b += c->w[c->rec[i].worker].cg[c->rec[i].cg + j];
+        double loss = c->w[0].p.loss;
+        st = take_back(c, h, from, c1);
+        if (st == GETME_OK)
+            st = sweep_serial(c, from, c1, &b);
+        levelled_mode(&c->w[0], loss);
+    }
+    *budget = b;
+    for (int t = 0; t < c->nw; t++)
+        c->w[t].ncg = c->w[t].nun = 0; /* the chunk's logs are done */
+    return st;
+}
+
 /* One levelled sweep (see above); *budget is the serial budget. */
 static getme_status sweep_levelled(sweep_ctx *c, int undo, double *budget)
 {
     const getme_levels *lv = &c->lv;
     for (int t = 0; t < c->nw; t++) {
-        worker *w = &c->w[t];
-        w->levelled = 1;
-        w->p.log = w->log, w->p.cap_log = LOG_CAP;
-        w->p.budget = INFINITY;
-        w->p.loss = c->w[0].p.loss;
-        w->ncg = w->nun = 0;
-        w->st = GETME_OK;
+        levelled_mode(&c->w[t], c->w[0].p.loss);
+        c->w[t].ncg = c->w[t].nun = 0;
+        c->w[t].st = GETME_OK;
     }
 #ifdef GETME_FINISH_TEST
     /* test builds: each level backwards on one thread, a schedule as good
@@ -1010,68 +1081,41 @@ static getme_status sweep_levelled(sweep_ctx *c, int undo, double *budget)
 #else
     const int reverse = 0;
 #endif
+    getme_status st = GETME_OK;
 #pragma omp parallel num_threads(c->nw)
     {
         worker *w = &c->w[omp_get_thread_num()];
-        for (int32_t L = 0; L < lv->num; L++) {
-            int32_t a = lv->ptr[L], b = lv->ptr[L + 1];
-            if (reverse) {
+        for (int32_t h = 0; h < lv->num_chunks; h++) {
+            for (int32_t L = lv->cfirst[h]; L < lv->cfirst[h + 1]; L++) {
+                int32_t a = lv->ptr[L], b = lv->ptr[L + 1];
+                if (reverse) {
 #pragma omp single
-                {
-                    for (int32_t x = b - 1; x >= a; x--)
-                        process(c, w, lv->order[x], undo);
-                    merge(c);
-                }
-            } else if (b - a > 1) {
+                    {
+                        for (int32_t x = b - 1; x >= a; x--)
+                            process(c, w, lv->order[x], undo);
+                        merge(c);
+                    }
+                } else if (b - a > 1) {
 #pragma omp for schedule(dynamic, 1)
-                for (int32_t x = a; x < b; x++)
-                    process(c, w, lv->order[x], undo);
+                    for (int32_t x = a; x < b; x++)
+                        process(c, w, lv->order[x], undo);
 #pragma omp single
-                merge(c);
-            } else {
-#pragma omp single
-                {
-                    process(c, w, lv->order[a], undo);
                     merge(c);
+                } else {
+#pragma omp single
+                    {
+                        process(c, w, lv->order[a], undo);
+                        merge(c);
+                    }
                 }
             }
+#pragma omp single
+            if (st == GETME_OK && (st = chunk_check(c, h, undo, budget)) != GETME_OK)
+                for (int t = 0; t < c->nw; t++)
+                    c->w[t].st = st; /* the rest does nothing */
         }
     }
-    for (int t = 0; t < c->nw; t++)
-        if (c->w[t].st != GETME_OK)
-            return c->w[t].st;
-    /* the serial budget, element by element in list order */
-    double b = *budget;
-    int32_t from = c->n;
-#ifdef GETME_FINISH_TEST /* test builds: take the second sweep back */
-    int32_t stop =
-        undo && getenv("GETME_FINISH_TAKE_BACK") && c->n >= 3 ? c->n / 3 : c->n;
-#else
-    int32_t stop = c->n;
-#endif
-    for (int32_t i = 0; i < c->n && from == c->n; i++) {
-        const sweep_rec *r = &c->rec[i];
-        const double *cg = c->w[r->worker].cg + r->cg;
-        for (int32_t j = 0; j < r->ncg && from == c->n; j++) {
-            if (!(cg[j] >= -b))
-                from = i; /* the serial budget refuses this move */
-            else
-                b += cg[j];
-        }
-        if (i + 1 == stop && from == c->n)
-            from = stop;
-        if (from == i) { /* b is the budget at i's start: again */
-            b = *budget;
-            for (int32_t h = 0; h < i; h++)
-                for (int32_t j = 0; j < c->rec[h].ncg; j++)
-                    b += c->w[c->rec[h].worker].cg[c->rec[h].cg + j];
-        }
-    }
-    *budget = b;
-    if (from == c->n)
-        return GETME_OK;
-    getme_status st = take_back(c, from);
-    return st == GETME_OK ? sweep_serial(c, from, budget) : st;
+    return st;
 }
 
 /* Workers for nw threads; GETME_OK or GETME_ERR_NOMEM. */
@@ -1121,7 +1165,8 @@ static getme_status pass_sweeps(sweep_ctx *c, double *budget)
             if (!c->rec)
                 return GETME_ERR_NOMEM;
         }
-        getme_status st = getme__levels_build(&c->lv, c->run->ws, c->list, c->n);
+        getme_status st = getme__levels_build(&c->lv, c->run->ws, c->list,
+                                              c->n, LEVELLED_CHUNK);
         if (st != GETME_OK)
             return st;
 #ifndef GETME_FINISH_TEST
@@ -1132,7 +1177,7 @@ static getme_status pass_sweeps(sweep_ctx *c, double *budget)
     for (int sweep = 0; sweep < 2 && st == GETME_OK; sweep++) {
         c->w[0].p.loss = sweep ? GETME_PATCH_LOSS : 0.0;
         st = levelled ? sweep_levelled(c, sweep, budget)
-                      : sweep_serial(c, 0, budget);
+                      : sweep_serial(c, 0, c->n, budget);
     }
     return st;
 }

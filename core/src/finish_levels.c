@@ -14,6 +14,7 @@ void getme__levels_free(getme_levels *lv)
     free(lv->key);
     free(lv->mark);
     free(lv->slot);
+    free(lv->cfirst);
     memset(lv, 0, sizeof *lv);
 }
 
@@ -99,8 +100,17 @@ static int64_t patch_slots(getme_levels *lv, const getme_ws *ws, int32_t e,
 }
 
 getme_status getme__levels_build(getme_levels *lv, const getme_ws *ws,
-                                 const getme_ranked *list, int32_t n)
+                                 const getme_ranked *list, int32_t n,
+                                 int32_t chunk)
 {
+    int32_t nc = n ? (n - 1) / chunk + 1 : 0;
+    if (nc + 1 > lv->cap_c) {
+        int32_t *f = realloc(lv->cfirst, (size_t)(nc + 1) * sizeof *f);
+        if (!f)
+            return GETME_ERR_NOMEM;
+        lv->cfirst = f, lv->cap_c = nc + 1;
+    }
+    lv->chunk = chunk, lv->num_chunks = nc;
     if (n > lv->cap) {
         int32_t *a = realloc(lv->level, (size_t)n * sizeof *a);
         if (a)
@@ -124,7 +134,11 @@ getme_status getme__levels_build(getme_levels *lv, const getme_ws *ws,
         int64_t m = patch_slots(lv, ws, e, w, k);
         if (m < 0)
             return GETME_ERR_NOMEM;
-        int32_t L = 0; /* marks are 1 + a level: L is the new level */
+        if (i % chunk == 0) /* a chunk starts above every earlier level */
+            lv->cfirst[i / chunk] = num;
+        /* marks are 1 + a level: L is the new level (earlier chunks'
+           marks are at most num, their chunk's start) */
+        int32_t L = lv->cfirst[i / chunk];
         for (int64_t r = 0; r < m; r++)
             L = lv->mark[lv->slot[r]] > L ? lv->mark[lv->slot[r]] : L;
         for (int64_t r = 0; r < m; r++)
@@ -132,6 +146,7 @@ getme_status getme__levels_build(getme_levels *lv, const getme_ws *ws,
         lv->level[i] = L;
         num = L + 1 > num ? L + 1 : num;
     }
+    lv->cfirst[nc] = num;
     if (num + 1 > lv->cap_ptr) {
         int32_t *p = realloc(lv->ptr, (size_t)(num + 1) * sizeof *p);
         if (!p)

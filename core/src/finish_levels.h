@@ -28,6 +28,13 @@ typedef struct getme_levels {
     int32_t *ptr;    /* num + 1: level L is order[ptr[L] .. ptr[L + 1])    */
     int32_t num;
     int64_t cap, cap_ptr;
+    /* Chunks of `chunk` consecutive list positions get levels of their
+       own, above every earlier chunk's: chunk h is positions
+       [h chunk, (h + 1) chunk) and levels [cfirst[h], cfirst[h + 1]) (the
+       finishing step checks its budget after each chunk). */
+    int32_t chunk, num_chunks;
+    int32_t *cfirst;
+    int64_t cap_c;
     /* Per element in some patch, 1 + the highest level whose patch held
        it: open addressing over the few elements a pass touches (no array
        over all elements: the step runs at the mesh's peak memory). */
@@ -38,10 +45,12 @@ typedef struct getme_levels {
     int64_t cap_s;
 } getme_levels;
 
-/* The levels of list[0..n) on ws (free nodes: !ws->fixed).  GETME_OK or
-   GETME_ERR_NOMEM.  lv starts zeroed and is reused across passes. */
+/* The levels of list[0..n) on ws (free nodes: !ws->fixed), in chunks of
+   chunk >= 1 positions.  GETME_OK or GETME_ERR_NOMEM.  lv starts zeroed
+   and is reused across passes. */
 getme_status getme__levels_build(getme_levels *lv, const getme_ws *ws,
-                                 const getme_ranked *list, int32_t n);
+                                 const getme_ranked *list, int32_t n,
+                                 int32_t chunk);
 
 void getme__levels_free(getme_levels *lv);
 
