@@ -830,8 +830,9 @@ GETME_API getme_status getme_smooth_part(getme_mesh *part,
  * finishing step exactly as getme_smooth() does after its loop; result
  * (filled by getme_smooth_part()) is updated (finishing passes, final
  * statistics, seconds added).  The mesh then equals getme_smooth()'s
- * output bit for bit.  The finishing step is serial in getme_smooth()
- * too; it touches only the worst elements' neighbourhoods.
+ * output bit for bit, for any thread count (the finishing step makes the
+ * same moves on any number of threads); it touches only the worst
+ * elements' neighbourhoods.
  */
 GETME_API getme_status getme_smooth_finish(getme_mesh *mesh,
                                            const getme_params *params,

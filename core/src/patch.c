@@ -86,8 +86,9 @@ static void elem_x(const getme_patch *p, int32_t i, double *x)
 }
 
 /* What elem_q adds to the mean ratio q of patch element i at coordinates
-   x: its worst corner into *sj when the corner guard applies to its type,
-   and 0 for a second-order element invalid at a node. */
+   x: its worst corner into *sj (unless NULL) when the corner guard
+   applies to its type, and 0 for a second-order element invalid at a
+   node. */
 static double elem_finish(const getme_patch *p, int32_t i, const double *x,
                           double q, double *sj)
 {
@@ -95,7 +96,7 @@ static double elem_finish(const getme_patch *p, int32_t i, const double *x,
     /* a skipped corner stays 1: above the floor, like the true one, it
        rejects nothing as a new corner, and as an old one the test is the
        same (sj < floor implies sj < any old corner >= floor) */
-    if (p->guard && getme__has_corners(t) && !(q >= p->skip_q[t]))
+    if (sj && p->guard && getme__has_corners(t) && !(q >= p->skip_q[t]))
         *sj = getme__corner_sj(t, x);
     if (q > 0.0 && p->ws && p->ws->ho && !getme__ho_valid(p->ws, p->x, p->id[i]))
         return 0.0; /* second order: det J > 0 at every node */
@@ -376,32 +377,76 @@ static double edge_scale(const getme_patch *p, const int32_t *mv, int k)
     return sqrt(l2);
 }
 
+/* The qualities of patch element i (a tet or hex of a first-order patch)
+   with one coordinate of a moving node moved by +h or -h, as elem_q gives
+   them after writing x0 +- h into p->x: evaluation m is node mv[m / 6],
+   coordinate m / 2 % 3, sign + for even m; only the nodes in the element
+   (in[j]).  Up to GETME_LANES at once through the lane kernel, which has
+   getme__quality's bits. */
+static void perturbed_q(const getme_patch *p, int32_t i, const int32_t *mv,
+                        int k, const int *in, double h, double *qs)
+{
+    const int32_t *c = p->conn[i];
+    int t = p->type[i], nv = getme__nv[t];
+    double x0[3 * GETME_MAX_NV], x[3 * GETME_MAX_NV][GETME_LANES];
+    double ql[GETME_LANES];
+    int ev[GETME_LANES], n = 0;
+    elem_x(p, i, x0);
+    for (int m = 0; m < 6 * k; m++) {
+        if (in[m / 6])
+            ev[n++] = m;
+        if (n < GETME_LANES && !(m == 6 * k - 1 && n > 0))
+            continue;
+        for (int l = 0; l < GETME_LANES; l++) { /* spare lanes repeat */
+            int e = ev[l < n ? l : n - 1], j = e / 6, d = e / 2 % 3;
+            double raw = *coord(p, mv[j], d);
+            double v = e % 2 ? raw - h : raw + h;
+            for (int r = 0; r < 3 * nv; r++)
+                x[r][l] = x0[r];
+            for (int a = 0; a < nv; a++)
+                if (c[a] == mv[j])
+                    x[3 * a + d][l] = p->mirror && d == 1 ? -v : v;
+        }
+        getme__quality_lanes(t, (const double(*)[GETME_LANES])x, ql);
+        for (int l = 0; l < n; l++)
+            qs[ev[l]] = ql[l];
+        n = 0;
+    }
+}
+
 /* Central-difference gradient of element i's quality with respect to the
-   moving nodes (zero for the nodes it does not contain). */
+   moving nodes (zero for the nodes it does not contain).  Only the mean
+   ratio: no worst corner (the step does not use one). */
 static void gradient(getme_patch *p, int32_t i, const int32_t *mv, int k,
                      double h, double *g)
 {
     const int32_t *c = p->conn[i];
-    int nv = getme__nv[p->type[i]];
-    double sj;
+    int t = p->type[i], nv = getme__nv[t];
+    int in[GETME_PATCH_MAX_MOVE];
     for (int j = 0; j < k; j++) {
-        int in = 0;
+        in[j] = 0;
         for (int v = 0; v < nv; v++)
-            in |= c[v] == mv[j];
-        for (int d = 0; d < 3; d++) {
-            double *x = coord(p, mv[j], d), x0 = *x;
-            if (!in) {
-                g[3 * j + d] = 0.0;
+            in[j] |= c[v] == mv[j];
+    }
+    double qs[6 * GETME_PATCH_MAX_MOVE], x[3 * GETME_MAX_NV];
+    if ((t == GETME_TET || t == GETME_HEX) && !(p->ws && p->ws->ho)) {
+        perturbed_q(p, i, mv, k, in, h, qs);
+    } else {
+        for (int m = 0; m < 6 * k; m++) {
+            if (!in[m / 6])
                 continue;
-            }
-            *x = x0 + h;
-            double qp = elem_q(p, i, &sj);
-            *x = x0 - h;
-            double qm = elem_q(p, i, &sj);
-            *x = x0;
-            g[3 * j + d] = (qp - qm) / (2.0 * h);
+            double *xp = coord(p, mv[m / 6], m / 2 % 3), x0 = *xp;
+            *xp = m % 2 ? x0 - h : x0 + h;
+            elem_x(p, i, x);
+            qs[m] = elem_finish(p, i, x, getme__quality(t, x), NULL);
+            *xp = x0;
         }
     }
+    for (int j = 0; j < k; j++)
+        for (int d = 0; d < 3; d++)
+            g[3 * j + d] = in[j] ? (qs[6 * j + 2 * d] - qs[6 * j + 2 * d + 1]) /
+                                       (2.0 * h)
+                                 : 0.0;
 }
 
 static double dot(const double *a, const double *b, int n)

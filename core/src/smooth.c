@@ -5,6 +5,7 @@
 #include "adjacency.h"
 #include "smooth_internal.h"
 
+#include <math.h>
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -132,6 +133,46 @@ int getme__report(getme_run *run, int iteration, getme_stage stage, int cycle,
 }
 
 /* The input must be valid: name the first invalid elements if not. */
+/*
+ * getme__ws_corner_min's value at qualities q (current at ws->x), without
+ * computing the corners of elements whose quality proves them no lower
+ * than the smallest corner found so far: a hex's corner mean ratios are
+ * <= 1 and average to q, so its worst corner's scaled Jacobian is >=
+ * (8q - 7)^(3/2), a quad's >= 4q - 3 (getme_adaptive.c, set_corner_floor;
+ * the margins cover roundings).  Such an element cannot lower the
+ * minimum, so the value is the same bits; on the full hexes most of them
+ * are skipped (q > ~0.93), the rest of the sweep is the same.
+ */
+static double corner_min(const getme_ws *ws, const double *q)
+{
+    double m = 1.0;
+    for (int t = 0; t < GETME_NUM_TYPES; t++) {
+        if (!getme__has_corners(t))
+            continue;
+        int hex = t == GETME_HEX, bounded = hex || t == GETME_QUAD;
+        /* m inside the loop is this thread's minimum so far */
+#pragma omp parallel for schedule(static) num_threads(ws->nt) \
+    reduction(min : m)
+        for (int32_t e = ws->tstart[t]; e < ws->tstart[t + 1]; e++) {
+            if (bounded) {
+                double k = (hex ? 8.0 * q[e] - 7.0 : 4.0 * q[e] - 3.0) - 1e-12;
+                double lb = hex ? (k > 0.0 ? k * sqrt(k) : 0.0) : k;
+                if (lb >= m * (1.0 + 1e-9) + 1e-12)
+                    continue;
+            }
+            double x[3 * GETME_MAX_NV];
+            getme__ws_gather(ws, ws->x, t, e, x);
+            double s = getme__corner_sj(t, x);
+            m = s < m ? s : m;
+        }
+    }
+#ifdef GETME_CHECK_SUMS /* test builds: the same as every corner's */
+    if (m != getme__ws_corner_min(ws))
+        m = NAN;
+#endif
+    return m;
+}
+
 static getme_status check_valid(getme_mesh *mesh, const getme_ws *ws,
                                 const double *q)
 {
@@ -268,7 +309,7 @@ getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
         goto done;
     getme__ws_summary(&ws, run.q, &result->q_mean_initial,
                       &result->q_min_star_initial, NULL);
-    result->corner_sj_initial = result->corner_sj = getme__ws_corner_min(&ws);
+    result->corner_sj_initial = result->corner_sj = corner_min(&ws, run.q);
     if (ws.num_free_nodes == 0) {
         getme__ws_summary(&ws, run.q, &result->q_mean, &result->q_min_star,
                           &result->q_min);
@@ -280,15 +321,16 @@ getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
     st = params->method == GETME_METHOD_SMART_LAPLACE ? getme__laplace(&run)
                                                       : getme__adaptive(&run);
     getme__ws_unpack_map(&ws); /* into the stars' array: no allocation */
+    /* run.q is at ws->x after a finished or stopped run */
+    if (st == GETME_OK || st == GETME_ERR_CANCELLED)
+        result->corner_sj = corner_min(&ws, run.q);
     /* The run's and the sums' arrays are done with: freed before the
        coordinates and the connectivity go back (permuted out of place, so
        below the peak they leave). */
     getme__run_free(&run);
     getme__adj_free(&adj);
-    if (st == GETME_OK || st == GETME_ERR_CANCELLED) {
-        result->corner_sj = getme__ws_corner_min(&ws);
+    if (st == GETME_OK || st == GETME_ERR_CANCELLED)
         getme__ws_store(&ws, mesh);
-    }
     if (st == GETME_ERR_CANCELLED)
         getme__fail(mesh, st, "stopped by the progress callback after "
                               "%d iterations", result->iterations);
