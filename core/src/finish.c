@@ -424,19 +424,18 @@ typedef struct worker {
     double log[LOG_CAP];
 } worker;
 
-/* Room for need entries of size bytes in *buf (room *cap, doubled); 0 or
-   -1 without memory. */
-static int reserve(void **buf, int64_t *cap, int64_t need, size_t size)
+/* buf with room for need >= 1 entries of size bytes (room *cap, doubled
+   when it grows), or NULL without memory (buf stays valid). */
+static void *room(void *buf, int64_t *cap, int64_t need, size_t size)
 {
     if (need <= *cap)
-        return 0;
+        return buf;
     int64_t c = *cap ? 2 * *cap : 256;
     c = c < need ? need : c;
-    void *b = realloc(*buf, (size_t)c * size);
-    if (!b)
-        return -1;
-    *buf = b, *cap = c;
-    return 0;
+    void *b = realloc(buf, (size_t)c * size);
+    if (b)
+        *cap = c;
+    return b;
 }
 
 /* Put the elements around the k nodes mv into the patch (each once), with
@@ -504,10 +503,13 @@ static void store(getme_run *run, worker *w, pool *pl)
 /* Log one memo event (or mark the memo lost). */
 static void log_event(worker *w, memo_event ev)
 {
-    if (reserve((void **)&w->ev, &w->cap_ev, w->nev + 1, sizeof *w->ev))
+    memo_event *b = room(w->ev, &w->cap_ev, w->nev + 1, sizeof *b);
+    if (!b) {
         w->memo_lost = 1;
-    else
-        w->ev[w->nev++] = ev;
+        return;
+    }
+    w->ev = b;
+    w->ev[w->nev++] = ev;
 }
 
 /* The k nodes mv moved in a kept move. */
@@ -934,18 +936,23 @@ static void process(sweep_ctx *c, worker *w, int32_t i, int undo)
     int32_t nl = w->p.nlog;
     if (st == GETME_OK && nl > LOG_CAP)
         st = GETME_ERR_STATE; /* not reached: LOG_CAP bounds improve() */
-    if (st == GETME_OK &&
-        (reserve((void **)&w->cg, &w->cap_cg, w->ncg + nl, sizeof *w->cg) ||
-         (undo && nl &&
-          reserve((void **)&w->un, &w->cap_un, w->nun + k, sizeof *w->un))))
-        st = GETME_ERR_NOMEM;
-    if (st != GETME_OK) {
+    if (st != GETME_OK || !nl) { /* nothing kept: nothing to replay */
         w->st = st;
+        return;
+    }
+    double *cg = room(w->cg, &w->cap_cg, w->ncg + nl, sizeof *cg);
+    if (cg)
+        w->cg = cg;
+    undo_rec *un = undo ? room(w->un, &w->cap_un, w->nun + k, sizeof *un) : NULL;
+    if (un)
+        w->un = un;
+    if (!cg || (undo && !un)) {
+        w->st = GETME_ERR_NOMEM;
         return;
     }
     memcpy(w->cg + w->ncg, w->log, (size_t)nl * sizeof *w->cg);
     w->ncg += nl, r->ncg = nl;
-    if (undo && nl) {
+    if (undo) {
         memcpy(w->un + w->nun, u, (size_t)k * sizeof *u);
         w->nun += k, r->nun = k;
     }
