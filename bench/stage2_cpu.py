@@ -88,12 +88,16 @@ def main():
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--freq", type=int, default=999)
     ap.add_argument("--top", type=int, default=0)
+    ap.add_argument("--keep", help="keep each build's output as KEEP.N.msh "
+                    "(N: its --getme position), e.g. to cmp them")
     a = ap.parse_args()
-    for g in a.getme:
+    for n, g in enumerate(a.getme):
         with tempfile.TemporaryDirectory() as d:
             data, lines = run(g, a.mesh, a.threads, a.freq, d)
             w = windows(lines)
             s = samples(data)
+            if a.keep:
+                os.replace(os.path.join(d, "out.msh"), f"{a.keep}.{n}.msh")
         print(f"{g} {os.path.basename(a.mesh)} threads {a.threads}")
         for name, (t0, t1) in w.items():
             if t0 is None or t1 is None:
