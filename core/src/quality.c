@@ -19,6 +19,7 @@
  * Non-finite coordinates give a NaN det or q, which fails the "> 0" tests
  * and so also yields 0.
  */
+#include "div3.h"
 #include "internal.h"
 
 #include <math.h>
@@ -119,11 +120,12 @@ double getme__cube_root(double x)
 static inline void cube_root_n(const double *restrict x, double *restrict y,
                                int n)
 {
-    uint64_t bits[8 * GETME_LANES];
-    memcpy(bits, x, sizeof(double) * (size_t)n);
-    for (int i = 0; i < n; i++)
-        bits[i] = bits[i] / 3u + UINT64_C(0x2A9F7893782DA1CE);
-    memcpy(y, bits, sizeof(double) * (size_t)n);
+#pragma omp simd
+    for (int i = 0; i < n; i++) {
+        union { double d; uint64_t u; } v = {x[i]};
+        v.u = getme__div3_u64(v.u) + UINT64_C(0x2A9F7893782DA1CE);
+        y[i] = v.d;
+    }
 #pragma omp simd
     for (int i = 0; i < n; i++) {
         double yi = y[i], y3, xi = x[i];
