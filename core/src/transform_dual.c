@@ -185,10 +185,12 @@ void getme__transform_hex(const double *x, double sigma, double *out)
    the unit and the adders took turns and the kernel took ~48 ns per hex;
    perf annotate put half of its samples on waits for square roots.  So
    the work is interleaved in program order, the way the out-of-order core
-   can overlap it: node by node, a node's mean and normal (arithmetic)
-   followed by its own two roots and division, one or two of the input's
-   12 edge lengths, and, two nodes behind (its roots are done by then),
-   the moved node and the output edges whose both ends have moved. */
+   can overlap it: 4 of the input's 12 edge lengths with the face
+   centroids, then node by node a node's mean and normal (arithmetic)
+   followed by its own two roots and division, one more input edge, and,
+   two nodes behind (its roots are done by then), the moved node and the
+   output edges whose both ends have moved (bench/kernels.sh: 50 -> ~40
+   ns per hex; lags of 1 and 3 nodes measured the same). */
 
 /* Node i's mean m, normal n and factor f = sigma / sqrt(sqrt|n|^2) from
    its three face centroids a, b, e (dual_step's triangles (a, b), (b, e),
@@ -240,11 +242,11 @@ hex_edge_len(const double (*p)[GETME_LANES], int a, int b, double *len)
 }
 
 /* The hex's edges (hex_topo.edges, the order their lengths are summed
-   in) that step i of the node loop measures: of the input, edges i and
-   (for even i) 8 + i/2; of the output, once node i - 2 has moved, the
-   edges from it to nodes moved before (-1: none). */
-static const signed char hex_in_edges[8][2] = {
-    {0, 8}, {1, -1}, {2, 9}, {3, -1}, {4, 10}, {5, -1}, {6, 11}, {7, -1}};
+   in) that step i of the node loop measures: of the input, edge 4 + i
+   (edges 0-3 go with the face centroids, where the unit would idle
+   otherwise); of the output, once node i - 2 has moved, the edges from it
+   to nodes moved before (-1: none). */
+static const signed char hex_in_edges[8] = {4, 5, 6, 7, 8, 9, 10, 11};
 static const signed char hex_out_edges[8][3] = {
     {-1, -1, -1}, {0, -1, -1}, {1, -1, -1}, {2, 3, -1},
     {8, -1, -1},  {4, 9, -1},  {5, 10, -1}, {6, 7, 11}};
@@ -291,6 +293,8 @@ void getme__transform_hex_lanes(const double (*x)[GETME_LANES], double sigma,
             c0[d][l] = s / 8;
             c1[d][l] = 0.0;
         }
+    for (int k = 0; k < 4; k++)
+        hex_edge_len(x, t->edges[k][0], t->edges[k][1], lin[k]);
     for (int fc = 0; fc < 6; fc++)
         for (int d = 0; d < 3; d++) {
             const double *x0 = x[3 * t->face[fc][0] + d], *x1 = x[3 * t->face[fc][1] + d],
@@ -303,11 +307,8 @@ void getme__transform_hex_lanes(const double (*x)[GETME_LANES], double sigma,
     for (int i = 0; i < 8; i++) {
         hex_node((const double(*)[L])c[t->around[i][0]], (const double(*)[L])c[t->around[i][1]],
                  (const double(*)[L])c[t->around[i][2]], sigma, m[i], n[i], f[i]);
-        for (int j = 0; j < 2; j++) {
-            int k = hex_in_edges[i][j];
-            if (k >= 0)
-                hex_edge_len(x, t->edges[k][0], t->edges[k][1], lin[k]);
-        }
+        hex_edge_len(x, t->edges[hex_in_edges[i]][0], t->edges[hex_in_edges[i]][1],
+                     lin[hex_in_edges[i]]);
         if (i >= 2)
             hex_move(i - 2, (const double(*)[3][L])m, (const double(*)[3][L])n,
                      (const double(*)[L])f, out, c1, lout);
