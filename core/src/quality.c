@@ -114,9 +114,12 @@ double getme__cube_root(double x)
    results are bit-identical to cube_root(); the Halley and Newton steps
    are one loop over all the values, so every step is a vector instruction
    and the n independent chains overlap instead of waiting on each other's
-   divisions.  Only the initial guess's division by 3 stays scalar (there
-   is no 64-bit vector multiply-high; an exact vector version through
-   32-bit multiplies measured no faster, bench/kernels.c). */
+   divisions.  The initial guess's bits / 3 is getme__div3_u64 (div3.h),
+   the same integer in vector instructions (there is no 64-bit vector
+   multiply-high); as scalar divisions through a memcpy'd array it cost
+   the hex mean ratio 12 % (bench/kernels.sh 24.3 -> 21.4 ns).  gcc 12
+   left this loop scalar with the bits memcpy'd as a whole array, and
+   with a floor() in div3 (it becomes lfloor, which has no vector form). */
 static inline void cube_root_n(const double *restrict x, double *restrict y,
                                int n)
 {
