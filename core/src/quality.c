@@ -119,14 +119,21 @@ double getme__cube_root(double x)
    multiply-high); as scalar divisions through a memcpy'd array it cost
    the hex mean ratio 12 % (bench/kernels.sh 24.3 -> 21.4 ns).  gcc 12
    left this loop scalar with the bits memcpy'd as a whole array, and
-   with a floor() in div3 (it becomes lfloor, which has no vector form). */
+   with a floor() in div3 (it becomes lfloor, which has no vector form).
+   Without AVX-512 DQ (the portable build's dispatched copies) the 64-bit
+   integer <-> double conversions have no vector instruction either, and
+   div3 measured 5 % slower there than bits / 3u: that build keeps it. */
 static inline void cube_root_n(const double *restrict x, double *restrict y,
                                int n)
 {
 #pragma omp simd
     for (int i = 0; i < n; i++) {
         union { double d; uint64_t u; } v = {x[i]};
+#ifdef __AVX512DQ__
         v.u = getme__div3_u64(v.u) + UINT64_C(0x2A9F7893782DA1CE);
+#else
+        v.u = v.u / 3u + UINT64_C(0x2A9F7893782DA1CE);
+#endif
         y[i] = v.d;
     }
 #pragma omp simd
