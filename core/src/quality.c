@@ -19,6 +19,7 @@
  * Non-finite coordinates give a NaN det or q, which fails the "> 0" tests
  * and so also yields 0.
  */
+#include "div3.h"
 #include "internal.h"
 
 #include <math.h>
@@ -113,17 +114,28 @@ double getme__cube_root(double x)
    results are bit-identical to cube_root(); the Halley and Newton steps
    are one loop over all the values, so every step is a vector instruction
    and the n independent chains overlap instead of waiting on each other's
-   divisions.  Only the initial guess's division by 3 stays scalar (there
-   is no 64-bit vector multiply-high; an exact vector version through
-   32-bit multiplies measured no faster, bench/kernels.c). */
+   divisions.  The initial guess's bits / 3 is getme__div3_u64 (div3.h),
+   the same integer in vector instructions (there is no 64-bit vector
+   multiply-high); as scalar divisions through a memcpy'd array it cost
+   the hex mean ratio 12 % (bench/kernels.sh 24.3 -> 21.4 ns).  gcc 12
+   left this loop scalar with the bits memcpy'd as a whole array, and
+   with a floor() in div3 (it becomes lfloor, which has no vector form).
+   Without AVX-512 DQ (the portable build's dispatched copies) the 64-bit
+   integer <-> double conversions have no vector instruction either, and
+   div3 measured 5 % slower there than bits / 3u: that build keeps it. */
 static inline void cube_root_n(const double *restrict x, double *restrict y,
                                int n)
 {
-    uint64_t bits[8 * GETME_LANES];
-    memcpy(bits, x, sizeof(double) * (size_t)n);
-    for (int i = 0; i < n; i++)
-        bits[i] = bits[i] / 3u + UINT64_C(0x2A9F7893782DA1CE);
-    memcpy(y, bits, sizeof(double) * (size_t)n);
+#pragma omp simd
+    for (int i = 0; i < n; i++) {
+        union { double d; uint64_t u; } v = {x[i]};
+#ifdef __AVX512DQ__
+        v.u = getme__div3_u64(v.u) + UINT64_C(0x2A9F7893782DA1CE);
+#else
+        v.u = v.u / 3u + UINT64_C(0x2A9F7893782DA1CE);
+#endif
+        y[i] = v.d;
+    }
 #pragma omp simd
     for (int i = 0; i < n; i++) {
         double yi = y[i], y3, xi = x[i];

@@ -173,76 +173,165 @@ void getme__transform_hex(const double *x, double sigma, double *out)
 }
 
 /* getme__transform_hex of GETME_LANES hexes at once (internal.h): the
-   same operations in the same order per lane as dual_step and
-   getme__rescale3, so every lane's result is bit-identical to the
-   one-element kernel's.  Written in phases over all 8 nodes, each a loop
-   over the lanes (vector instructions): the 24 divisions by 3 of the
-   means side by side, then the 8 nodes' square roots and divisions side
-   by side (8 independent chains instead of one per node), then the
-   moves.  The differences c_j - m of a node's face centroids are taken
-   once each (dual_step takes each twice, as u of one triangle and v of
-   the next: the same values). */
+   same operations per lane as dual_step and getme__rescale3, so every
+   lane's result is bit-identical to the one-element kernel's (the
+   differences below change no bit, see there).  Each step is a loop over
+   the lanes (vector instructions).
+
+   Why this order: the 40 square roots and 9 divisions per hex run on one
+   unit (zmm: 4.5 and 2.5 ns per instruction of 8 lanes, ~25 ns per hex)
+   and the ~900 additions and multiplications on others (~25 ns).  Done in
+   phases (all edge lengths, then all normals, then all 8 nodes' roots)
+   the unit and the adders took turns and the kernel took ~48 ns per hex;
+   perf annotate put half of its samples on waits for square roots.  So
+   the work is interleaved in program order, the way the out-of-order core
+   can overlap it: 4 of the input's 12 edge lengths with the face
+   centroids, then node by node a node's mean and normal (arithmetic)
+   followed by its own two roots and division, one more input edge, and,
+   two nodes behind (its roots are done by then), the moved node and the
+   output edges whose both ends have moved (bench/kernels.sh: 50 -> ~40
+   ns per hex; lags of 1 and 3 nodes measured the same). */
+
+/* Node i's mean m, normal n and factor f = sigma / sqrt(sqrt|n|^2) from
+   its three face centroids a, b, e (dual_step's triangles (a, b), (b, e),
+   (e, a) in its order; each difference c_j - m taken once).  The sums
+   start without dual_step's "0.0 +": that only turns a -0 sum into +0,
+   and n is only used squared and as f n added to m, which is never -0
+   (its own sum starts with 0.0 +): +0 and -0 give the same bits there. */
+__attribute__((always_inline)) static inline void
+hex_node(const double (*a)[GETME_LANES], const double (*b)[GETME_LANES],
+         const double (*e)[GETME_LANES], double sigma, double (*m)[GETME_LANES],
+         double (*n)[GETME_LANES], double *f)
+{
+    enum { L = GETME_LANES };
+    for (int d = 0; d < 3; d++)
+#pragma omp simd
+        for (int l = 0; l < L; l++)
+            m[d][l] = getme__div3(0.0 + a[d][l] + b[d][l] + e[d][l]);
+#pragma omp simd
+    for (int l = 0; l < L; l++) {
+        double ax = a[0][l] - m[0][l], ay = a[1][l] - m[1][l], az = a[2][l] - m[2][l];
+        double bx = b[0][l] - m[0][l], by = b[1][l] - m[1][l], bz = b[2][l] - m[2][l];
+        double ex = e[0][l] - m[0][l], ey = e[1][l] - m[1][l], ez = e[2][l] - m[2][l];
+        double n0 = 0.5 * (ay * bz - az * by);
+        double n1 = 0.5 * (az * bx - ax * bz);
+        double n2 = 0.5 * (ax * by - ay * bx);
+        n0 += 0.5 * (by * ez - bz * ey);
+        n1 += 0.5 * (bz * ex - bx * ez);
+        n2 += 0.5 * (bx * ey - by * ex);
+        n0 += 0.5 * (ey * az - ez * ay);
+        n1 += 0.5 * (ez * ax - ex * az);
+        n2 += 0.5 * (ex * ay - ey * ax);
+        n[0][l] = n0, n[1][l] = n1, n[2][l] = n2;
+        double nn = n0 * n0 + n1 * n1 + n2 * n2; /* = getme__inv_sqrt_norm */
+        f[l] = sigma * (1.0 / sqrt(sqrt(getme__at_least(nn, DBL_MIN))));
+    }
+}
+
+/* len = |p[b] - p[a]| of every lane (getme__shape3_lanes's edge length) */
+__attribute__((always_inline)) static inline void
+hex_edge_len(const double (*p)[GETME_LANES], int a, int b, double *len)
+{
+    const double *pa = p[3 * a], *pb = p[3 * b];
+#pragma omp simd
+    for (int l = 0; l < GETME_LANES; l++) {
+        double dx = pb[l] - pa[l], dy = pb[GETME_LANES + l] - pa[GETME_LANES + l],
+               dz = pb[2 * GETME_LANES + l] - pa[2 * GETME_LANES + l];
+        len[l] = sqrt(dx * dx + dy * dy + dz * dz);
+    }
+}
+
+/* The hex's edges (hex_topo.edges, the order their lengths are summed
+   in) that step i of the node loop measures: of the input, edge 4 + i
+   (edges 0-3 go with the face centroids, where the unit would idle
+   otherwise); of the output, once node i - 2 has moved, the edges from it
+   to nodes moved before (-1: none). */
+static const signed char hex_in_edges[8] = {4, 5, 6, 7, 8, 9, 10, 11};
+static const signed char hex_out_edges[8][3] = {
+    {-1, -1, -1}, {0, -1, -1}, {1, -1, -1}, {2, 3, -1},
+    {8, -1, -1},  {4, 9, -1},  {5, 10, -1}, {6, 7, 11}};
+
+/* Output node i = m + f n, added to the output centroid's sum; then the
+   output edges it completes. */
+__attribute__((always_inline)) static inline void
+hex_move(int i, const double (*m)[3][GETME_LANES], const double (*n)[3][GETME_LANES],
+         const double (*f)[GETME_LANES], double (*out)[GETME_LANES],
+         double (*c)[GETME_LANES], double (*lout)[GETME_LANES])
+{
+    for (int d = 0; d < 3; d++)
+#pragma omp simd
+        for (int l = 0; l < GETME_LANES; l++) {
+            out[3 * i + d][l] = m[i][d][l] + f[i][l] * n[i][d][l];
+            c[d][l] += out[3 * i + d][l];
+        }
+    for (int j = 0; j < 3; j++) {
+        int k = hex_out_edges[i][j];
+        if (k >= 0)
+            hex_edge_len((const double(*)[GETME_LANES])out, hex_topo.edges[k][0],
+                         hex_topo.edges[k][1], lout[k]);
+    }
+}
+
 GETME_LANES_TARGETS
 void getme__transform_hex_lanes(const double (*x)[GETME_LANES], double sigma,
                                 double (*out)[GETME_LANES])
 {
     enum { L = GETME_LANES };
     const dual_topology *t = &hex_topo;
-    double c[6][3][L], m[8][3][L], n[8][3][L], f[8][L], c0[3][L], sum_x[L];
-    /* the input's half of the scaling first: its 12 square roots overlap
-       the dual step's arithmetic */
-    getme__shape3_lanes(x, 8, 12, t->edges, c0, sum_x);
+    double c[6][3][L], m[8][3][L], n[8][3][L], f[8][L];
+    double c0[3][L], c1[3][L], lin[12][L], lout[12][L];
+    /* the centroids of the input (getme__shape3_lanes's sums in node
+       order, then / 8) and of its 6 faces; the face sums start without
+       dual_step's "0.0 +" (a -0 centroid only enters hex_node, see
+       there) */
+    for (int d = 0; d < 3; d++)
+#pragma omp simd
+        for (int l = 0; l < L; l++) {
+            double s = 0.0;
+            for (int i = 0; i < 8; i++)
+                s += x[3 * i + d][l];
+            c0[d][l] = s / 8;
+            c1[d][l] = 0.0;
+        }
+    for (int k = 0; k < 4; k++)
+        hex_edge_len(x, t->edges[k][0], t->edges[k][1], lin[k]);
     for (int fc = 0; fc < 6; fc++)
         for (int d = 0; d < 3; d++) {
             const double *x0 = x[3 * t->face[fc][0] + d], *x1 = x[3 * t->face[fc][1] + d],
                          *x2 = x[3 * t->face[fc][2] + d], *x3 = x[3 * t->face[fc][3] + d];
 #pragma omp simd
             for (int l = 0; l < L; l++)
-                c[fc][d][l] = (0.0 + x0[l] + x1[l] + x2[l] + x3[l]) / 4;
+                c[fc][d][l] = (x0[l] + x1[l] + x2[l] + x3[l]) / 4;
         }
-    for (int i = 0; i < 8; i++)
-        for (int d = 0; d < 3; d++) {
-            const double *c0 = c[t->around[i][0]][d], *c1 = c[t->around[i][1]][d],
-                         *c2 = c[t->around[i][2]][d];
-#pragma omp simd
-            for (int l = 0; l < L; l++)
-                m[i][d][l] = (0.0 + c0[l] + c1[l] + c2[l]) / 3;
-        }
+#pragma GCC unroll 8
     for (int i = 0; i < 8; i++) {
-        double(*a)[L] = c[t->around[i][0]], (*b)[L] = c[t->around[i][1]],
-        (*e)[L] = c[t->around[i][2]];
+        hex_node((const double(*)[L])c[t->around[i][0]], (const double(*)[L])c[t->around[i][1]],
+                 (const double(*)[L])c[t->around[i][2]], sigma, m[i], n[i], f[i]);
+        hex_edge_len(x, t->edges[hex_in_edges[i]][0], t->edges[hex_in_edges[i]][1],
+                     lin[hex_in_edges[i]]);
+        if (i >= 2)
+            hex_move(i - 2, (const double(*)[3][L])m, (const double(*)[3][L])n,
+                     (const double(*)[L])f, out, c1, lout);
+    }
+    hex_move(6, (const double(*)[3][L])m, (const double(*)[3][L])n, (const double(*)[L])f,
+             out, c1, lout);
+    hex_move(7, (const double(*)[3][L])m, (const double(*)[3][L])n, (const double(*)[L])f,
+             out, c1, lout);
+    /* getme__rescale3_lanes_out: edge-length sums in edge order */
 #pragma omp simd
-        for (int l = 0; l < L; l++) {
-            double ax = a[0][l] - m[i][0][l], ay = a[1][l] - m[i][1][l],
-                   az = a[2][l] - m[i][2][l];
-            double bx = b[0][l] - m[i][0][l], by = b[1][l] - m[i][1][l],
-                   bz = b[2][l] - m[i][2][l];
-            double ex = e[0][l] - m[i][0][l], ey = e[1][l] - m[i][1][l],
-                   ez = e[2][l] - m[i][2][l];
-            /* the triangles (a, b), (b, e), (e, a) in dual_step's order */
-            double n0 = 0.0 + 0.5 * (ay * bz - az * by);
-            double n1 = 0.0 + 0.5 * (az * bx - ax * bz);
-            double n2 = 0.0 + 0.5 * (ax * by - ay * bx);
-            n0 += 0.5 * (by * ez - bz * ey);
-            n1 += 0.5 * (bz * ex - bx * ez);
-            n2 += 0.5 * (bx * ey - by * ex);
-            n0 += 0.5 * (ey * az - ez * ay);
-            n1 += 0.5 * (ez * ax - ex * az);
-            n2 += 0.5 * (ex * ay - ey * ax);
-            n[i][0][l] = n0, n[i][1][l] = n1, n[i][2][l] = n2;
-            f[i][l] = n0 * n0 + n1 * n1 + n2 * n2;
+    for (int l = 0; l < L; l++) {
+        double sx = 0.0, so = 0.0;
+        for (int k = 0; k < 12; k++) {
+            sx += lin[k][l];
+            so += lout[k][l];
+        }
+        double fs = sx / getme__at_least(so, DBL_MIN);
+        for (int d = 0; d < 3; d++) {
+            double cd = c1[d][l] / 8;
+            for (int i = 0; i < 8; i++)
+                out[3 * i + d][l] = c0[d][l] + fs * (out[3 * i + d][l] - cd);
         }
     }
-    for (int i = 0; i < 8; i++)
-#pragma omp simd
-        for (int l = 0; l < L; l++) /* = sigma * getme__inv_sqrt_norm(n) */
-            f[i][l] = sigma * (1.0 / sqrt(sqrt(getme__at_least(f[i][l], DBL_MIN))));
-    for (int i = 0; i < 8; i++)
-        for (int d = 0; d < 3; d++)
-#pragma omp simd
-            for (int l = 0; l < L; l++)
-                out[3 * i + d][l] = m[i][d][l] + f[i][l] * n[i][d][l];
-    getme__rescale3_lanes_out(out, 8, 12, t->edges, (const double(*)[L])c0, sum_x);
 }
 
 /* ---- prism -------------------------------------------------------------- */

@@ -11,6 +11,8 @@
 #ifndef GETME_TRANSFORM_SCALE_H
 #define GETME_TRANSFORM_SCALE_H
 
+#include "div3.h"
+
 #include <float.h>
 #include <math.h>
 

@@ -99,12 +99,27 @@ static double ref_corner_sj_hex(const double *x)
 
 /* Element l of a batch of type t: kind 0 the regular element, 1 moved a
    little, 2 moved a lot (often inverted), 3 two nodes on top of each
-   other (degenerate); scaled and shifted far from the origin. */
+   other (degenerate); scaled and shifted far from the origin.  Kind 4 is
+   the regular element at the origin, and kind 5 every node there, each
+   zero coordinate +0 or -0 at random: the sums whose "0.0 +" the hex
+   transformation's lanes leave out see -0 terms there.  Kind 6 is kind 1
+   at the origin, unscaled: far from it the last bits of the scaling
+   factor vanish in the shift back (a summation order that changed them
+   went unseen on kinds 0-3). */
 static void element(int t, int kind, double *x)
 {
     int nv = getme__nv[t];
     const double *r = regular[t];
+    if (kind == 4 || kind == 5) {
+        for (int i = 0; i < 3 * nv; i++) {
+            double v = kind == 4 ? r[i] : 0.0;
+            x[i] = v == 0.0 && srand1() < 0.0 ? -0.0 : v;
+        }
+        return;
+    }
     double s = 1e-3 * (1.0 + 0.5 * srand1()), o = 1e3 * srand1();
+    if (kind == 6)
+        s = 1.0, o = 0.0, kind = 1;
     for (int i = 0; i < 3 * nv; i++) {
         double d = kind == 1 ? 0.2 * srand1() : kind == 2 ? 1.5 * srand1() : 0.0;
         x[i] = o + s * (r[i] + d);
@@ -120,22 +135,24 @@ static void check_type(int t)
         double x[GETME_LANES][3 * GETME_MAX_NV], xl[3 * GETME_MAX_NV][GETME_LANES];
         double yl[3 * GETME_MAX_NV][GETME_LANES], ql[GETME_LANES];
         for (int l = 0; l < GETME_LANES; l++) {
-            element(t, batch < 4 ? batch : (batch + l) % 4, x[l]);
+            element(t, batch < 7 ? batch : (batch + l) % 7, x[l]);
             for (int i = 0; i < 3 * nv; i++)
                 xl[i][l] = x[l][i];
         }
+        /* a large sigma too: the normals' last bits then reach the output */
+        double sigma = batch % 3 ? 0.3 : 4.0;
         CHECK(getme__quality_lanes(t, (const double(*)[GETME_LANES])xl, ql));
         if (t == GETME_TET)
-            getme__transform_tet_lanes((const double(*)[GETME_LANES])xl, 0.3, yl);
+            getme__transform_tet_lanes((const double(*)[GETME_LANES])xl, sigma, yl);
         else
-            getme__transform_hex_lanes((const double(*)[GETME_LANES])xl, 0.3, yl);
+            getme__transform_hex_lanes((const double(*)[GETME_LANES])xl, sigma, yl);
         for (int l = 0; l < GETME_LANES; l++) {
             double y[3 * GETME_MAX_NV];
             ok_q &= same_bits(ql[l], getme__quality(t, x[l]));
             if (t == GETME_HEX)
                 ok_ref &= same_bits(ql[l], ref_quality_hex(x[l])) &
                           same_bits(getme__corner_sj(t, x[l]), ref_corner_sj_hex(x[l]));
-            getme__transform(t, x[l], 0.3, y);
+            getme__transform(t, x[l], sigma, y);
             for (int i = 0; i < 3 * nv; i++)
                 ok_t &= same_bits(yl[i][l], y[i]);
         }
