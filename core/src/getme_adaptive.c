@@ -857,6 +857,33 @@ static int sums_current(getme_run *run)
 }
 #endif
 
+#ifdef GETME_CHECK_SUMS
+/* Test builds (tests/core), every q_mean iteration: a scatter with a bound
+   32 times smaller first (elements with a coordinate beyond it overflow,
+   the other blocks place their nodes: transform_block), undone as after a
+   real overflow (clear_sums); the coordinates must be back bit for bit.
+   The real scatter follows with the real bound, so outputs are a release
+   build's.  A real overflow is never seen in practice, so this is where
+   the undo of early placements runs.  GETME_OK, or GETME_ERR_STATE. */
+static getme_status undo_check(getme_run *run, double q_lo)
+{
+    size_t xb = (size_t)run->ws->nn * 3 * sizeof(double);
+    double *x0 = malloc(xb ? xb : 1), bound = run->xbound;
+    if (!x0)
+        return GETME_ERR_STATE;
+    memcpy(x0, run->ws->x, xb);
+    run->xbound = bound / 32.0;
+    set_scales(run, q_lo);
+    scatter_all(run);
+    run->overflow = 0;
+    clear_sums(run);
+    run->xbound = bound;
+    int same = memcmp(x0, run->ws->x, xb) == 0;
+    free(x0);
+    return same ? GETME_OK : GETME_ERR_STATE;
+}
+#endif
+
 /* One iteration of the main loop (Fig. 3 lines 5-9).  mean_stage: the
    q_mean stage, where every free element is transformed over the lists
    lists_all() built; otherwise the elements with q <= qt (run->tlist).
@@ -875,6 +902,10 @@ static getme_status iterate(getme_run *run, int mean_stage, double qt,
        the processes */
     run->place_early = mean_stage && !run->comm;
     run->place_rho = R[0];
+#ifdef GETME_CHECK_SUMS
+    if (run->place_early && undo_check(run, q_lo) != GETME_OK)
+        return GETME_ERR_STATE;
+#endif
     for (;;) {
         set_scales(run, q_lo);
         run->overflow = 0;
