@@ -46,7 +46,10 @@
 typedef struct getme_blocks {
     int64_t *nptr;   /* num_blocks + 1: block b's nodes are
                         nodes[nptr[b] .. nptr[b + 1])                     */
-    int32_t *nodes;  /* global node indices, in first-use order           */
+    int32_t *nodes;  /* global node indices, in first-use order; during
+                        a GETMe adaptive run the sign bit marks a node's
+                        last block (getme_adaptive.c mark_last): read
+                        them as nodes[k] & INT32_MAX                      */
     uint16_t *lconn; /* like ws->conn, but each entry the node's index in
                         its block's list (< 8 * 512, fits 16 bits)        */
     int32_t max_nodes; /* the largest block's node count                  */

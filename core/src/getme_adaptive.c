@@ -226,13 +226,28 @@ weights_3d(int t, const getme_run *run, int32_t e0, int32_t e1,
     }
 }
 
+/* ComputeNewNodes' p-hat of a node from its complete exact sums f: the
+   quotient of the two integers' doubles scaled back by back = 1 / pscale,
+   a power of two, so the only roundings are the two conversions and the
+   division; the same operations wherever it runs (compute_new_nodes,
+   transform_block), so the same bits. */
+static inline void node_phat(const getme_fx *f, double back, double a[3])
+{
+    double inv = 1.0 / (double)f[3];
+    a[0] = (double)f[0] * inv * back;
+    a[1] = (double)f[1] * inv * back;
+    a[2] = (double)f[2] * inv * back;
+}
+
 /* The free elements of block b (all of type t, a constant in each copy,
    GETME_FOR_TYPE) transformed, in three steps on the block's own node
    list (block_local.h): copy its nodes' coordinates, S_v and fixed flags
    into the thread's scratch; weight, transform and sum every element's
    contributions there; add each node's block sum to its global sums once
    and mark it in I_T.  The integer sums are exact, so this gives the same
-   bits as adding element by element into the global sums. */
+   bits as adding element by element into the global sums.  With
+   run->place_early, a node whose last block this is (mark_last) is then
+   complete: its p-hat is computed and the node placed here. */
 __attribute__((always_inline)) /* one copy per type: t is a constant */
 static inline void transform_block(int t, getme_run *run, int32_t b,
                                    double sigma, int32_t *count, int *ovf)
@@ -251,9 +266,9 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
        nodes ahead, here and in the final addition (perf annotate: those
        loads missed). */
     for (int32_t k = 0; k < m; k++) {
-        int32_t g = gn[k];
+        int32_t g = gn[k] & INT32_MAX; /* the sign bit: mark_last */
         if (k + PREFETCH_AHEAD < m) {
-            int64_t gp = gn[k + PREFETCH_AHEAD];
+            int64_t gp = gn[k + PREFETCH_AHEAD] & INT32_MAX;
             __builtin_prefetch(ws->x + 3 * gp, 0, 3);
             __builtin_prefetch(adj->nsum + gp, 0, 3);
         }
@@ -358,16 +373,34 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
         }
     }
     getme_fx *facc = run->facc;
+    /* not after a bound overflow: the iteration starts over (iterate) */
+    const int early = run->place_early && !o;
+    const double back = 1.0 / run->pscale, rho = run->place_rho;
+    double *x = ws->x;
+    uint8_t *in_t = run->in_t, *ridx = run->ridx;
     for (int32_t k = 0; k < m; k++) {
         if (k + PREFETCH_AHEAD < m)
-            __builtin_prefetch(facc + 4 * (int64_t)gn[k + PREFETCH_AHEAD], 1, 3);
+            __builtin_prefetch(
+                facc + 4 * (int64_t)(gn[k + PREFETCH_AHEAD] & INT32_MAX), 1, 3);
         if (flag[k] == 2) {
-            int64_t g = gn[k];
-            facc[4 * g] += acc[4 * k];
-            facc[4 * g + 1] += acc[4 * k + 1];
-            facc[4 * g + 2] += acc[4 * k + 2];
-            facc[4 * g + 3] += acc[4 * k + 3];
-            run->in_t[g] = 1;
+            int32_t gk = gn[k];
+            int64_t g = gk & INT32_MAX;
+            getme_fx *f = facc + 4 * g;
+            f[0] += acc[4 * k];
+            f[1] += acc[4 * k + 1];
+            f[2] += acc[4 * k + 2];
+            f[3] += acc[4 * k + 3];
+            if (early && gk < 0) { /* the node's last block: complete */
+                double a[3];
+                node_phat(f, back, a);
+                unsigned char *p = (unsigned char *)f; /* as compute_new_nodes */
+                memcpy(p, a, sizeof a);
+                getme__place_first(x, p + GETME_XOLD_OFF, ridx, (int32_t)g,
+                                   rho, a);
+                in_t[g] = 2;
+            } else {
+                in_t[g] = 1;
+            }
         }
     }
     *count += n;
@@ -385,6 +418,33 @@ static int64_t scatter_block(void *ctx, int32_t b)
     GETME_FOR_TYPE(getme__ws_type(ws, ws->block_start[b]), transform_block,
                    run, b, run->params->sigma, &count, &ovf);
     return count + ((int64_t)(ovf != 0) << 32);
+}
+
+/* For the q_mean stage's placement in the blocks (transform_block): the
+   sign bit of a node's entry in blk->nodes marks the last block, in
+   getme__blocks_run's order, that holds the node (node indices are below
+   2^31, so the bit is free; transform_block masks it).  That order runs
+   the blocks of blk->order by position, and blocks running at the same
+   time share no node, so a node's blocks run one after another and the
+   last one is well defined.  One backward walk over the order, in_t (zero
+   before and after) as the seen flags; once per run. */
+static void mark_last(getme_run *run)
+{
+    getme_blocks *blk = &run->adj->blk;
+    const getme_ws *ws = run->ws;
+    uint8_t *seen = run->in_t;
+    for (int32_t k = ws->num_blocks - 1; k >= 0; k--) {
+        int32_t b = blk->order[k];
+        for (int64_t j = blk->nptr[b]; j < blk->nptr[b + 1]; j++) {
+            uint32_t g = (uint32_t)blk->nodes[j] & INT32_MAX;
+            if (!seen[g]) {
+                seen[g] = 1;
+                g |= (uint32_t)1 << 31;
+            }
+            blk->nodes[j] = (int32_t)g;
+        }
+    }
+    memset(seen, 0, (size_t)ws->nn);
 }
 
 /* q_mean stage: every free element is transformed, block by block in the
@@ -653,28 +713,31 @@ static getme_status start_tlist(getme_run *run, double qt)
 }
 
 /* ComputeNewNodes: p-hat = weighted sum / weight sum, for I_T, from the
-   exact sums, written over them (cleared by getme__reset_nodes).  The quotient of
-   the two integers' doubles is scaled back by 1 / pscale, a power of two,
-   so the only roundings are the two conversions and the division.  In the
-   same pass each node takes the relaxation's first position (rho0 =
-   R[0]; getme__place_first), which saves the relaxation a pass over the
-   nodes' sums. */
+   exact sums (node_phat), written over them (cleared by
+   getme__reset_nodes).  In the same pass each node takes the relaxation's
+   first position (rho0 = R[0]; getme__place_first), which saves the
+   relaxation a pass over the nodes' sums.  Nodes their last block placed
+   already (in_t 2, transform_block) are skipped: in the q_mean stage on
+   one process that is all of them, and this pass reads only the list and
+   the flags. */
 static void compute_new_nodes(getme_run *run, double rho0)
 {
     double back = 1.0 / run->pscale;
     getme_fx *facc = run->facc;
     double *x = run->ws->x;
     uint8_t *ridx = run->ridx;
+    const uint8_t *in_t = run->in_t;
     const int32_t *nodes = run->nodes;
     int32_t nn = run->num_nodes;
 #pragma omp parallel for schedule(static) num_threads(run->ws->nt) \
     if (nn > GETME_PAR_MIN)
     for (int32_t k = 0; k < nn; k++) {
         int32_t n = nodes[k];
+        if (in_t[n] == 2)
+            continue; /* placed by its last block (transform_block) */
         getme_fx *f = facc + 4 * (int64_t)n;
-        double inv = 1.0 / (double)f[3];
-        double a[3] = {(double)f[0] * inv * back, (double)f[1] * inv * back,
-                       (double)f[2] * inv * back};
+        double a[3];
+        node_phat(f, back, a);
         /* p-hat over the node's sums (run->phat): getme__reset_nodes
            zeroes them again before the next scatter. */
         unsigned char *p = (unsigned char *)f;
@@ -684,9 +747,17 @@ static void compute_new_nodes(getme_run *run, double rho0)
     run->placed = 1;
 }
 
-/* Undo a scatter: zero the sums and the I_T flags it set. */
+/* Undo a scatter: put back the nodes it placed (in_t 2: their old
+   coordinates are after their p-hat), zero the sums and the I_T flags it
+   set. */
 static void clear_sums(getme_run *run)
 {
+    for (int32_t k = 0; k < run->num_nodes; k++) {
+        int32_t n = run->nodes[k];
+        if (run->in_t[n] == 2)
+            memcpy(run->ws->x + 3 * (int64_t)n, getme__xold(run, n),
+                   3 * sizeof(double));
+    }
     memset(run->facc, 0, (size_t)run->ws->nn * 4 * sizeof *run->facc);
     for (int32_t k = 0; k < run->num_nodes; k++)
         run->in_t[run->nodes[k]] = 0;
@@ -786,6 +857,33 @@ static int sums_current(getme_run *run)
 }
 #endif
 
+#ifdef GETME_CHECK_SUMS
+/* Test builds (tests/core), every q_mean iteration: a scatter with a bound
+   32 times smaller first (elements with a coordinate beyond it overflow,
+   the other blocks place their nodes: transform_block), undone as after a
+   real overflow (clear_sums); the coordinates must be back bit for bit.
+   The real scatter follows with the real bound, so outputs are a release
+   build's.  A real overflow is never seen in practice, so this is where
+   the undo of early placements runs.  GETME_OK, or GETME_ERR_STATE. */
+static getme_status undo_check(getme_run *run, double q_lo)
+{
+    size_t xb = (size_t)run->ws->nn * 3 * sizeof(double);
+    double *x0 = malloc(xb ? xb : 1), bound = run->xbound;
+    if (!x0)
+        return GETME_ERR_STATE;
+    memcpy(x0, run->ws->x, xb);
+    run->xbound = bound / 32.0;
+    set_scales(run, q_lo);
+    scatter_all(run);
+    run->overflow = 0;
+    clear_sums(run);
+    run->xbound = bound;
+    int same = memcmp(x0, run->ws->x, xb) == 0;
+    free(x0);
+    return same ? GETME_OK : GETME_ERR_STATE;
+}
+#endif
+
 /* One iteration of the main loop (Fig. 3 lines 5-9).  mean_stage: the
    q_mean stage, where every free element is transformed over the lists
    lists_all() built; otherwise the elements with q <= qt (run->tlist).
@@ -799,6 +897,15 @@ static getme_status iterate(getme_run *run, int mean_stage, double qt,
     /* The q_mean stage's relaxation keeps the Eq. 9 sums at run->q (relax.c);
        in the q*_min stage update_after brings them up to date. */
     run->live = mean_stage ? run->adj : NULL;
+    /* the q_mean stage's blocks place their nodes (transform_block); not
+       distributed, where a node's sums are complete only once summed over
+       the processes */
+    run->place_early = mean_stage && !run->comm;
+    run->place_rho = R[0];
+#ifdef GETME_CHECK_SUMS
+    if (run->place_early && undo_check(run, q_lo) != GETME_OK)
+        return GETME_ERR_STATE;
+#endif
     for (;;) {
         set_scales(run, q_lo);
         run->overflow = 0;
@@ -812,6 +919,7 @@ static getme_status iterate(getme_run *run, int mean_stage, double qt,
         clear_sums(run);
         run->xbound *= 256.0;
     }
+    run->place_early = 0;
     if (run->comm) { /* every copy of a node gets the whole mesh's sums */
         if (mean_stage)
             getme__dist_node_or(run, run->in_t);
@@ -1096,6 +1204,8 @@ getme_status getme__adaptive(getme_run *run)
     }
     lists_all(run);
     set_bounds(run);
+    if (!run->comm)
+        mark_last(run);
     /* The Eq. 9 sums at the input's qualities; from here on every change of
        run->q updates them (the relaxation, update_after). */
     getme__adj_sums_all(run->adj, ws, run->q);

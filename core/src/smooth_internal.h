@@ -46,7 +46,16 @@ typedef struct getme_run {
        done by GETMe adaptive's ComputeNewNodes in the same pass);
        getme__relax clears it. */
     int placed;
-    uint8_t *in_t;      /* nn: node is in I_T (moves this iteration)        */
+    /* GETMe adaptive's q_mean stage on one process: the block that adds a
+       node's last contribution (the sign bit of its entry in blk->nodes,
+       getme_adaptive.c mark_last) computes the node's p-hat and places it
+       at R[0] = place_rho itself, while the node's sums and coordinates
+       are in its cache, instead of ComputeNewNodes' pass over all nodes;
+       in_t = 2 marks a node so placed.  0: ComputeNewNodes does it. */
+    int place_early;
+    double place_rho;
+    uint8_t *in_t;      /* nn: node is in I_T (moves this iteration); 2:
+                           placed by its last block (place_early)         */
     uint8_t *flag;      /* nn: scratch flag, all zero between uses          */
     uint8_t *ridx;      /* nn: index into the relaxation table              */
     uint8_t *eflag;     /* ne: scratch flag                                 */
