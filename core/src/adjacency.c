@@ -150,9 +150,12 @@ node_edges(int tf, getme_adj *adj, const getme_ws *ws,
                 s = nbr[q] == o ? q : s;
             int fresh = s == m;
             nbr[m] = o; /* past the list's end unless fresh */
-            deg[s] = (fresh ? 0 : deg[s]) + 1;
+            /* masks, not selects: gcc made the selects branches, and
+               whether an edge is new is a coin toss */
+            uint32_t keep = 0 - (uint32_t)!fresh;
+            deg[s] = (int32_t)(((uint32_t)deg[s] & keep) + 1);
             if (checks)
-                chk[s] = (fresh ? 0 : chk[s]) + cv;
+                chk[s] = (chk[s] & (0 - (uint64_t)!fresh)) + cv;
             m += fresh;
             slots[ju[i]] = (uint8_t)(s < GETME_NO_SLOT ? s : GETME_NO_SLOT);
         }
@@ -355,10 +358,11 @@ static void check_element(getme_adj *adj, const getme_ws *ws,
     for (int i = 0; i < nv; i++)
         for (int32_t k = ws->star_ptr[c[i]]; k < ws->star_ptr[c[i] + 1]; k++) {
             int32_t n = star[k];
-            int fresh = stamp[n] != now;
+            uint32_t fresh = stamp[n] != now;
             stamp[n] = now;
-            truth += fresh ? check_value(n) : 0;
-            cnt += fresh;
+            /* masked, not selected: gcc made the select a branch again */
+            truth += check_value(n) & (0 - (uint64_t)fresh);
+            cnt += (int32_t)fresh;
         }
     const int32_t *f = getme__adj_faces(adj, ws, t, e);
     uint64_t formula = 0, fs = 0;
