@@ -29,6 +29,17 @@ int64_t getme__ws_face_offsets(const getme_ws *ws,
     return total;
 }
 
+/* The node of a simplex face f's element not on f (tet: 6 minus the sum
+   of the face's local nodes, triangle: 3 minus it), or -1. */
+static int apex(int t, int f)
+{
+    const getme_face_table *ft = &getme__faces[t];
+    int sum = 0;
+    for (int i = 0; i < ft->size[f]; i++)
+        sum += ft->node[f][i];
+    return t == GETME_TET ? 6 - sum : t == GETME_TRI ? 3 - sum : -1;
+}
+
 /* The faces of each type at each corner, with the face's other corners:
    built from getme__faces once per call (a few hundred bytes). */
 typedef struct corner_faces {
@@ -36,6 +47,7 @@ typedef struct corner_faces {
     int8_t face[4];    /* which faces                           */
     int8_t size[4];    /* how many other corners each has       */
     int8_t other[4][3];
+    int8_t apex[4];    /* simplices: the corner not on the face, else -1 */
 } corner_faces;
 
 static void corner_table(corner_faces table[GETME_NUM_TYPES][GETME_MAX_NV])
@@ -51,6 +63,7 @@ static void corner_table(corner_faces table[GETME_NUM_TYPES][GETME_MAX_NV])
                 cf->size[k] = (int8_t)(ft->size[f] - 1);
                 for (int i = 1; i < ft->size[f]; i++)
                     cf->other[k][i - 1] = ft->node[f][(j + i) % ft->size[f]];
+                cf->apex[k] = (int8_t)apex(t, f);
             }
     }
 }
@@ -66,31 +79,17 @@ typedef struct face_group {
 /* One side: the element, which face of it, its group. */
 typedef struct face_side {
     int32_t elem, face, group;
+    int32_t apex; /* simplices: the element's node not on the face; -1 */
 } face_side;
-
-/* The node of a simplex face f's element not on f (tet: 6 minus the sum
-   of the face's local nodes, triangle: 3 minus it), or -1. */
-static int apex(int t, int f)
-{
-    const getme_face_table *ft = &getme__faces[t];
-    int sum = 0;
-    for (int i = 0; i < ft->size[f]; i++)
-        sum += ft->node[f][i];
-    return t == GETME_TET ? 6 - sum : t == GETME_TRI ? 3 - sum : -1;
-}
 
 /* Are the two sides of a two-sided face the same simplex (duplicate
    elements)?  They share the face's nodes, so exactly when their apexes
-   are the same node.  tf: the mesh's one type, or -1. */
-static inline int same_simplex(int tf, const getme_ws *ws, const face_side *a,
-                               const face_side *b)
+   are the same node, read when the side was met (its element's row then
+   in cache).  Other types' sides have apex -1: a side of a tet and one
+   of a prism or pyramid are never the same element. */
+static inline int same_simplex(const face_side *a, const face_side *b)
 {
-    int ta = tf >= 0 ? tf : getme__ws_type(ws, a->elem);
-    int tb = tf >= 0 ? tf : getme__ws_type(ws, b->elem);
-    if (ta != tb || (ta != GETME_TET && ta != GETME_TRI))
-        return 0;
-    return getme__ws_nodes(ws, ta, a->elem)[apex(ta, a->face)] ==
-           getme__ws_nodes(ws, tb, b->elem)[apex(tb, b->face)];
+    return a->apex >= 0 && a->apex == b->apex;
 }
 
 /* The faces whose lowest node is u: every side in sides, grouped by its
@@ -140,7 +139,8 @@ faces_at(int tf, const getme_ws *ws,
             r->k[0] = k0;
             r->k[1] = k1 == INT32_MAX ? -1 : k1;
             r->k[2] = k2 == INT32_MAX ? -1 : k2;
-            sides[m] = (face_side){n, cf->face[k], 0};
+            int8_t ap = cf->apex[k];
+            sides[m] = (face_side){n, cf->face[k], 0, ap >= 0 ? c[ap] : -1};
             m += lowest;
         }
     }
@@ -194,8 +194,8 @@ faces_node(int tf, const getme_ws *ws,
             v = GETME_FACE_IRREGULAR;
         } else if (r->n == 2) {
             const face_side *other = &sd[r->first == i ? r->second : r->first];
-            v = same_simplex(tf, ws, &sd[i], other) ? GETME_FACE_IRREGULAR
-                                                    : other->elem;
+            v = same_simplex(&sd[i], other) ? GETME_FACE_IRREGULAR
+                                            : other->elem;
         }
         int t = tf >= 0 ? tf : getme__ws_type(ws, sd[i].elem);
         out[foff[t] + (int64_t)(sd[i].elem - ws->tstart[t]) *
