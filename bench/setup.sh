@@ -5,7 +5,8 @@
 #     bench/setup.sh MESH.msh|MESH.raw [threads] [repetitions]
 # A .msh is converted once to MESH.raw in $RAW (default /tmp) with Gmsh's
 # Python module (Debian's /usr/bin/python3).  SRC=other checkout measures
-# another tree's set-up with the same driver; CPU=N pins it (taskset).
+# another tree's set-up with the same driver; CPU=N pins it (taskset);
+# WALL=1 reports wall seconds instead of CPU seconds.
 set -e
 here=$(cd "$(dirname "$0")/.." && pwd)
 src=${SRC:-$here}

@@ -150,9 +150,12 @@ node_edges(int tf, getme_adj *adj, const getme_ws *ws,
                 s = nbr[q] == o ? q : s;
             int fresh = s == m;
             nbr[m] = o; /* past the list's end unless fresh */
-            deg[s] = (fresh ? 0 : deg[s]) + 1;
+            /* masks, not selects: gcc made the selects branches, and
+               whether an edge is new is a coin toss */
+            uint32_t keep = 0 - (uint32_t)!fresh;
+            deg[s] = (int32_t)(((uint32_t)deg[s] & keep) + 1);
             if (checks)
-                chk[s] = (fresh ? 0 : chk[s]) + cv;
+                chk[s] = (chk[s] & (0 - (uint64_t)!fresh)) + cv;
             m += fresh;
             slots[ju[i]] = (uint8_t)(s < GETME_NO_SLOT ? s : GETME_NO_SLOT);
         }
@@ -329,6 +332,7 @@ static void counts_and_flags(getme_adj *adj, const getme_ws *ws,
 
 typedef struct union_scratch {
     uint32_t *stamp; /* ne: element last seen at this stamp value */
+    const uint64_t *cv; /* ne: check_value of every element (shared) */
     int32_t *list;
     uint32_t now;
 } union_scratch;
@@ -351,14 +355,16 @@ static void check_element(getme_adj *adj, const getme_ws *ws,
     /* Branch-free: whether an element was seen already is a coin toss
        (a hex's 8 stars hold ~64 entries, ~27 of them distinct). */
     uint32_t *restrict stamp = sc->stamp;
+    const uint64_t *restrict cv = sc->cv;
     const int32_t *restrict star = ws->star;
     for (int i = 0; i < nv; i++)
         for (int32_t k = ws->star_ptr[c[i]]; k < ws->star_ptr[c[i] + 1]; k++) {
             int32_t n = star[k];
-            int fresh = stamp[n] != now;
+            uint32_t fresh = stamp[n] != now;
             stamp[n] = now;
-            truth += fresh ? check_value(n) : 0;
-            cnt += fresh;
+            /* masked, not selected: gcc made the select a branch again */
+            truth += cv[n] & (0 - (uint64_t)fresh);
+            cnt += (int32_t)fresh;
         }
     const int32_t *f = getme__adj_faces(adj, ws, t, e);
     uint64_t formula = 0, fs = 0;
@@ -387,18 +393,27 @@ static getme_status check_all(getme_adj *adj, const getme_ws *ws,
     union_scratch *sc = calloc((size_t)nt, sizeof *sc);
     int ok = sc != NULL;
     size_t ne = (size_t)(ws->ne ? ws->ne : 1);
+    /* every element's check value once (8 B per element while the
+       check runs, below the smoothing's peak): the union walk meets each
+       ~2.4 times */
+    uint64_t *cv = malloc(ne * sizeof *cv);
+    ok = ok && cv != NULL;
     for (int k = 0; ok && k < nt; k++) {
         sc[k].stamp = calloc(ne, sizeof *sc[k].stamp);
+        sc[k].cv = cv;
         ok = sc[k].stamp != NULL;
     }
     if (ok) {
+#pragma omp parallel for schedule(static) num_threads(nt)
+        for (int32_t e = 0; e < ws->ne; e++)
+            cv[e] = check_value(e);
 #pragma omp parallel for schedule(dynamic, 2048) num_threads(nt)
         for (int32_t e = 0; e < ws->ne; e++)
             check_element(adj, ws, rn, re, e, &sc[omp_get_thread_num()]);
     }
     for (int k = 0; sc && k < nt; k++)
         free(sc[k].stamp);
-    free(sc);
+    free(sc), free(cv);
     return ok ? GETME_OK : GETME_ERR_NOMEM;
 }
 

@@ -29,6 +29,17 @@ int64_t getme__ws_face_offsets(const getme_ws *ws,
     return total;
 }
 
+/* The node of a simplex face f's element not on f (tet: 6 minus the sum
+   of the face's local nodes, triangle: 3 minus it), or -1. */
+static int apex(int t, int f)
+{
+    const getme_face_table *ft = &getme__faces[t];
+    int sum = 0;
+    for (int i = 0; i < ft->size[f]; i++)
+        sum += ft->node[f][i];
+    return t == GETME_TET ? 6 - sum : t == GETME_TRI ? 3 - sum : -1;
+}
+
 /* The faces of each type at each corner, with the face's other corners:
    built from getme__faces once per call (a few hundred bytes). */
 typedef struct corner_faces {
@@ -36,6 +47,7 @@ typedef struct corner_faces {
     int8_t face[4];    /* which faces                           */
     int8_t size[4];    /* how many other corners each has       */
     int8_t other[4][3];
+    int8_t apex[4];    /* simplices: the corner not on the face, else -1 */
 } corner_faces;
 
 static void corner_table(corner_faces table[GETME_NUM_TYPES][GETME_MAX_NV])
@@ -51,6 +63,7 @@ static void corner_table(corner_faces table[GETME_NUM_TYPES][GETME_MAX_NV])
                 cf->size[k] = (int8_t)(ft->size[f] - 1);
                 for (int i = 1; i < ft->size[f]; i++)
                     cf->other[k][i - 1] = ft->node[f][(j + i) % ft->size[f]];
+                cf->apex[k] = (int8_t)apex(t, f);
             }
     }
 }
@@ -66,38 +79,30 @@ typedef struct face_group {
 /* One side: the element, which face of it, its group. */
 typedef struct face_side {
     int32_t elem, face, group;
+    int32_t apex; /* simplices: the element's node not on the face; -1 */
 } face_side;
-
-/* The node of a simplex face f's element not on f (tet: 6 minus the sum
-   of the face's local nodes, triangle: 3 minus it), or -1. */
-static int apex(int t, int f)
-{
-    const getme_face_table *ft = &getme__faces[t];
-    int sum = 0;
-    for (int i = 0; i < ft->size[f]; i++)
-        sum += ft->node[f][i];
-    return t == GETME_TET ? 6 - sum : t == GETME_TRI ? 3 - sum : -1;
-}
 
 /* Are the two sides of a two-sided face the same simplex (duplicate
    elements)?  They share the face's nodes, so exactly when their apexes
-   are the same node. */
-static int same_simplex(const getme_ws *ws, const face_side *a,
-                        const face_side *b)
+   are the same node, read when the side was met (its element's row then
+   in cache).  Other types' sides have apex -1: a side of a tet and one
+   of a prism or pyramid are never the same element. */
+static inline int same_simplex(const face_side *a, const face_side *b)
 {
-    int ta = getme__ws_type(ws, a->elem), tb = getme__ws_type(ws, b->elem);
-    if (ta != tb || (ta != GETME_TET && ta != GETME_TRI))
-        return 0;
-    return getme__ws_nodes(ws, ta, a->elem)[apex(ta, a->face)] ==
-           getme__ws_nodes(ws, tb, b->elem)[apex(tb, b->face)];
+    return a->apex >= 0 && a->apex == b->apex;
 }
 
 /* The faces whose lowest node is u: every side in sides, grouped by its
    other nodes into groups through the hash table (all -1 on entry and on
    return; mask + 1 slots, at least twice the sides: a linear search of
    the ~11 faces a node has in a tet mesh was slower).  Returns how many
-   sides; *ng: how many groups.  tf: the mesh's
-   one type (a constant in each inlined copy), or -1. */
+   sides; *ng: how many groups.  tf: the mesh's one type (a constant in
+   each inlined copy), or -1.
+   Two passes: the star's faces at u are first written as candidates, each
+   kept (the count advanced) only if u is its lowest node, without a
+   branch: whether it is, is a coin toss (about one face in three at a
+   corner), and its mispredictions were most of the walk's cost.  The
+   keys' other nodes are sorted by a min/max network, also branch-free. */
 static inline __attribute__((always_inline)) int
 faces_at(int tf, const getme_ws *ws,
          corner_faces table[GETME_NUM_TYPES][GETME_MAX_NV], int32_t u,
@@ -106,6 +111,10 @@ faces_at(int tf, const getme_ws *ws,
 {
     int m = 0, g = 0;
     int32_t kend = ws->star_ptr[ws->nn];
+    /* groups[] doubles as the candidates' key store: a candidate's key
+       goes to groups[m].k until the second pass moves it into its group
+       (groups are numbered in first-seen order, so group q <= candidate
+       m and is written only after candidate m was read). */
     for (int32_t s = ws->star_ptr[u]; s < ws->star_ptr[u + 1]; s++) {
         int32_t n = ws->star[s];
         if (tf >= 0 && s + GETME_STAR_AHEAD < kend)
@@ -117,38 +126,50 @@ faces_at(int tf, const getme_ws *ws,
             li |= (c[i] == u) * i;
         const corner_faces *cf = &table[t][li];
         for (int k = 0; k < cf->num; k++) {
-            int32_t o[3] = {-1, -1, -1};
-            int lowest = 1;
-            for (int i = 0; i < cf->size[k]; i++) {
-                o[i] = c[cf->other[k][i]];
-                lowest &= o[i] > u;
-            }
-            if (!lowest)
-                continue;
-            for (int i = 1; i < cf->size[k]; i++) /* sort the <= 3 others */
-                for (int j = i; j > 0 && o[j - 1] > o[j]; j--) {
-                    int32_t tmp = o[j];
-                    o[j] = o[j - 1];
-                    o[j - 1] = tmp;
-                }
-            uint32_t h = (((uint32_t)o[0] * 0x9E3779B1u) ^
-                          ((uint32_t)o[1] * 0x85EBCA77u) ^
-                          ((uint32_t)o[2] * 0xC2B2AE3Du));
-            h = (h ^ (h >> 15)) & mask;
-            while (hash[h] >= 0 && !(groups[hash[h]].k[0] == o[0] &&
-                                     groups[hash[h]].k[1] == o[1] &&
-                                     groups[hash[h]].k[2] == o[2]))
-                h = (h + 1) & mask;
-            int q = hash[h];
-            if (q < 0) {
-                q = hash[h] = g++;
-                groups[q] = (face_group){{o[0], o[1], o[2]}, 0, m, -1, (int32_t)h};
-            } else if (groups[q].n == 1) {
-                groups[q].second = m;
-            }
-            groups[q].n++;
-            sides[m++] = (face_side){n, cf->face[k], q};
+            /* INT32_MAX stands for "none" (a face of 2 or 3 nodes): it
+               passes the test and sorts last */
+            int32_t a = c[cf->other[k][0]];
+            int32_t b = cf->size[k] > 1 ? c[cf->other[k][1]] : INT32_MAX;
+            int32_t d = cf->size[k] > 2 ? c[cf->other[k][2]] : INT32_MAX;
+            int lowest = (a > u) & (b > u) & (d > u);
+            int32_t lo = a < b ? a : b, hi = a < b ? b : a;
+            int32_t k0 = lo < d ? lo : d, mid = lo < d ? d : lo;
+            int32_t k1 = mid < hi ? mid : hi, k2 = mid < hi ? hi : mid;
+            face_group *r = &groups[m];
+            r->k[0] = k0;
+            r->k[1] = k1 == INT32_MAX ? -1 : k1;
+            r->k[2] = k2 == INT32_MAX ? -1 : k2;
+            int8_t ap = cf->apex[k];
+            sides[m] = (face_side){n, cf->face[k], 0, ap >= 0 ? c[ap] : -1};
+            m += lowest;
         }
+    }
+    for (int i = 0; i < m; i++) {
+        int32_t o0 = groups[i].k[0], o1 = groups[i].k[1], o2 = groups[i].k[2];
+        uint32_t h = (((uint32_t)o0 * 0x9E3779B1u) ^
+                      ((uint32_t)o1 * 0x85EBCA77u) ^
+                      ((uint32_t)o2 * 0xC2B2AE3Du));
+        h = (h ^ (h >> 15)) & mask;
+        /* Probing past a slot taken by another face is rare (the table
+           is at least 8 times the sides); whether the face is new or
+           seen before is a coin toss, so that is decided by selects. */
+        while (hash[h] >= 0 && !(groups[hash[h]].k[0] == o0 &&
+                                 groups[hash[h]].k[1] == o1 &&
+                                 groups[hash[h]].k[2] == o2))
+            h = (h + 1) & mask;
+        int32_t q0 = hash[h];
+        int fresh = q0 < 0;
+        int32_t q = fresh ? g : q0;
+        face_group *r = &groups[q];
+        int32_t n0 = fresh ? 0 : r->n;
+        r->second = n0 == 1 ? i : fresh ? -1 : r->second;
+        r->first = fresh ? i : r->first;
+        r->k[0] = o0, r->k[1] = o1, r->k[2] = o2;
+        r->n = n0 + 1;
+        r->slot = (int32_t)h;
+        hash[h] = q;
+        g += fresh;
+        sides[i].group = q;
     }
     for (int i = 0; i < g; i++)
         hash[groups[i].slot] = -1;
@@ -156,12 +177,30 @@ faces_at(int tf, const getme_ws *ws,
     return m;
 }
 
-/* Entry of out for face f of element e. */
-static inline int32_t *slot(const getme_ws *ws, const int64_t *foff,
-                            int32_t *out, int32_t e, int f)
+/* The out entries of the faces whose lowest node is u (tf: the mesh's
+   one type, or -1). */
+static inline __attribute__((always_inline)) void
+faces_node(int tf, const getme_ws *ws,
+           corner_faces table[GETME_NUM_TYPES][GETME_MAX_NV], int32_t u,
+           face_side *sd, face_group *gr, int32_t *hs, uint32_t mask,
+           const int64_t *foff, int32_t *out)
 {
-    int t = getme__ws_type(ws, e);
-    return out + foff[t] + (int64_t)(e - ws->tstart[t]) * getme__faces[t].num_faces + f;
+    int ng;
+    int m = faces_at(tf, ws, table, u, sd, gr, hs, mask, &ng);
+    for (int i = 0; i < m; i++) {
+        const face_group *r = &gr[sd[i].group];
+        int32_t v = -1;
+        if (r->n > 2) {
+            v = GETME_FACE_IRREGULAR;
+        } else if (r->n == 2) {
+            const face_side *other = &sd[r->first == i ? r->second : r->first];
+            v = same_simplex(&sd[i], other) ? GETME_FACE_IRREGULAR
+                                            : other->elem;
+        }
+        int t = tf >= 0 ? tf : getme__ws_type(ws, sd[i].elem);
+        out[foff[t] + (int64_t)(sd[i].elem - ws->tstart[t]) *
+                          getme__faces[t].num_faces + sd[i].face] = v;
+    }
 }
 
 getme_status getme__ws_faces(const getme_ws *ws, const int64_t *foff,
@@ -185,28 +224,17 @@ getme_status getme__ws_faces(const getme_ws *ws, const int64_t *foff,
     int single = getme__ws_single_type(ws);
 #pragma omp parallel for schedule(dynamic, 1024) num_threads(ws->nt)
     for (int32_t u = 0; u < ws->nn; u++) {
-        int th = omp_get_thread_num(), ng;
+        int th = omp_get_thread_num();
         face_side *sd = sides + (size_t)th * bufsize;
         face_group *gr = groups + (size_t)th * bufsize;
         int32_t *hs = hashes + (size_t)th * hsize;
         uint32_t mask = (uint32_t)(hsize - 1);
-        int m = single == GETME_TET
-                    ? faces_at(GETME_TET, ws, table, u, sd, gr, hs, mask, &ng)
-                : single == GETME_HEX
-                    ? faces_at(GETME_HEX, ws, table, u, sd, gr, hs, mask, &ng)
-                    : faces_at(-1, ws, table, u, sd, gr, hs, mask, &ng);
-        for (int i = 0; i < m; i++) {
-            const face_group *r = &gr[sd[i].group];
-            int32_t v = -1;
-            if (r->n > 2) {
-                v = GETME_FACE_IRREGULAR;
-            } else if (r->n == 2) {
-                const face_side *other = &sd[r->first == i ? r->second : r->first];
-                v = same_simplex(ws, &sd[i], other) ? GETME_FACE_IRREGULAR
-                                                    : other->elem;
-            }
-            *slot(ws, foff, out, sd[i].elem, sd[i].face) = v;
-        }
+        if (single == GETME_TET)
+            faces_node(GETME_TET, ws, table, u, sd, gr, hs, mask, foff, out);
+        else if (single == GETME_HEX)
+            faces_node(GETME_HEX, ws, table, u, sd, gr, hs, mask, foff, out);
+        else
+            faces_node(-1, ws, table, u, sd, gr, hs, mask, foff, out);
     }
     free(sides), free(groups), free(hashes);
     return GETME_OK;

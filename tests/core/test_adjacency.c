@@ -655,6 +655,104 @@ static void same_setup(const getme_ws *a, const getme_adj *aa,
     }
 }
 
+/* ---- the face table against a plain construction -------------------- */
+
+typedef struct ref_side {
+    int32_t key[4]; /* the face's nodes, sorted, -1 padded */
+    int32_t elem, face;
+} ref_side;
+
+static int cmp_side(const void *pa, const void *pb)
+{
+    const ref_side *a = pa, *b = pb;
+    for (int i = 0; i < 4; i++)
+        if (a->key[i] != b->key[i])
+            return a->key[i] < b->key[i] ? -1 : 1;
+    return a->elem != b->elem ? (a->elem < b->elem ? -1 : 1)
+                              : (a->face > b->face) - (a->face < b->face);
+}
+
+static int same_nodes(const getme_ws *ws, int32_t a, int32_t b)
+{
+    int ta = getme__ws_type(ws, a), tb = getme__ws_type(ws, b);
+    if (ta != tb)
+        return 0;
+    int32_t x[GETME_MAX_NV], y[GETME_MAX_NV];
+    int nv = getme__nv[ta];
+    memcpy(x, getme__ws_nodes(ws, ta, a), (size_t)nv * sizeof *x);
+    memcpy(y, getme__ws_nodes(ws, tb, b), (size_t)nv * sizeof *y);
+    for (int i = 1; i < nv; i++) /* insertion sorts of <= 8 */
+        for (int j = i; j > 0 && x[j - 1] > x[j]; j--) {
+            int32_t t = x[j]; x[j] = x[j - 1]; x[j - 1] = t;
+        }
+    for (int i = 1; i < nv; i++)
+        for (int j = i; j > 0 && y[j - 1] > y[j]; j--) {
+            int32_t t = y[j]; y[j] = y[j - 1]; y[j - 1] = t;
+        }
+    return !memcmp(x, y, (size_t)nv * sizeof *x);
+}
+
+/* Every element face's entry of the face table (getme__ws_faces, as
+   getme__adj_build keeps it) against the definition, from all sides
+   sorted by their node sets: a face of one side is -1, of three or more
+   GETME_FACE_IRREGULAR, of two the other element, unless the two are the
+   same tet or triangle (duplicates: irregular). */
+static void check_faces_reference(const getme_ws *ws, const getme_adj *adj,
+                                  int duplicates)
+{
+    int64_t foff[GETME_NUM_TYPES];
+    int64_t nf = getme__ws_face_offsets(ws, foff);
+    ref_side *sd = malloc((size_t)(nf ? nf : 1) * sizeof *sd);
+    int64_t m = 0;
+    for (int t = 0; t < GETME_NUM_TYPES; t++) {
+        const getme_face_table *ft = &getme__faces[t];
+        for (int32_t e = ws->tstart[t]; e < ws->tstart[t + 1]; e++) {
+            const int32_t *c = getme__ws_nodes(ws, t, e);
+            for (int f = 0; f < ft->num_faces; f++, m++) {
+                ref_side *r = &sd[m];
+                r->elem = e, r->face = f;
+                for (int i = 0; i < 4; i++)
+                    r->key[i] = i < ft->size[f] ? c[ft->node[f][i]] : -1;
+                for (int i = 1; i < ft->size[f]; i++)
+                    for (int j = i; j > 0 && r->key[j - 1] > r->key[j]; j--) {
+                        int32_t tmp = r->key[j];
+                        r->key[j] = r->key[j - 1];
+                        r->key[j - 1] = tmp;
+                    }
+            }
+        }
+    }
+    qsort(sd, (size_t)m, sizeof *sd, cmp_side);
+    int64_t bad = 0, irregular = 0, two = 0;
+    for (int64_t a = 0, b; a < m; a = b) {
+        for (b = a + 1; b < m && !memcmp(sd[a].key, sd[b].key, sizeof sd[a].key); b++)
+            ;
+        for (int64_t k = a; k < b; k++) {
+            int32_t e = sd[k].elem, want = -1;
+            int t = getme__ws_type(ws, e);
+            if (b - a > 2) {
+                want = GETME_FACE_IRREGULAR;
+            } else if (b - a == 2) {
+                int32_t o = sd[k == a ? a + 1 : a].elem;
+                int simplex = t == GETME_TET || t == GETME_TRI;
+                want = simplex && same_nodes(ws, e, o) ? GETME_FACE_IRREGULAR : o;
+                two++;
+            }
+            irregular += want == GETME_FACE_IRREGULAR;
+            int32_t got = adj->fnb[foff[t] + (int64_t)(e - ws->tstart[t]) *
+                                                 getme__faces[t].num_faces +
+                                   sd[k].face];
+            if (got != want && bad++ < 5)
+                fprintf(stderr, "element %d face %d: table %d, reference %d\n",
+                        (int)e, (int)sd[k].face, (int)got, (int)want);
+        }
+    }
+    CHECK_EQ_INT((int)bad, 0);
+    CHECK(two > 0);
+    CHECK(duplicates ? irregular > 0 : irregular == 0);
+    free(sd);
+}
+
 static void check_threads(const char *kind, int duplicates)
 {
     int n0 = N;
@@ -688,6 +786,8 @@ static void check_threads(const char *kind, int duplicates)
     }
     CHECK(ws[0].nn > 500 && ws[0].num_blocks > 3);
     CHECK(duplicates ? adj[0].num_irregular > 0 : 1);
+    check_faces_reference(&ws[0], &adj[0], duplicates);
+    check_faces_reference(&ws[2], &adj[2], duplicates);
     for (int k = 1; k < 3; k++)
         same_setup(&ws[0], &adj[0], &ws[k], &adj[k]);
     for (int k = 0; k < 3; k++) {
