@@ -136,8 +136,11 @@ __attribute__((constructor)) static void start(void)
 
 __attribute__((destructor)) static void report(void)
 {
+    /* only the file the user names (HEAPPEAK_OUT), else stderr: a tool
+       preloaded into any command must not create or replace a file in
+       its working directory */
     const char *path = getenv("HEAPPEAK_OUT");
-    FILE *f = fopen(path ? path : "heappeak.txt", "w");
+    FILE *f = path ? fopen(path, "w") : stderr;
     if (!f)
         return;
     fprintf(f, "peak %.1f MiB in %d blocks of %d KiB or more\n",
@@ -154,5 +157,6 @@ __attribute__((destructor)) static void report(void)
         }
         fprintf(f, "\n");
     }
-    fclose(f);
+    if (f != stderr)
+        fclose(f);
 }
