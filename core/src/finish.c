@@ -424,20 +424,6 @@ typedef struct worker {
     double log[LOG_CAP];
 } worker;
 
-/* buf with room for need >= 1 entries of size bytes (room *cap, doubled
-   when it grows), or NULL without memory (buf stays valid). */
-static void *room(void *buf, int64_t *cap, int64_t need, size_t size)
-{
-    if (need <= *cap)
-        return buf;
-    int64_t c = *cap ? 2 * *cap : 256;
-    c = c < need ? need : c;
-    void *b = realloc(buf, (size_t)c * size);
-    if (b)
-        *cap = c;
-    return b;
-}
-
 /* Put the elements around the k nodes mv into the patch (each once), with
    their qualities from run->q if known (else evaluated). */
 static getme_status fill(getme_run *run, getme_patch *p, const int32_t *mv,
@@ -503,7 +489,7 @@ static void store(getme_run *run, worker *w, pool *pl)
 /* Log one memo event (or mark the memo lost). */
 static void log_event(worker *w, memo_event ev)
 {
-    memo_event *b = room(w->ev, &w->cap_ev, w->nev + 1, sizeof *b);
+    memo_event *b = getme__room(w->ev, &w->cap_ev, w->nev + 1, sizeof *b);
     if (!b) {
         w->memo_lost = 1;
         return;
@@ -940,10 +926,11 @@ static void process(sweep_ctx *c, worker *w, int32_t i, int undo)
         w->st = st;
         return;
     }
-    double *cg = room(w->cg, &w->cap_cg, w->ncg + nl, sizeof *cg);
+    double *cg = getme__room(w->cg, &w->cap_cg, w->ncg + nl, sizeof *cg);
     if (cg)
         w->cg = cg;
-    undo_rec *un = undo ? room(w->un, &w->cap_un, w->nun + k, sizeof *un) : NULL;
+    undo_rec *un =
+        undo ? getme__room(w->un, &w->cap_un, w->nun + k, sizeof *un) : NULL;
     if (un)
         w->un = un;
     if (!cg || (undo && !un)) {

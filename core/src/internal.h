@@ -88,21 +88,32 @@ static inline int getme__cmp_ranked(const void *a, const void *b)
     return (x->e > y->e) - (x->e < y->e);
 }
 
-/* Append x to the growing index list *list (*n entries, room *cap; the
-   room doubles, so no allocation per entry).  0, or -1 if out of memory
-   (the list as it was). */
+/* buf with room for need >= 1 entries of size bytes (room *cap, at least
+   doubled when it grows, so no allocation per entry), or NULL without
+   memory (buf and *cap stay valid). */
+static inline void *getme__room(void *buf, int64_t *cap, int64_t need,
+                                size_t size)
+{
+    if (need <= *cap)
+        return buf;
+    int64_t c = *cap ? 2 * *cap : 256;
+    c = c < need ? need : c;
+    void *b = realloc(buf, (size_t)c * size);
+    if (b)
+        *cap = c;
+    return b;
+}
+
+/* Append x to the growing index list *list (*n entries, room *cap).  0,
+   or -1 if out of memory (the list as it was). */
 static inline int getme__push_i32(int32_t **list, int32_t *n, int64_t *cap,
                                   int32_t x)
 {
-    if (*n >= *cap) {
-        int64_t c = 2 * *cap + 64;
-        int32_t *p = realloc(*list, (size_t)c * sizeof *p);
-        if (!p)
-            return -1;
-        *list = p;
-        *cap = c;
-    }
-    (*list)[(*n)++] = x;
+    int32_t *p = getme__room(*list, cap, (int64_t)*n + 1, sizeof *p);
+    if (!p)
+        return -1;
+    *list = p;
+    p[(*n)++] = x;
     return 0;
 }
 
