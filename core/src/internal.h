@@ -165,6 +165,12 @@ void getme__transform_tet_lanes(const double (*x)[GETME_LANES], double sigma,
 /* The same for hexahedra (transform_dual.c). */
 void getme__transform_hex_lanes(const double (*x)[GETME_LANES], double sigma,
                                 double (*out)[GETME_LANES]);
+/* its two forms (transform_dual.c: node by node for AVX-512, in phases
+   for AVX2), both in every build so that core_lanes checks both */
+void getme__transform_hex_lanes_nodes(const double (*x)[GETME_LANES], double sigma,
+                                      double (*out)[GETME_LANES]);
+void getme__transform_hex_lanes_phases(const double (*x)[GETME_LANES], double sigma,
+                                       double (*out)[GETME_LANES]);
 /* getme__quality of GETME_LANES elements of type type at once (x in
    lanes as above) into q; bit-identical per lane.  Returns 0 (nothing
    done) for a type without a lane kernel (only tets and hexes have one). */

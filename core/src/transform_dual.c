@@ -172,18 +172,21 @@ void getme__transform_hex(const double *x, double sigma, double *out)
     getme__rescale3(out, x, t->nv, t->ne, t->edges);
 }
 
-/* getme__transform_hex of GETME_LANES hexes at once (internal.h): the
-   same operations per lane as dual_step and getme__rescale3, so every
-   lane's result is bit-identical to the one-element kernel's (the
-   differences below change no bit, see there).  Each step is a loop over
-   the lanes (vector instructions).
+/* getme__transform_hex of GETME_LANES hexes at once (internal.h), in two
+   forms with the same operations per lane as dual_step and
+   getme__rescale3, so every lane's result is bit-identical to the
+   one-element kernel's (the differences below change no bit, see there).
+   Each step is a loop over the lanes (vector instructions).  Which form
+   is faster depends on the vector width (getme__transform_hex_lanes at
+   the end chooses).
 
-   Why this order: the 40 square roots and 9 divisions per hex run on one
-   unit (zmm: 4.5 and 2.5 ns per instruction of 8 lanes, ~25 ns per hex)
-   and the ~900 additions and multiplications on others (~25 ns).  Done in
-   phases (all edge lengths, then all normals, then all 8 nodes' roots)
-   the unit and the adders took turns and the kernel took ~48 ns per hex;
-   perf annotate put half of its samples on waits for square roots.  So
+   getme__transform_hex_lanes_nodes, for AVX-512: the 40 square roots and
+   9 divisions per hex run on one unit (zmm: 4.5 and 2.5 ns per
+   instruction of 8 lanes, ~25 ns per hex) and the ~900 additions and
+   multiplications on others (~25 ns).  Done in phases (all edge lengths,
+   then all normals, then all 8 nodes' roots) the unit and the adders took
+   turns and the kernel took ~48 ns per hex on the Intel machine of round
+   8; perf annotate put half of its samples on waits for square roots.  So
    the work is interleaved in program order, the way the out-of-order core
    can overlap it: 4 of the input's 12 edge lengths with the face
    centroids, then node by node a node's mean and normal (arithmetic)
@@ -273,8 +276,8 @@ hex_move(int i, const double (*m)[3][GETME_LANES], const double (*n)[3][GETME_LA
 }
 
 GETME_LANES_TARGETS
-void getme__transform_hex_lanes(const double (*x)[GETME_LANES], double sigma,
-                                double (*out)[GETME_LANES])
+void getme__transform_hex_lanes_nodes(const double (*x)[GETME_LANES], double sigma,
+                                      double (*out)[GETME_LANES])
 {
     enum { L = GETME_LANES };
     const dual_topology *t = &hex_topo;
@@ -332,6 +335,101 @@ void getme__transform_hex_lanes(const double (*x)[GETME_LANES], double sigma,
                 out[3 * i + d][l] = c0[d][l] + fs * (out[3 * i + d][l] - cd);
         }
     }
+}
+
+/* getme__transform_hex_lanes_phases, for AVX2 (4 doubles a register, 16
+   registers): the same work in phases over all 8 nodes, each a loop over
+   the lanes: the input's centroid and edge lengths, the face centroids,
+   the 24 node means / 3, the 8 normals, the 8 nodes' square roots and
+   divisions side by side (8 independent chains), the moves, the output's
+   scaling.  On AMD Zen 3 the node-by-node form above was 45 % slower
+   (bench/kernels.sh hex transform lanes ~125 -> ~180 ns; medium hexes,
+   perf samples of the kernel 1590 -> 2530 at one thread): its live
+   values do not fit 16 ymm registers.  This is the kernel of 1b1fe30
+   with getme__div3 for the means (the same bits as / 3; on Zen 3 it and
+   the division measured the same). */
+GETME_LANES_TARGETS
+void getme__transform_hex_lanes_phases(const double (*x)[GETME_LANES], double sigma,
+                                       double (*out)[GETME_LANES])
+{
+    enum { L = GETME_LANES };
+    const dual_topology *t = &hex_topo;
+    double c[6][3][L], m[8][3][L], n[8][3][L], f[8][L], c0[3][L], sum_x[L];
+    /* the input's half of the scaling first: its 12 square roots overlap
+       the dual step's arithmetic */
+    getme__shape3_lanes(x, 8, 12, t->edges, c0, sum_x);
+    for (int fc = 0; fc < 6; fc++)
+        for (int d = 0; d < 3; d++) {
+            const double *x0 = x[3 * t->face[fc][0] + d], *x1 = x[3 * t->face[fc][1] + d],
+                         *x2 = x[3 * t->face[fc][2] + d], *x3 = x[3 * t->face[fc][3] + d];
+#pragma omp simd
+            for (int l = 0; l < L; l++)
+                c[fc][d][l] = (0.0 + x0[l] + x1[l] + x2[l] + x3[l]) / 4;
+        }
+    for (int i = 0; i < 8; i++)
+        for (int d = 0; d < 3; d++) {
+            const double *a = c[t->around[i][0]][d], *b = c[t->around[i][1]][d],
+                         *e = c[t->around[i][2]][d];
+#pragma omp simd
+            for (int l = 0; l < L; l++)
+                m[i][d][l] = getme__div3(0.0 + a[l] + b[l] + e[l]);
+        }
+    for (int i = 0; i < 8; i++) {
+        double(*a)[L] = c[t->around[i][0]], (*b)[L] = c[t->around[i][1]],
+        (*e)[L] = c[t->around[i][2]];
+#pragma omp simd
+        for (int l = 0; l < L; l++) {
+            double ax = a[0][l] - m[i][0][l], ay = a[1][l] - m[i][1][l],
+                   az = a[2][l] - m[i][2][l];
+            double bx = b[0][l] - m[i][0][l], by = b[1][l] - m[i][1][l],
+                   bz = b[2][l] - m[i][2][l];
+            double ex = e[0][l] - m[i][0][l], ey = e[1][l] - m[i][1][l],
+                   ez = e[2][l] - m[i][2][l];
+            /* the triangles (a, b), (b, e), (e, a) in dual_step's order */
+            double n0 = 0.0 + 0.5 * (ay * bz - az * by);
+            double n1 = 0.0 + 0.5 * (az * bx - ax * bz);
+            double n2 = 0.0 + 0.5 * (ax * by - ay * bx);
+            n0 += 0.5 * (by * ez - bz * ey);
+            n1 += 0.5 * (bz * ex - bx * ez);
+            n2 += 0.5 * (bx * ey - by * ex);
+            n0 += 0.5 * (ey * az - ez * ay);
+            n1 += 0.5 * (ez * ax - ex * az);
+            n2 += 0.5 * (ex * ay - ey * ax);
+            n[i][0][l] = n0, n[i][1][l] = n1, n[i][2][l] = n2;
+            f[i][l] = n0 * n0 + n1 * n1 + n2 * n2;
+        }
+    }
+    for (int i = 0; i < 8; i++)
+#pragma omp simd
+        for (int l = 0; l < L; l++) /* = sigma * getme__inv_sqrt_norm(n) */
+            f[i][l] = sigma * (1.0 / sqrt(sqrt(getme__at_least(f[i][l], DBL_MIN))));
+    for (int i = 0; i < 8; i++)
+        for (int d = 0; d < 3; d++)
+#pragma omp simd
+            for (int l = 0; l < L; l++)
+                out[3 * i + d][l] = m[i][d][l] + f[i][l] * n[i][d][l];
+    getme__rescale3_lanes_out(out, 8, 12, t->edges, (const double(*)[L])c0, sum_x);
+}
+
+/* The form for this CPU: fixed at compile time in the native build (the
+   ISA macros of -march=native), chosen at run time in the portable one
+   (GETME_DISPATCH: each form has its own load-time copies, and the
+   node-by-node form is taken where the AVX-512 copy will run).  Both give
+   the same bits (core_lanes runs both on every build). */
+void getme__transform_hex_lanes(const double (*x)[GETME_LANES], double sigma,
+                                double (*out)[GETME_LANES])
+{
+#if defined(GETME_DISPATCH) && defined(__x86_64__) && defined(__GNUC__) && \
+    !defined(__clang__)
+    if (__builtin_cpu_supports("avx512f"))
+        getme__transform_hex_lanes_nodes(x, sigma, out);
+    else
+        getme__transform_hex_lanes_phases(x, sigma, out);
+#elif defined(__AVX512F__)
+    getme__transform_hex_lanes_nodes(x, sigma, out);
+#else
+    getme__transform_hex_lanes_phases(x, sigma, out);
+#endif
 }
 
 /* ---- prism -------------------------------------------------------------- */

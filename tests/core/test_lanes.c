@@ -134,6 +134,9 @@ static void check_type(int t)
     for (int batch = 0; batch < 2000; batch++) {
         double x[GETME_LANES][3 * GETME_MAX_NV], xl[3 * GETME_MAX_NV][GETME_LANES];
         double yl[3 * GETME_MAX_NV][GETME_LANES], ql[GETME_LANES];
+        /* the hex transformation's two forms (transform_dual.c), whichever
+           getme__transform_hex_lanes chose on this machine */
+        double yn[3 * GETME_MAX_NV][GETME_LANES], yp[3 * GETME_MAX_NV][GETME_LANES];
         for (int l = 0; l < GETME_LANES; l++) {
             element(t, batch < 7 ? batch : (batch + l) % 7, x[l]);
             for (int i = 0; i < 3 * nv; i++)
@@ -144,8 +147,11 @@ static void check_type(int t)
         CHECK(getme__quality_lanes(t, (const double(*)[GETME_LANES])xl, ql));
         if (t == GETME_TET)
             getme__transform_tet_lanes((const double(*)[GETME_LANES])xl, sigma, yl);
-        else
+        else {
             getme__transform_hex_lanes((const double(*)[GETME_LANES])xl, sigma, yl);
+            getme__transform_hex_lanes_nodes((const double(*)[GETME_LANES])xl, sigma, yn);
+            getme__transform_hex_lanes_phases((const double(*)[GETME_LANES])xl, sigma, yp);
+        }
         for (int l = 0; l < GETME_LANES; l++) {
             double y[3 * GETME_MAX_NV];
             ok_q &= same_bits(ql[l], getme__quality(t, x[l]));
@@ -153,8 +159,11 @@ static void check_type(int t)
                 ok_ref &= same_bits(ql[l], ref_quality_hex(x[l])) &
                           same_bits(getme__corner_sj(t, x[l]), ref_corner_sj_hex(x[l]));
             getme__transform(t, x[l], sigma, y);
-            for (int i = 0; i < 3 * nv; i++)
+            for (int i = 0; i < 3 * nv; i++) {
                 ok_t &= same_bits(yl[i][l], y[i]);
+                if (t == GETME_HEX)
+                    ok_t &= same_bits(yn[i][l], y[i]) & same_bits(yp[i][l], y[i]);
+            }
         }
     }
     CHECK(ok_q);
