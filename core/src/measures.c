@@ -643,7 +643,11 @@ static void add_stat(getme_measure_stats *s, double v, int32_t e, double *sum)
         s->num_below++;
         return;
     }
-    double t = (v - s->hist_lo) / (s->hist_hi - s->hist_lo);
+    /* most ranges are [0, 1]: dividing by 1 changes no bit, so it is
+       skipped (a scalar division per element and measure) */
+    double w = s->hist_hi - s->hist_lo, t = v - s->hist_lo;
+    if (w != 1.0)
+        t /= w;
     int bin = (int)(t * GETME_HIST_BINS);
     s->histogram[bin >= GETME_HIST_BINS ? GETME_HIST_BINS - 1 : bin]++;
 }
