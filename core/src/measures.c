@@ -869,13 +869,17 @@ static void hex_axes_lanes(const double (*x)[L], double *u)
 KERNEL void sicn_corner_lanes(int type, const double (*x)[L],
                               const int8_t *c, double *out)
 {
+    double r[L];
 #pragma omp simd
     for (int l = 0; l < L; l++) {
         v3 o = v3_lane(x, c[0], l);
-        out[l] = min_nn(out[l], icn3(type, v3_sub(v3_lane(x, c[1], l), o),
-                                     v3_sub(v3_lane(x, c[2], l), o),
-                                     v3_sub(v3_lane(x, c[3], l), o)));
+        r[l] = icn3(type, v3_sub(v3_lane(x, c[1], l), o),
+                    v3_sub(v3_lane(x, c[2], l), o),
+                    v3_sub(v3_lane(x, c[3], l), o));
     }
+#pragma omp simd
+    for (int l = 0; l < L; l++)
+        out[l] = min_nn(out[l], r[l]);
 }
 
 static void sicn_lanes(int type, const double (*x)[L], double *out)
