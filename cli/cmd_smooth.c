@@ -84,6 +84,10 @@ static int run(smooth_args *a)
     if (getme_doc_info(doc)[0])
         cli_info(log, "%s", getme_doc_info(doc));
 
+    /* the measures, statistics and worst lists before and after
+       smoothing run on the OpenMP default team: make it --threads (the
+       reader's and the smoother's own count), not every core */
+    omp_set_num_threads(opts.num_threads);
     getme_quality_stats before = *getme_doc_stats(doc);
     cli_print_stats(log, "Quality before", &before);
     cli_measures mbefore;

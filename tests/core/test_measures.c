@@ -425,6 +425,30 @@ static void test_threads(void)
         CHECK_EQ_INT(getme_mesh_measure_stats(mesh, -1, (getme_measure)k, &s2), GETME_OK);
         CHECK(memcmp(&s1, &s2, sizeof s1) == 0);
         CHECK_EQ_INT(s1.num_elements, k == GETME_MEASURE_GAMMA ? 0 : n);
+        /* the histogram is the values' bins by the documented formula
+           (v - lo) / (hi - lo) * bins, the division by a width of 1
+           included: in the one-measure and in the all-measures sweep */
+        double *v = malloc((size_t)n * sizeof *v), lo, hi;
+        CHECK_EQ_INT(getme_mesh_element_measures(mesh, (getme_measure)k, v), GETME_OK);
+        CHECK_EQ_INT(getme_measure_range((getme_measure)k, &lo, &hi), GETME_OK);
+        int64_t hist[GETME_HIST_BINS] = {0}, below = 0;
+        for (int e = 0; e < n; e++) {
+            if (isnan(v[e]))
+                continue;
+            if (v[e] < lo) {
+                below++;
+                continue;
+            }
+            int b = (int)((v[e] - lo) / (hi - lo) * GETME_HIST_BINS);
+            hist[b >= GETME_HIST_BINS ? GETME_HIST_BINS - 1 : b]++;
+        }
+        free(v);
+        getme_measure_stats all[GETME_NUM_TYPES * GETME_NUM_MEASURES];
+        CHECK_EQ_INT(getme_mesh_measure_all(mesh, all), GETME_OK);
+        CHECK(memcmp(s1.histogram, hist, sizeof hist) == 0);
+        CHECK_EQ_INT(s1.num_below, below);
+        CHECK(memcmp(all[GETME_HEX * GETME_NUM_MEASURES + k].histogram, hist,
+                     sizeof hist) == 0);
         /* distorted: away from the regular value */
         if (k == DMAX)
             CHECK(s1.max > 90.0);
