@@ -7,6 +7,7 @@
 #include "tally.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -84,50 +85,63 @@ uint32_t getme__morton(const double *x, const double lo[3],
 }
 
 /* Stable LSD radix sort of idx[0..n) by key: three passes of 11, 11 and
-   10 bits, their counts taken in one read.  Two 16-bit passes scattered
-   each key to one of 65536 places (4M tets: most of the workspace
-   build's serial time in cache and TLB misses); 2048 write streams stay
-   in cache.  Stable, so the same order as any stable sort by key. */
-static int radix_sort(uint32_t *key, int32_t *idx, int32_t n)
+   10 bits.  Two 16-bit passes scattered each key to one of 65536 places
+   (4M tets: most of the workspace build's serial time in cache and TLB
+   misses); 2048 write streams stay in cache.  On nt threads: each pass,
+   every thread counts the digits of its own range of the array, then
+   scatters that range after the keys of the same digit in the ranges
+   before it, so the order is that of a serial stable sort for any thread
+   count (and the same as any stable sort by key). */
+static int radix_sort(uint32_t *key, int32_t *idx, int32_t n, int nt)
 {
     enum { BITS = 11, DIGITS = 1 << BITS };
     uint32_t *k2 = malloc((size_t)(n ? n : 1) * sizeof *k2);
     int32_t *i2 = malloc((size_t)(n ? n : 1) * sizeof *i2);
-    int64_t *cnt = calloc(3 * (size_t)DIGITS, sizeof *cnt);
+    int64_t *cnt = malloc((size_t)nt * DIGITS * sizeof *cnt);
     if (!k2 || !i2 || !cnt) {
         free(k2), free(i2), free(cnt);
         return -1;
     }
-    for (int32_t i = 0; i < n; i++) {
-        uint32_t k = key[i];
-        cnt[k & (DIGITS - 1)]++;
-        cnt[DIGITS + ((k >> BITS) & (DIGITS - 1))]++;
-        cnt[2 * DIGITS + (k >> 2 * BITS)]++;
-    }
-    uint32_t *ks = key, *kd = k2;
-    int32_t *is = idx, *id = i2;
-    for (int p = 0; p < 3; p++) {
-        int64_t *c = cnt + (size_t)p * DIGITS, at = 0;
-        for (int d = 0; d < DIGITS; d++) { /* counts -> first positions */
-            int64_t v = c[d];
-            c[d] = at;
-            at += v;
+    uint32_t *kbuf[2] = {key, k2};
+    int32_t *ibuf[2] = {idx, i2};
+#pragma omp parallel num_threads(nt)
+    {
+        int th = omp_get_thread_num(), team = omp_get_num_threads();
+        int32_t lo = (int32_t)((int64_t)n * th / team);
+        int32_t hi = (int32_t)((int64_t)n * (th + 1) / team);
+        int64_t *c = cnt + (size_t)th * DIGITS;
+        for (int p = 0; p < 3; p++) {
+            const uint32_t *ks = kbuf[p & 1];
+            const int32_t *is = ibuf[p & 1];
+            uint32_t *kd = kbuf[(p + 1) & 1];
+            int32_t *id = ibuf[(p + 1) & 1];
+            int shift = p * BITS;
+            memset(c, 0, DIGITS * sizeof *c);
+            for (int32_t i = lo; i < hi; i++)
+                c[(ks[i] >> shift) & (DIGITS - 1)]++;
+#pragma omp barrier
+#pragma omp single
+            { /* counts -> first positions: by digit, then by thread */
+                int64_t at = 0;
+                for (int d = 0; d < DIGITS; d++)
+                    for (int t = 0; t < team; t++) {
+                        int64_t v = cnt[(size_t)t * DIGITS + d];
+                        cnt[(size_t)t * DIGITS + d] = at;
+                        at += v;
+                    }
+            }
+            for (int32_t i = lo; i < hi; i++) {
+                uint32_t k = ks[i];
+                int64_t pos = c[(k >> shift) & (DIGITS - 1)]++;
+                kd[pos] = k;
+                id[pos] = is[i];
+            }
+#pragma omp barrier
         }
-        int shift = p * BITS;
-        for (int32_t i = 0; i < n; i++) {
-            uint32_t k = ks[i];
-            int64_t pos = c[(k >> shift) & (DIGITS - 1)]++;
-            kd[pos] = k;
-            id[pos] = is[i];
-        }
-        uint32_t *kt = ks;
-        ks = kd, kd = kt;
-        int32_t *it = is;
-        is = id, id = it;
     }
     /* three passes: the result is in k2 / i2 */
-    memcpy(key, ks, (size_t)n * sizeof *key);
-    memcpy(idx, is, (size_t)n * sizeof *idx);
+    memcpy(key, k2, (size_t)n * sizeof *key);
+    memcpy(idx, i2, (size_t)n * sizeof *idx);
     free(k2), free(i2), free(cnt);
     return 0;
 }
@@ -194,7 +208,7 @@ static getme_status order_elements(getme_ws *ws, const getme_mesh *mesh,
     /* Sort inside each type range; stable, so ties keep the caller order. */
     for (int t = 0; t < GETME_NUM_TYPES; t++) {
         int32_t a = ws->tstart[t], n = ws->tstart[t + 1] - a;
-        if (n > 1 && radix_sort(key + a, ws->elem_orig + a, n) != 0) {
+        if (n > 1 && radix_sort(key + a, ws->elem_orig + a, n, ws->nt) != 0) {
             free(key);
             return GETME_ERR_NOMEM;
         }
