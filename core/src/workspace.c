@@ -244,8 +244,16 @@ static getme_status number_nodes(getme_ws *ws, const getme_mesh *mesh,
             int32_t local;
             const getme_block *bl =
                 getme__find_block(mesh, ws->elem_orig[e], &local);
-            memcpy(ws->conn + ws->coff[t] + (int64_t)(e - ws->tstart[t]) * nv,
-                   bl->conn + (int64_t)local * nv, (size_t)nv * sizeof *ws->conn);
+            int32_t *dst = ws->conn + ws->coff[t] +
+                           (int64_t)(e - ws->tstart[t]) * nv;
+            const int32_t *src = bl->conn + (int64_t)local * nv;
+            /* a constant size: a few moves, not a call per row */
+            if (nv == 4)
+                memcpy(dst, src, 4 * sizeof *dst);
+            else if (nv == 8)
+                memcpy(dst, src, 8 * sizeof *dst);
+            else
+                memcpy(dst, src, (size_t)nv * sizeof *dst);
         }
     }
     /* First-touch numbering: serial by nature, now a stream over the
@@ -282,8 +290,25 @@ static getme_status build_stars(getme_ws *ws)
     ws->star = malloc((size_t)(total ? total : 1) * sizeof *ws->star);
     if (!ws->star_ptr || !ws->star)
         return GETME_ERR_NOMEM;
-    for (int64_t k = 0; k < total; k++)
-        ws->star_ptr[ws->conn[k] + 1]++;
+    /* Each thread owns a range of nodes and walks all the connectivity,
+       counting and then filling only its own nodes' stars: no shared
+       writes, and each star is filled in ascending element order as by
+       one thread.  The node numbers are first-touch in element order
+       (number_nodes), so whether an entry is the thread's own is a
+       well-predicted branch. */
+    const int32_t *conn = ws->conn;
+    int32_t *ptr = ws->star_ptr;
+#pragma omp parallel num_threads(ws->nt)
+    {
+        int th = omp_get_thread_num(), team = omp_get_num_threads();
+        int32_t n0 = (int32_t)((int64_t)ws->nn * th / team);
+        int32_t n1 = (int32_t)((int64_t)ws->nn * (th + 1) / team);
+        for (int64_t k = 0; k < total; k++) {
+            int32_t v = conn[k];
+            if (v >= n0 && v < n1)
+                ptr[v + 1]++;
+        }
+    }
     ws->max_star = 0;
     for (int32_t i = 0; i < ws->nn; i++) {
         int32_t c = ws->star_ptr[i + 1];
@@ -296,12 +321,19 @@ static getme_status build_stars(getme_ws *ws)
         return GETME_ERR_NOMEM;
     memcpy(pos, ws->star_ptr, (size_t)ws->nn * sizeof *pos);
     /* Elements in ascending order, so every star comes out sorted. */
-    for (int t = 0; t < GETME_NUM_TYPES; t++) {
-        int nv = getme__nv[t];
-        for (int32_t e = ws->tstart[t]; e < ws->tstart[t + 1]; e++) {
-            const int32_t *c = getme__ws_nodes(ws, t, e);
-            for (int i = 0; i < nv; i++)
-                ws->star[pos[c[i]]++] = e;
+#pragma omp parallel num_threads(ws->nt)
+    {
+        int th = omp_get_thread_num(), team = omp_get_num_threads();
+        int32_t n0 = (int32_t)((int64_t)ws->nn * th / team);
+        int32_t n1 = (int32_t)((int64_t)ws->nn * (th + 1) / team);
+        for (int t = 0; t < GETME_NUM_TYPES; t++) {
+            int nv = getme__nv[t];
+            for (int32_t e = ws->tstart[t]; e < ws->tstart[t + 1]; e++) {
+                const int32_t *c = getme__ws_nodes(ws, t, e);
+                for (int i = 0; i < nv; i++)
+                    if (c[i] >= n0 && c[i] < n1)
+                        ws->star[pos[c[i]]++] = e;
+            }
         }
     }
     free(pos);
