@@ -129,15 +129,21 @@ getme_status getme_mesh_add_elements(getme_mesh *mesh, getme_elem_type type,
         return getme__fail(mesh, GETME_ERR_ARGUMENT,
                            "more than 2^31-1 elements");
     int nv = getme__nv[type];
-    for (int32_t e = 0; e < count; e++) {
-        if (!getme__element_nodes_ok(conn + (size_t)e * nv, nv,
-                                     mesh->num_nodes))
-            return getme__fail(mesh, GETME_ERR_TOPOLOGY,
-                               "element %d (%s %d of this block): node index "
-                               "out of range or repeated",
-                               (int)(mesh->num_elements + e),
-                               getme_type_name(type), (int)e);
-    }
+    /* the first bad element: the least of the threads' first ones, the
+       same for any thread count */
+    int32_t bad = count;
+#pragma omp parallel for schedule(static) reduction(min : bad) \
+    if (count >= 16384)
+    for (int32_t e = 0; e < count; e++)
+        if (e < bad && !getme__element_nodes_ok(conn + (size_t)e * nv, nv,
+                                                mesh->num_nodes))
+            bad = e;
+    if (bad < count)
+        return getme__fail(mesh, GETME_ERR_TOPOLOGY,
+                           "element %d (%s %d of this block): node index "
+                           "out of range or repeated",
+                           (int)(mesh->num_elements + bad),
+                           getme_type_name(type), (int)bad);
     if (mesh->num_blocks == mesh->cap_blocks) {
         int cap = mesh->cap_blocks ? 2 * mesh->cap_blocks : 4;
         getme_block *nb = realloc(mesh->blocks, (size_t)cap * sizeof *nb);

@@ -78,9 +78,31 @@ getme_status getme_mesh_fix_boundary(getme_mesh *mesh, unsigned flags,
     }
     const int32_t *fnb = ws.faces;
     int regions = (flags & GETME_FIX_INTERFACES) && !one_region(mesh);
+    /* Which elements have a face to fix: a read-only scan of the whole
+       face table, in parallel; the marking below (its writes to shared
+       nodes serial) then visits only those, the few on the skin and the
+       interfaces. */
+    uint8_t *touch = malloc((size_t)(ws.ne ? ws.ne : 1));
+    if (!touch) {
+        getme__ws_free(&ws);
+        return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
+    }
+    for (int t = 0; t < GETME_NUM_TYPES; t++) {
+        int nf = getme__faces[t].num_faces;
+#pragma omp parallel for schedule(static) num_threads(ws.nt)
+        for (int32_t e = ws.tstart[t]; e < ws.tstart[t + 1]; e++) {
+            const int32_t *f = fnb + foff[t] + (int64_t)(e - ws.tstart[t]) * nf;
+            int any = 0;
+            for (int k = 0; k < nf; k++)
+                any |= face_fixed(mesh, &ws, e, f[k], flags, regions) != 0;
+            touch[e] = (uint8_t)any;
+        }
+    }
     for (int t = 0; t < GETME_NUM_TYPES; t++) {
         const getme_face_table *ft = &getme__faces[t];
         for (int32_t e = ws.tstart[t]; e < ws.tstart[t + 1]; e++) {
+            if (!touch[e])
+                continue;
             const int32_t *c = getme__ws_nodes(&ws, t, e);
             const int32_t *f = fnb + foff[t] + (int64_t)(e - ws.tstart[t]) * ft->num_faces;
             for (int k = 0; k < ft->num_faces; k++) {
@@ -90,6 +112,7 @@ getme_status getme_mesh_fix_boundary(getme_mesh *mesh, unsigned flags,
             }
         }
     }
+    free(touch);
     for (int32_t i = 0; i < ws.nn; i++)
         if (ws.star_ptr[i + 1] == ws.star_ptr[i])
             mesh->fixed[ws.node_orig[i]] |= GETME__FIXED_UNUSED;

@@ -7,6 +7,7 @@
 #include "tally.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -84,50 +85,63 @@ uint32_t getme__morton(const double *x, const double lo[3],
 }
 
 /* Stable LSD radix sort of idx[0..n) by key: three passes of 11, 11 and
-   10 bits, their counts taken in one read.  Two 16-bit passes scattered
-   each key to one of 65536 places (4M tets: most of the workspace
-   build's serial time in cache and TLB misses); 2048 write streams stay
-   in cache.  Stable, so the same order as any stable sort by key. */
-static int radix_sort(uint32_t *key, int32_t *idx, int32_t n)
+   10 bits.  Two 16-bit passes scattered each key to one of 65536 places
+   (4M tets: most of the workspace build's serial time in cache and TLB
+   misses); 2048 write streams stay in cache.  On nt threads: each pass,
+   every thread counts the digits of its own range of the array, then
+   scatters that range after the keys of the same digit in the ranges
+   before it, so the order is that of a serial stable sort for any thread
+   count (and the same as any stable sort by key). */
+static int radix_sort(uint32_t *key, int32_t *idx, int32_t n, int nt)
 {
     enum { BITS = 11, DIGITS = 1 << BITS };
     uint32_t *k2 = malloc((size_t)(n ? n : 1) * sizeof *k2);
     int32_t *i2 = malloc((size_t)(n ? n : 1) * sizeof *i2);
-    int64_t *cnt = calloc(3 * (size_t)DIGITS, sizeof *cnt);
+    int64_t *cnt = malloc((size_t)nt * DIGITS * sizeof *cnt);
     if (!k2 || !i2 || !cnt) {
         free(k2), free(i2), free(cnt);
         return -1;
     }
-    for (int32_t i = 0; i < n; i++) {
-        uint32_t k = key[i];
-        cnt[k & (DIGITS - 1)]++;
-        cnt[DIGITS + ((k >> BITS) & (DIGITS - 1))]++;
-        cnt[2 * DIGITS + (k >> 2 * BITS)]++;
-    }
-    uint32_t *ks = key, *kd = k2;
-    int32_t *is = idx, *id = i2;
-    for (int p = 0; p < 3; p++) {
-        int64_t *c = cnt + (size_t)p * DIGITS, at = 0;
-        for (int d = 0; d < DIGITS; d++) { /* counts -> first positions */
-            int64_t v = c[d];
-            c[d] = at;
-            at += v;
+    uint32_t *kbuf[2] = {key, k2};
+    int32_t *ibuf[2] = {idx, i2};
+#pragma omp parallel num_threads(nt)
+    {
+        int th = omp_get_thread_num(), team = omp_get_num_threads();
+        int32_t lo = (int32_t)((int64_t)n * th / team);
+        int32_t hi = (int32_t)((int64_t)n * (th + 1) / team);
+        int64_t *c = cnt + (size_t)th * DIGITS;
+        for (int p = 0; p < 3; p++) {
+            const uint32_t *ks = kbuf[p & 1];
+            const int32_t *is = ibuf[p & 1];
+            uint32_t *kd = kbuf[(p + 1) & 1];
+            int32_t *id = ibuf[(p + 1) & 1];
+            int shift = p * BITS;
+            memset(c, 0, DIGITS * sizeof *c);
+            for (int32_t i = lo; i < hi; i++)
+                c[(ks[i] >> shift) & (DIGITS - 1)]++;
+#pragma omp barrier
+#pragma omp single
+            { /* counts -> first positions: by digit, then by thread */
+                int64_t at = 0;
+                for (int d = 0; d < DIGITS; d++)
+                    for (int t = 0; t < team; t++) {
+                        int64_t v = cnt[(size_t)t * DIGITS + d];
+                        cnt[(size_t)t * DIGITS + d] = at;
+                        at += v;
+                    }
+            }
+            for (int32_t i = lo; i < hi; i++) {
+                uint32_t k = ks[i];
+                int64_t pos = c[(k >> shift) & (DIGITS - 1)]++;
+                kd[pos] = k;
+                id[pos] = is[i];
+            }
+#pragma omp barrier
         }
-        int shift = p * BITS;
-        for (int32_t i = 0; i < n; i++) {
-            uint32_t k = ks[i];
-            int64_t pos = c[(k >> shift) & (DIGITS - 1)]++;
-            kd[pos] = k;
-            id[pos] = is[i];
-        }
-        uint32_t *kt = ks;
-        ks = kd, kd = kt;
-        int32_t *it = is;
-        is = id, id = it;
     }
     /* three passes: the result is in k2 / i2 */
-    memcpy(key, ks, (size_t)n * sizeof *key);
-    memcpy(idx, is, (size_t)n * sizeof *idx);
+    memcpy(key, k2, (size_t)n * sizeof *key);
+    memcpy(idx, i2, (size_t)n * sizeof *idx);
     free(k2), free(i2), free(cnt);
     return 0;
 }
@@ -194,7 +208,7 @@ static getme_status order_elements(getme_ws *ws, const getme_mesh *mesh,
     /* Sort inside each type range; stable, so ties keep the caller order. */
     for (int t = 0; t < GETME_NUM_TYPES; t++) {
         int32_t a = ws->tstart[t], n = ws->tstart[t + 1] - a;
-        if (n > 1 && radix_sort(key + a, ws->elem_orig + a, n) != 0) {
+        if (n > 1 && radix_sort(key + a, ws->elem_orig + a, n, ws->nt) != 0) {
             free(key);
             return GETME_ERR_NOMEM;
         }
@@ -230,8 +244,16 @@ static getme_status number_nodes(getme_ws *ws, const getme_mesh *mesh,
             int32_t local;
             const getme_block *bl =
                 getme__find_block(mesh, ws->elem_orig[e], &local);
-            memcpy(ws->conn + ws->coff[t] + (int64_t)(e - ws->tstart[t]) * nv,
-                   bl->conn + (int64_t)local * nv, (size_t)nv * sizeof *ws->conn);
+            int32_t *dst = ws->conn + ws->coff[t] +
+                           (int64_t)(e - ws->tstart[t]) * nv;
+            const int32_t *src = bl->conn + (int64_t)local * nv;
+            /* a constant size: a few moves, not a call per row */
+            if (nv == 4)
+                memcpy(dst, src, 4 * sizeof *dst);
+            else if (nv == 8)
+                memcpy(dst, src, 8 * sizeof *dst);
+            else
+                memcpy(dst, src, (size_t)nv * sizeof *dst);
         }
     }
     /* First-touch numbering: serial by nature, now a stream over the
@@ -268,8 +290,25 @@ static getme_status build_stars(getme_ws *ws)
     ws->star = malloc((size_t)(total ? total : 1) * sizeof *ws->star);
     if (!ws->star_ptr || !ws->star)
         return GETME_ERR_NOMEM;
-    for (int64_t k = 0; k < total; k++)
-        ws->star_ptr[ws->conn[k] + 1]++;
+    /* Each thread owns a range of nodes and walks all the connectivity,
+       counting and then filling only its own nodes' stars: no shared
+       writes, and each star is filled in ascending element order as by
+       one thread.  The node numbers are first-touch in element order
+       (number_nodes), so whether an entry is the thread's own is a
+       well-predicted branch. */
+    const int32_t *conn = ws->conn;
+    int32_t *ptr = ws->star_ptr;
+#pragma omp parallel num_threads(ws->nt)
+    {
+        int th = omp_get_thread_num(), team = omp_get_num_threads();
+        int32_t n0 = (int32_t)((int64_t)ws->nn * th / team);
+        int32_t n1 = (int32_t)((int64_t)ws->nn * (th + 1) / team);
+        for (int64_t k = 0; k < total; k++) {
+            int32_t v = conn[k];
+            if (v >= n0 && v < n1)
+                ptr[v + 1]++;
+        }
+    }
     ws->max_star = 0;
     for (int32_t i = 0; i < ws->nn; i++) {
         int32_t c = ws->star_ptr[i + 1];
@@ -282,12 +321,19 @@ static getme_status build_stars(getme_ws *ws)
         return GETME_ERR_NOMEM;
     memcpy(pos, ws->star_ptr, (size_t)ws->nn * sizeof *pos);
     /* Elements in ascending order, so every star comes out sorted. */
-    for (int t = 0; t < GETME_NUM_TYPES; t++) {
-        int nv = getme__nv[t];
-        for (int32_t e = ws->tstart[t]; e < ws->tstart[t + 1]; e++) {
-            const int32_t *c = getme__ws_nodes(ws, t, e);
-            for (int i = 0; i < nv; i++)
-                ws->star[pos[c[i]]++] = e;
+#pragma omp parallel num_threads(ws->nt)
+    {
+        int th = omp_get_thread_num(), team = omp_get_num_threads();
+        int32_t n0 = (int32_t)((int64_t)ws->nn * th / team);
+        int32_t n1 = (int32_t)((int64_t)ws->nn * (th + 1) / team);
+        for (int t = 0; t < GETME_NUM_TYPES; t++) {
+            int nv = getme__nv[t];
+            for (int32_t e = ws->tstart[t]; e < ws->tstart[t + 1]; e++) {
+                const int32_t *c = getme__ws_nodes(ws, t, e);
+                for (int i = 0; i < nv; i++)
+                    if (c[i] >= n0 && c[i] < n1)
+                        ws->star[pos[c[i]]++] = e;
+            }
         }
     }
     free(pos);

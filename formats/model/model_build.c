@@ -103,11 +103,14 @@ getme_status getme__model_number(getme__model_in *in, getme__model_out *out)
             out->loc[i] = k++;
         }
     }
+    /* file indices -> mesh nodes: independent entries, in parallel */
     for (size_t b = 0; b < in->num_blocks; b++) {
         size_t len = block_len(&in->blocks[b]);
         int32_t *c = in->blocks[b].conn;
+        const int32_t *loc = out->loc;
+#pragma omp parallel for schedule(static) if (len >= 65536)
         for (size_t i = 0; i < len; i++)
-            c[i] = out->loc[c[i]];
+            c[i] = loc[c[i]];
     }
     return GETME_OK;
 }
@@ -138,15 +141,22 @@ static void entity_regions(const getme__model_in *in, int32_t *region)
     }
 }
 
-/* First element of a block that has a node twice, -1 if none. */
+/* First element of a block that has a node twice, -1 if none: the least
+   of the threads' first ones, so the same for any thread count. */
 static int32_t repeated_node(const int32_t *conn, int32_t count, int nv)
 {
-    for (int32_t e = 0; e < count; e++)
+    int32_t first = count;
+#pragma omp parallel for schedule(static) reduction(min : first) \
+    if (count >= 16384)
+    for (int32_t e = 0; e < count; e++) {
+        int rep = 0;
         for (int i = 1; i < nv; i++)
             for (int j = 0; j < i; j++)
-                if (conn[(size_t)e * nv + i] == conn[(size_t)e * nv + j])
-                    return e;
-    return -1;
+                rep |= conn[(size_t)e * nv + i] == conn[(size_t)e * nv + j];
+        if (rep && e < first)
+            first = e;
+    }
+    return first < count ? first : -1;
 }
 
 static void free_block(getme__model_block *b)

@@ -90,6 +90,19 @@ int msh41_in_getc(msh41_input *in)
     return c;
 }
 
+size_t msh41_in_read_some(msh41_input *in, void *dst, size_t n)
+{
+    unsigned char *d = dst;
+    size_t done = 0;
+    while (done < n && !refill(in)) {
+        size_t k = in->len - in->pos < n - done ? in->len - in->pos : n - done;
+        memcpy(d + done, in->buf + in->pos, k);
+        in->pos += k;
+        done += k;
+    }
+    return done;
+}
+
 int msh41_in_read(msh41_input *in, void *dst, size_t n)
 {
     unsigned char *d = dst;

@@ -47,6 +47,9 @@ int msh41_in_getc(msh41_input *in);
 int msh41_in_peek(msh41_input *in);
 /* Exactly n bytes into dst (dst may be NULL: skip); 0 or -1 (short). */
 int msh41_in_read(msh41_input *in, void *dst, size_t n);
+/* As msh41_in_read into dst, but returns how many bytes it read (fewer
+   than n only at the end of the file). */
+size_t msh41_in_read_some(msh41_input *in, void *dst, size_t n);
 /* One line without its end ("\n" or "\r\n"), cut to size-1 bytes (the
    rest is consumed); -1 at end of file with nothing read. */
 int msh41_in_line(msh41_input *in, char *buf, size_t size);
@@ -188,6 +191,10 @@ typedef struct msh41_reader {
     size_t cap_cur;           /* room in the last element block            */
     int threads;              /* for the ASCII fast path                   */
     size_t fast_want;         /* its window (msh41_fast.c)                 */
+    /* binary: the offset a message names when it is not where the input
+       stands (read_binary_elements reads ahead of the record it names) */
+    int64_t msg_offset;
+    int msg_offset_set;
 } msh41_reader;
 
 /* Error at the current position: "'file', line N: ..." (ASCII) or

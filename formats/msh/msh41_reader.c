@@ -39,7 +39,9 @@ getme_formats_status msh41_fail(msh41_reader *r, getme_formats_status st,
     if (r->binary)
         return getme_doc_fail(r->doc, st, "'%s': %s (byte %lld)",
                               r->doc->path, msg,
-                              (long long)msh41_in_offset(&r->in));
+                              (long long)(r->msg_offset_set
+                                              ? r->msg_offset
+                                              : msh41_in_offset(&r->in)));
     return getme_doc_fail(r->doc, st, "'%s', line %ld: %s", r->doc->path,
                           r->in.line, msg);
 }
@@ -870,27 +872,64 @@ static getme_formats_status take_element(msh41_reader *r, msh41_eblock *b,
     return GETME_FORMATS_OK;
 }
 
-/* Binary elements are read a chunk of records at a time. */
+/* Binary elements are read a chunk of records at a time (BIG_CHUNK, so
+   that each thread gets a long run of records to decode and store).  A
+   bad record is named with the byte offset the reader reported when it
+   read REC_CHUNK records at a time: the end of the REC_CHUNK-record piece
+   that holds it, so messages stay what they were. */
 #define REC_CHUNK 4096
+#define BIG_CHUNK (16 * REC_CHUNK)
+
+/* Records [0, k) of buf, decoded and stored (record j as element i0 + j)
+   on up to threads threads; returns the first bad record (take_element
+   then says why), or k.  Each record writes only its own entries of the
+   block, so the stored arrays are the same for any thread count, and the
+   first bad record is a minimum over the threads' first ones. */
+static size_t store_records(msh41_reader *r, msh41_eblock *b, uint64_t *buf,
+                            size_t k, size_t i0, int nv, int fix, int threads)
+{
+    size_t rec = (size_t)nv + 1, bad = k;
+#pragma omp parallel for schedule(static) num_threads(threads) \
+    reduction(min : bad) if (threads > 1 && k >= 1024)
+    for (size_t j = 0; j < k; j++) {
+        uint64_t *p = buf + j * rec;
+        for (size_t q = 0; q < rec; q++)
+            p[q] = le64((const unsigned char *)&p[q]);
+        if (j < bad && msh41_store_element(r, b, i0 + j, p, nv, fix) != 0)
+            bad = j;
+    }
+    return bad;
+}
 
 static getme_formats_status read_binary_elements(msh41_reader *r, msh41_eblock *b,
                                             uint64_t count, int nv, int fix)
 {
     size_t rec = (size_t)nv + 1;
-    uint64_t *buf = malloc(REC_CHUNK * rec * sizeof *buf);
+    size_t chunk = count < BIG_CHUNK ? (size_t)(count ? count : 1) : BIG_CHUNK;
+    uint64_t *buf = malloc(chunk * rec * sizeof *buf);
     if (!buf)
         return oom(r);
+    /* --fix flags nodes while storing: one thread, no shared writes */
+    int threads = fix ? 1 : r->threads;
+    int64_t start = msh41_in_offset(&r->in);
     getme_formats_status st = GETME_FORMATS_OK;
-    for (uint64_t i0 = 0; i0 < count && st == GETME_FORMATS_OK; i0 += REC_CHUNK) {
-        size_t k = count - i0 < REC_CHUNK ? (size_t)(count - i0) : REC_CHUNK;
-        if (msh41_in_read(&r->in, buf, k * rec * 8)) {
+    for (uint64_t i0 = 0; i0 < count && st == GETME_FORMATS_OK; i0 += chunk) {
+        size_t k = count - i0 < chunk ? (size_t)(count - i0) : chunk;
+        size_t got = msh41_in_read_some(&r->in, buf, k * rec * 8);
+        int eof = got < k * rec * 8;
+        if (eof) /* the REC_CHUNK reads stored the whole pieces before it */
+            k = got / (rec * 8) / REC_CHUNK * REC_CHUNK;
+        size_t bad = store_records(r, b, buf, k, (size_t)i0, nv, fix, threads);
+        if (bad < k) {
+            uint64_t at = i0 + bad, end = (at / REC_CHUNK + 1) * REC_CHUNK;
+            end = end < count ? end : count;
+            r->msg_offset = start + (int64_t)(end * rec * 8);
+            r->msg_offset_set = 1;
+            st = take_element(r, b, (size_t)at, buf + bad * rec, nv, fix);
+            r->msg_offset_set = 0;
+        } else if (eof) {
             st = eof_error(r);
-            break;
         }
-        for (size_t j = 0; j < k * rec; j++)
-            buf[j] = le64((const unsigned char *)&buf[j]);
-        for (size_t j = 0; j < k && st == GETME_FORMATS_OK; j++)
-            st = take_element(r, b, (size_t)i0 + j, buf + j * rec, nv, fix);
     }
     free(buf);
     return st;
