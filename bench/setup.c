@@ -203,7 +203,7 @@ int main(int argc, char **argv)
             node_checks(&ws, rn);
 #ifdef GETME_ADJ_LENT_SCRATCH
             void *scr = malloc(check_scratch_bytes(&ws));
-            if (!scr || check_all(&adj, &ws, rn, adj.eslot ? re : NULL, scr) !=
+            if (!scr || check_all(&adj, &ws, rn, adj.eslot ? re : NULL, edeg, scr) !=
                             GETME_OK)
                 return 1;
             free(scr);

@@ -365,12 +365,42 @@ typedef struct union_scratch {
    pseudo-random integers in place of q (exact arithmetic), and take the
    union's exact count where they disagree. */
 static void check_element(getme_adj *adj, const getme_ws *ws,
-                          const uint64_t *rn, const uint64_t *re, int32_t e,
-                          union_scratch *sc)
+                          const uint64_t *rn, const uint64_t *re,
+                          const int32_t *edeg, int32_t e, union_scratch *sc)
 {
     int t = getme__ws_type(ws, e), nv = getme__nv[t];
     const int32_t *c = getme__ws_nodes(ws, t, e);
     const getme_face_table *ft = &getme__faces[t];
+    const int32_t *f = getme__adj_faces(adj, ws, t, e);
+    /* counts_and_flags' test first, fused here (it read the same edge
+       ids and faces in a pass of its own; its count was overwritten
+       below): an element it would mark irregular is marked, count 0, as
+       the walk below would leave it, without the walk. */
+    int64_t fcnt = 0, nb = 0, bad = 0;
+    for (int i = 0; i < nv; i++)
+        fcnt += ws->star_ptr[c[i] + 1] - ws->star_ptr[c[i]];
+    for (int k = 0; k < ft->num_faces; k++) {
+        nb += f[k] >= 0;
+        bad |= f[k] == GETME_FACE_IRREGULAR;
+    }
+    if (ws->dim == 2) {
+        fcnt -= (nv - 1) + nb;
+    } else {
+        const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
+        for (int j = 0; j < getme__edges[t].num_edges; j++) {
+            bad |= slot[j] == GETME_NO_SLOT;
+            /* a missing slot's id is not read */
+            fcnt -= slot[j] == GETME_NO_SLOT
+                        ? 0
+                        : edeg[getme__adj_edge(adj, c, t, j, slot[j])];
+        }
+        fcnt += (ft->num_faces - 1) + nb;
+    }
+    if (bad || fcnt > UINT16_MAX) {
+        adj->irregular[e] = 1;
+        adj->count[e] = 0;
+        return;
+    }
     uint32_t now = ++sc->now;
     int32_t cnt = 0;
     uint64_t truth = 0;
@@ -388,7 +418,6 @@ static void check_element(getme_adj *adj, const getme_ws *ws,
             truth += cv[n] & (0 - (uint64_t)fresh);
             cnt += (int32_t)fresh;
         }
-    const int32_t *f = getme__adj_faces(adj, ws, t, e);
     uint64_t formula = 0, fs = 0;
     for (int i = 0; i < nv; i++)
         formula += rn[c[i]];
@@ -421,7 +450,7 @@ static size_t check_scratch_bytes(const getme_ws *ws)
    lends the pages the blocks' build used: already faulted in). */
 static getme_status check_all(getme_adj *adj, const getme_ws *ws,
                               const uint64_t *rn, const uint64_t *re,
-                              void *scratch)
+                              const int32_t *edeg, void *scratch)
 {
     int nt = ws->nt;
     union_scratch *sc = calloc((size_t)nt, sizeof *sc);
@@ -446,7 +475,7 @@ static getme_status check_all(getme_adj *adj, const getme_ws *ws,
             cv[e] = check_value(e);
 #pragma omp parallel for schedule(dynamic, 2048) num_threads(nt)
         for (int32_t e = 0; e < ws->ne; e++)
-            check_element(adj, ws, rn, re, e, &sc[omp_get_thread_num()]);
+            check_element(adj, ws, rn, re, edeg, e, &sc[omp_get_thread_num()]);
     }
     free(sc);
     return ok ? GETME_OK : GETME_ERR_NOMEM;
@@ -508,7 +537,8 @@ getme_status getme__adj_build(getme_adj *adj, getme_ws *ws)
     if (!have_faces &&
         (st = getme__ws_faces(ws, adj->foff, adj->fnb)) != GETME_OK)
         goto fail;
-    counts_and_flags(adj, ws, edeg);
+    if (!check) /* else fused into check_all's walk */
+        counts_and_flags(adj, ws, edeg);
     if (ws->dim == 3) {
         /* S_e's array: the check sums' (read by check_all below, then
            overwritten by the sums) or the counts' */
@@ -518,21 +548,21 @@ getme_status getme__adj_build(getme_adj *adj, getme_ws *ws)
         else
             edeg = NULL;
     }
-    free(edeg), edeg = NULL; /* read only by counts_and_flags */
     if (!(scratch = malloc(sbytes)))
         goto fail;
     if ((st = getme__blocks_build(&adj->blk, ws, scratch)) != GETME_OK)
         goto fail;
     if (check && (st = check_all(adj, ws, rn, (const uint64_t *)adj->esum,
-                                 scratch)) != GETME_OK)
+                                 edeg, scratch)) != GETME_OK)
         goto fail;
+    free(edeg), edeg = NULL;
     int32_t nirr = 0;
 #pragma omp parallel for schedule(static) num_threads(ws->nt) \
     reduction(+ : nirr)
     for (int32_t e = 0; e < ws->ne; e++)
         nirr += adj->irregular[e];
     adj->num_irregular = nirr;
-    free(scratch);
+    free(scratch), free(edeg);
     return GETME_OK;
 fail:
     free(re), free(edeg), free(scratch);
