@@ -18,6 +18,7 @@
    the sources it compiles) */
 #include "adjacency.c"
 
+#include <malloc.h>
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -153,6 +154,10 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: setup MESH.raw [threads] [repetitions]\n");
         return 2;
     }
+    /* as the CLI does (cli/main.c): every block of 1 MiB or more is
+       mapped afresh, so the set-up's temporaries pay their page faults
+       in every repetition, as in the command */
+    mallopt(M_MMAP_THRESHOLD, 1 << 20);
     int nt = argc > 2 ? atoi(argv[2]) : 1;
     int reps = argc > 3 ? atoi(argv[3]) : 3;
     getme_mesh *mesh = load(argv[1]);
@@ -196,13 +201,25 @@ int main(int argc, char **argv)
         if (check) {
             uint64_t *rn = malloc((size_t)ws.nn * sizeof *rn);
             node_checks(&ws, rn);
+#ifdef GETME_ADJ_LENT_SCRATCH
+            void *scr = malloc(check_scratch_bytes(&ws));
+            if (!scr || check_all(&adj, &ws, rn, adj.eslot ? re : NULL, edeg, scr) !=
+                            GETME_OK)
+                return 1;
+            free(scr);
+#else
             if (check_all(&adj, &ws, rn, adj.eslot ? re : NULL) != GETME_OK)
                 return 1;
+#endif
             free(rn);
         }
         t[5] = cpu();
         getme_blocks blk;
+#ifdef GETME_ADJ_LENT_SCRATCH
+        if (getme__blocks_build(&blk, &ws, NULL) != GETME_OK)
+#else
         if (getme__blocks_build(&blk, &ws) != GETME_OK)
+#endif
             return 1;
         t[6] = cpu();
         getme__blocks_free(&blk);

@@ -15,6 +15,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* bench/setup.c times the phases below on their own: their signatures
+   take a lent scratch since this was set (round 9). */
+#define GETME_ADJ_LENT_SCRATCH 1
+
 void getme__adj_free(getme_adj *adj)
 {
     free(adj->eptr);
@@ -212,11 +216,13 @@ static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
         goto done;
     corner_edges ce;
     corner_edge_table(&ce);
-    int ok = 1, single = getme__ws_single_type(ws);
+    int ok = 1, single = getme__ws_single_type(ws), nteam = 1;
     adj->eptr[0] = 0;
 #pragma omp parallel num_threads(nt) reduction(&& : ok)
     {
         int th = omp_get_thread_num(), n = omp_get_num_threads();
+        if (th == 0)
+            nteam = n;
         edge_walk *w = &walks[th];
         w->nbr = bufs + (size_t)th * 2 * bufsize;
         w->deg = w->nbr + bufsize;
@@ -242,6 +248,14 @@ static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
             adj->eptr[u + 1] = m; /* a count until the prefix sum */
             ok = walk_append(w, m, checks);
         }
+        /* the range's own prefix sum (its edges before each node); the
+           ranges' offsets are added below (a serial pass over all nodes
+           took ~50 ms of the full hexes' set-up at any thread count) */
+        int64_t sum = 0;
+        for (int32_t u = u0; u < u1 && ok; u++) {
+            sum += adj->eptr[u + 1];
+            adj->eptr[u + 1] = (int32_t)sum; /* <= w->len */
+        }
         first[th + 1] = w->len;
     }
     if (!ok)
@@ -250,13 +264,21 @@ static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
         first[k + 1] += first[k];
     if (first[nt] > INT32_MAX)
         goto done;
-    for (int32_t u = 0; u < ws->nn; u++) /* fits: the sum is first[nt] */
-        adj->eptr[u + 1] += adj->eptr[u];
+    /* fits: every entry is at most first[nt] */
+#pragma omp parallel for schedule(static, 1) num_threads(nteam)
+    for (int k = 0; k < nteam; k++) {
+        int32_t u1 = star_split(ws, k + 1, nteam), off = (int32_t)first[k];
+        for (int32_t u = star_split(ws, k, nteam); u < u1; u++)
+            adj->eptr[u + 1] += off;
+    }
     adj->num_edges = (int32_t)first[nt];
     /* The first thread's arrays become the whole (no copy with one
-       thread); the others' are appended in thread order. */
+       thread); the others' are appended in thread order.  Without checks
+       the counts get 8 bytes per edge: their buffer becomes the S_e
+       array once they are read (getme__adj_build). */
     size_t nedge = (size_t)(first[nt] ? first[nt] : 1);
-    edeg = realloc(walks[0].edeg, nedge * sizeof *edeg);
+    edeg = realloc(walks[0].edeg,
+                   nedge * (checks ? sizeof *edeg : sizeof(int64_t)));
     if (edeg)
         walks[0].edeg = NULL;
     re = checks ? realloc(walks[0].re, nedge * sizeof *re) : NULL;
@@ -343,12 +365,42 @@ typedef struct union_scratch {
    pseudo-random integers in place of q (exact arithmetic), and take the
    union's exact count where they disagree. */
 static void check_element(getme_adj *adj, const getme_ws *ws,
-                          const uint64_t *rn, const uint64_t *re, int32_t e,
-                          union_scratch *sc)
+                          const uint64_t *rn, const uint64_t *re,
+                          const int32_t *edeg, int32_t e, union_scratch *sc)
 {
     int t = getme__ws_type(ws, e), nv = getme__nv[t];
     const int32_t *c = getme__ws_nodes(ws, t, e);
     const getme_face_table *ft = &getme__faces[t];
+    const int32_t *f = getme__adj_faces(adj, ws, t, e);
+    /* counts_and_flags' test first, fused here (it read the same edge
+       ids and faces in a pass of its own; its count was overwritten
+       below): an element it would mark irregular is marked, count 0, as
+       the walk below would leave it, without the walk. */
+    int64_t fcnt = 0, nb = 0, bad = 0;
+    for (int i = 0; i < nv; i++)
+        fcnt += ws->star_ptr[c[i] + 1] - ws->star_ptr[c[i]];
+    for (int k = 0; k < ft->num_faces; k++) {
+        nb += f[k] >= 0;
+        bad |= f[k] == GETME_FACE_IRREGULAR;
+    }
+    if (ws->dim == 2) {
+        fcnt -= (nv - 1) + nb;
+    } else {
+        const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
+        for (int j = 0; j < getme__edges[t].num_edges; j++) {
+            bad |= slot[j] == GETME_NO_SLOT;
+            /* a missing slot's id is not read */
+            fcnt -= slot[j] == GETME_NO_SLOT
+                        ? 0
+                        : edeg[getme__adj_edge(adj, c, t, j, slot[j])];
+        }
+        fcnt += (ft->num_faces - 1) + nb;
+    }
+    if (bad || fcnt > UINT16_MAX) {
+        adj->irregular[e] = 1;
+        adj->count[e] = 0;
+        return;
+    }
     uint32_t now = ++sc->now;
     int32_t cnt = 0;
     uint64_t truth = 0;
@@ -366,7 +418,6 @@ static void check_element(getme_adj *adj, const getme_ws *ws,
             truth += cv[n] & (0 - (uint64_t)fresh);
             cnt += (int32_t)fresh;
         }
-    const int32_t *f = getme__adj_faces(adj, ws, t, e);
     uint64_t formula = 0, fs = 0;
     for (int i = 0; i < nv; i++)
         formula += rn[c[i]];
@@ -386,34 +437,47 @@ static void check_element(getme_adj *adj, const getme_ws *ws,
     adj->count[e] = (uint16_t)(adj->irregular[e] ? 0 : cnt);
 }
 
+/* The bytes check_all needs in its scratch: a stamp per element and
+   thread, and every element's check value. */
+static size_t check_scratch_bytes(const getme_ws *ws)
+{
+    size_t ne = (size_t)(ws->ne ? ws->ne : 1);
+    size_t stamps = ((size_t)ws->nt * ne * sizeof(uint32_t) + 7) & ~(size_t)7;
+    return stamps + ne * sizeof(uint64_t);
+}
+
+/* scratch: check_scratch_bytes(ws) bytes, any contents (getme__adj_build
+   lends the pages the blocks' build used: already faulted in). */
 static getme_status check_all(getme_adj *adj, const getme_ws *ws,
-                              const uint64_t *rn, const uint64_t *re)
+                              const uint64_t *rn, const uint64_t *re,
+                              const int32_t *edeg, void *scratch)
 {
     int nt = ws->nt;
     union_scratch *sc = calloc((size_t)nt, sizeof *sc);
     int ok = sc != NULL;
     size_t ne = (size_t)(ws->ne ? ws->ne : 1);
+    uint32_t *stamps = scratch;
     /* every element's check value once (8 B per element while the
        check runs, below the smoothing's peak): the union walk meets each
        ~2.4 times */
-    uint64_t *cv = malloc(ne * sizeof *cv);
-    ok = ok && cv != NULL;
+    uint64_t *cv = (uint64_t *)(void *)((char *)scratch +
+                                        (((size_t)nt * ne * sizeof *stamps + 7) &
+                                         ~(size_t)7));
     for (int k = 0; ok && k < nt; k++) {
-        sc[k].stamp = calloc(ne, sizeof *sc[k].stamp);
+        sc[k].stamp = stamps + (size_t)k * ne;
         sc[k].cv = cv;
-        ok = sc[k].stamp != NULL;
     }
     if (ok) {
+        /* the stamps start at 0 and a walk's first stamp is 1 */
+        memset(stamps, 0, (size_t)nt * ne * sizeof *stamps);
 #pragma omp parallel for schedule(static) num_threads(nt)
         for (int32_t e = 0; e < ws->ne; e++)
             cv[e] = check_value(e);
 #pragma omp parallel for schedule(dynamic, 2048) num_threads(nt)
         for (int32_t e = 0; e < ws->ne; e++)
-            check_element(adj, ws, rn, re, e, &sc[omp_get_thread_num()]);
+            check_element(adj, ws, rn, re, edeg, e, &sc[omp_get_thread_num()]);
     }
-    for (int k = 0; sc && k < nt; k++)
-        free(sc[k].stamp);
-    free(sc), free(cv);
+    free(sc);
     return ok ? GETME_OK : GETME_ERR_NOMEM;
 }
 
@@ -447,37 +511,61 @@ getme_status getme__adj_build(getme_adj *adj, getme_ws *ws)
     /* The fixed-point scale of the sums (adjacency.h). */
     adj->qscale = 0x1p61 / getme__pow2_ceil((double)ws->max_star + 1.0);
     adj->qinv = 1.0 / adj->qscale;
-    uint64_t *rn = check ? malloc(nn * sizeof *rn) : NULL, *re = NULL;
+    /* The temporaries live in arrays the run needs anyway, or share
+       pages: a fresh page costs ~3 ms per MiB to fault in on the VMs
+       measured (the CLI maps every block of 1 MiB or more afresh), ~0.3 s
+       of the full hexes' set-up.  The nodes' check sums (rn) are built in
+       S_v's array, the edges' (re) become S_e's, and without checks the
+       edges' element counts' buffer does (8 bytes per edge reserved):
+       getme__adj_sums_all overwrites both before any sum is read.  The
+       blocks' build and the check share one scratch. */
+    uint64_t *rn = check ? (uint64_t *)(void *)adj->nsum : NULL, *re = NULL;
     int32_t *edeg = NULL;
+    size_t sbytes = getme__blocks_scratch_bytes(ws);
+    if (check && check_scratch_bytes(ws) > sbytes)
+        sbytes = check_scratch_bytes(ws);
+    void *scratch = NULL;
     getme_status st = GETME_ERR_NOMEM;
-    if (!adj->fnb || !adj->count || !adj->irregular || !adj->nsum ||
-        (check && !rn))
+    if (!adj->fnb || !adj->count || !adj->irregular || !adj->nsum)
         goto fail;
-    if (ws->dim == 3) {
-        if ((st = build_edges(adj, ws, &edeg, check, &re)) != GETME_OK)
-            goto fail;
-        st = GETME_ERR_NOMEM;
-        adj->esum = malloc((size_t)(adj->num_edges ? adj->num_edges : 1) *
-                           sizeof *adj->esum);
-        if (!adj->esum)
-            goto fail;
-    }
+    if (ws->dim == 3 &&
+        (st = build_edges(adj, ws, &edeg, check, &re)) != GETME_OK)
+        goto fail;
+    st = GETME_ERR_NOMEM;
     if (check)
         node_checks(ws, rn);
     if (!have_faces &&
         (st = getme__ws_faces(ws, adj->foff, adj->fnb)) != GETME_OK)
         goto fail;
-    counts_and_flags(adj, ws, edeg);
-    if ((st = getme__blocks_build(&adj->blk, ws)) != GETME_OK)
+    if (!check) /* else fused into check_all's walk */
+        counts_and_flags(adj, ws, edeg);
+    if (ws->dim == 3) {
+        /* S_e's array: the check sums' (read by check_all below, then
+           overwritten by the sums) or the counts' */
+        adj->esum = check ? (int64_t *)(void *)re : (int64_t *)(void *)edeg;
+        if (check)
+            re = NULL;
+        else
+            edeg = NULL;
+    }
+    if (!(scratch = malloc(sbytes)))
         goto fail;
-    if (check && (st = check_all(adj, ws, rn, re)) != GETME_OK)
+    if ((st = getme__blocks_build(&adj->blk, ws, scratch)) != GETME_OK)
         goto fail;
+    if (check && (st = check_all(adj, ws, rn, (const uint64_t *)adj->esum,
+                                 edeg, scratch)) != GETME_OK)
+        goto fail;
+    free(edeg), edeg = NULL;
+    int32_t nirr = 0;
+#pragma omp parallel for schedule(static) num_threads(ws->nt) \
+    reduction(+ : nirr)
     for (int32_t e = 0; e < ws->ne; e++)
-        adj->num_irregular += adj->irregular[e];
-    free(rn), free(re), free(edeg);
+        nirr += adj->irregular[e];
+    adj->num_irregular = nirr;
+    free(scratch), free(edeg);
     return GETME_OK;
 fail:
-    free(rn), free(re), free(edeg);
+    free(re), free(edeg), free(scratch);
     getme__adj_free(adj);
     return st;
 }

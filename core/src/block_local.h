@@ -92,9 +92,13 @@ typedef struct getme_blocks {
     } group;
 } getme_blocks;
 
-/* Build it for ws (parallel over blocks, deterministic).  GETME_OK or
+/* Build it for ws (parallel over blocks, deterministic).  scratch: NULL,
+   or getme__blocks_scratch_bytes(ws) bytes the caller lends for the
+   build's temporaries (their contents are garbage after).  GETME_OK or
    GETME_ERR_NOMEM. */
-getme_status getme__blocks_build(getme_blocks *blk, const getme_ws *ws);
+getme_status getme__blocks_build(getme_blocks *blk, const getme_ws *ws,
+                                 void *scratch);
+size_t getme__blocks_scratch_bytes(const getme_ws *ws);
 void getme__blocks_free(getme_blocks *blk);
 /* Free only the blocks' node lists and local connectivity (nptr, nodes,
    lconn: ~10 B per tet, ~18 B per hex), which only the q_mean stage's
