@@ -13,6 +13,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "check.h"
 
+#include "doc_read.h"
 #include "getme_formats.h"
 
 #include <stdint.h>
@@ -141,47 +142,6 @@ static long write_msh(const char *path, const damage *d, long data[2])
 
 /* ---- reading ------------------------------------------------------------- */
 
-typedef struct result {
-    getme_formats_status st;
-    char error[1024];
-    double *x;
-    int32_t *conn;
-    int32_t nn, ne;
-} result;
-
-static result read_file(const char *path, int threads)
-{
-    result r;
-    memset(&r, 0, sizeof r);
-    getme_doc_options o;
-    getme_doc_options_init(&o);
-    o.num_threads = threads;
-    getme_doc *doc = NULL;
-    r.st = getme_doc_open(&doc, path, &o);
-    snprintf(r.error, sizeof r.error, "%s",
-             r.st == GETME_FORMATS_OK ? "" : getme_doc_error(doc));
-    getme_mesh *m = r.st == GETME_FORMATS_OK ? getme_doc_mesh(doc) : NULL;
-    if (m) {
-        r.nn = getme_mesh_num_nodes(m);
-        r.ne = getme_mesh_num_elements(m);
-        r.x = malloc((size_t)r.nn * 3 * sizeof *r.x);
-        r.conn = calloc((size_t)r.ne * 8, sizeof *r.conn);
-        getme_mesh_get_coords(m, r.x);
-        for (int32_t e = 0; e < r.ne; e++) {
-            getme_elem_type t;
-            getme_mesh_get_element(m, e, &t, r.conn + 8 * e);
-        }
-    }
-    getme_doc_close(doc);
-    return r;
-}
-
-static void free_result(result *r)
-{
-    free(r->x);
-    free(r->conn);
-}
-
 static const int THREADS[] = {1, 2, 3, 7};
 #define NT ((int)(sizeof THREADS / sizeof *THREADS))
 
@@ -209,13 +169,13 @@ static void want_error(char *buf, size_t size, const char *path, long e,
 static void check_errors(const char *path, const char *want)
 {
     for (int t = 0; t < NT; t++) {
-        result r = read_file(path, THREADS[t]);
+        doc_read r = doc_read_file(path, THREADS[t]);
         CHECK(r.st != GETME_FORMATS_OK);
         CHECK(strcmp(r.error, want) == 0);
         if (strcmp(r.error, want) != 0)
             fprintf(stderr, "%d threads: got  %s\n           want %s\n",
                     THREADS[t], r.error, want);
-        free_result(&r);
+        doc_read_free(&r);
     }
 }
 
@@ -226,21 +186,21 @@ int main(void)
     make_mesh();
     damage d = {{-1, -1}, {0, 0}, 0};
     CHECK(write_msh(path, &d, data) > 0);
-    result plain = read_file(path, 1);
+    doc_read plain = doc_read_file(path, 1);
     CHECK(plain.st == GETME_FORMATS_OK);
     CHECK_EQ_INT(plain.nn, NN);
     CHECK_EQ_INT(plain.ne, NE);
     for (int t = 1; t < NT; t++) {
-        result r = read_file(path, THREADS[t]);
+        doc_read r = doc_read_file(path, THREADS[t]);
         CHECK(r.st == GETME_FORMATS_OK && r.nn == plain.nn && r.ne == plain.ne);
         if (r.st == GETME_FORMATS_OK && plain.st == GETME_FORMATS_OK) {
             CHECK(memcmp(r.x, plain.x, (size_t)NN * 3 * sizeof *r.x) == 0);
             CHECK(memcmp(r.conn, plain.conn,
                          (size_t)NE * 8 * sizeof *r.conn) == 0);
         }
-        free_result(&r);
+        doc_read_free(&r);
     }
-    free_result(&plain);
+    doc_read_free(&plain);
     /* bad records: the first in file order is named, at its piece's end;
        the last records of a chunk and of a block, and the first ones */
     rng_state = 2024;

@@ -17,6 +17,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "check.h"
 
+#include "doc_read.h"
 #include "getme_formats.h"
 
 #include <stdint.h>
@@ -263,55 +264,6 @@ static void write_inp(const char *path, out *o)
 
 /* ---- reading -------------------------------------------------------------- */
 
-typedef struct result {
-    getme_formats_status st;
-    char error[1024];
-    double *x;
-    int32_t *conn;
-    int32_t nn, ne;
-} result;
-
-static result read_file(const char *path, int threads)
-{
-    result r;
-    memset(&r, 0, sizeof r);
-    getme_doc_options o;
-    getme_doc_options_init(&o);
-    o.num_threads = threads;
-    getme_doc *doc = NULL;
-    r.st = getme_doc_open(&doc, path, &o);
-    snprintf(r.error, sizeof r.error, "%s",
-             r.st == GETME_FORMATS_OK ? "" : getme_doc_error(doc));
-    getme_mesh *m = r.st == GETME_FORMATS_OK ? getme_doc_mesh(doc) : NULL;
-    if (m) {
-        r.nn = getme_mesh_num_nodes(m);
-        r.ne = getme_mesh_num_elements(m);
-        r.x = malloc((size_t)r.nn * 3 * sizeof *r.x);
-        r.conn = calloc((size_t)r.ne * 8, sizeof *r.conn);
-        getme_mesh_get_coords(m, r.x);
-        for (int32_t e = 0; e < r.ne; e++) {
-            getme_elem_type t;
-            getme_mesh_get_element(m, e, &t, r.conn + 8 * e);
-        }
-    }
-    getme_doc_close(doc);
-    return r;
-}
-
-static int same_mesh(const result *a, const result *b)
-{
-    return a->st == GETME_FORMATS_OK && b->st == GETME_FORMATS_OK &&
-           a->nn == b->nn && a->ne == b->ne &&
-           memcmp(a->x, b->x, (size_t)a->nn * 3 * sizeof *a->x) == 0 &&
-           memcmp(a->conn, b->conn, (size_t)a->ne * 8 * sizeof *a->conn) == 0;
-}
-
-static void free_result(result *r)
-{
-    free(r->x);
-    free(r->conn);
-}
-
 static const int THREADS[] = {1, 2, 3, 7};
 #define NT ((int)(sizeof THREADS / sizeof *THREADS))
 
@@ -322,7 +274,7 @@ static void run_format(int msh)
     memset(&o, 0, sizeof o);
     o.mode = PLAIN;
     (msh ? write_msh : write_inp)(name, &o);
-    result plain = read_file(name, 1);
+    doc_read plain = doc_read_file(name, 1);
     CHECK(plain.st == GETME_FORMATS_OK);
     CHECK_EQ_INT(plain.nn, NN);
     CHECK_EQ_INT(plain.ne, NE);
@@ -332,9 +284,9 @@ static void run_format(int msh)
         exact = plain.x[i] == xyz[i];
     CHECK(exact);
     for (int t = 1; t < NT; t++) {
-        result r = read_file(name, THREADS[t]);
-        CHECK(same_mesh(&plain, &r));
-        free_result(&r);
+        doc_read r = doc_read_file(name, THREADS[t]);
+        CHECK(doc_read_same(&plain, &r));
+        doc_read_free(&r);
     }
     /* few reshaped lines: long runs, split across threads; many: the
        fast path stops and resumes every few lines */
@@ -345,12 +297,12 @@ static void run_format(int msh)
         o.one_in = one_in[seed - 1];
         (msh ? write_msh : write_inp)(name, &o);
         for (int t = 0; t < NT; t++) {
-            result r = read_file(name, THREADS[t]);
-            CHECK(same_mesh(&plain, &r));
+            doc_read r = doc_read_file(name, THREADS[t]);
+            CHECK(doc_read_same(&plain, &r));
             if (r.st != GETME_FORMATS_OK)
                 fprintf(stderr, "reshaped %s seed %d: %s\n", name, seed,
                         r.error);
-            free_result(&r);
+            doc_read_free(&r);
         }
     }
     long nrec = msh ? 2L * NN + NE : (long)NN + NE;
@@ -372,7 +324,7 @@ static void run_format(int msh)
             snprintf(want, sizeof want, "%s:%ld: ", name, first);
         char first_error[1024] = "";
         for (int t = 0; t < NT; t++) {
-            result r = read_file(name, THREADS[t]);
+            doc_read r = doc_read_file(name, THREADS[t]);
             CHECK(r.st != GETME_FORMATS_OK);
             CHECK(strstr(r.error, want) == r.error);
             if (t == 0)
@@ -381,10 +333,10 @@ static void run_format(int msh)
             if (strstr(r.error, want) != r.error)
                 fprintf(stderr, "%s seed %d, %d threads: %s (want '%s')\n",
                         name, seed, THREADS[t], r.error, want);
-            free_result(&r);
+            doc_read_free(&r);
         }
     }
-    free_result(&plain);
+    doc_read_free(&plain);
 }
 
 int main(void)
