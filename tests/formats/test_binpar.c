@@ -14,6 +14,7 @@
 #include "check.h"
 
 #include "doc_read.h"
+#include "kuhn_cube.h"
 #include "getme_formats.h"
 
 #include <stdint.h>
@@ -22,71 +23,8 @@
 #include <string.h>
 #include <unistd.h>
 
-#define N 24 /* cubes per side: 25^3 nodes, 6 N^3 = 82,944 tets */
-#define NN ((N + 1) * (N + 1) * (N + 1))
-#define NE (6 * N * N * N)
 #define SPLIT 70000 /* first block's records: more than one 65,536 chunk */
 #define PIECE 4096  /* the earlier reader's records per read */
-
-static double xyz[3 * NN];
-static int32_t tet[NE][4];
-
-static uint64_t rng_state;
-static uint32_t rnd(void)
-{
-    rng_state = rng_state * 6364136223846793005ULL + 1442695040888963407ULL;
-    return (uint32_t)(rng_state >> 33);
-}
-
-static int node_at(int i, int j, int k)
-{
-    return i + (N + 1) * (j + (N + 1) * k);
-}
-
-/* A cube of Kuhn tets, positively oriented, inner nodes jittered. */
-static void make_mesh(void)
-{
-    rng_state = 11;
-    for (int k = 0; k <= N; k++)
-        for (int j = 0; j <= N; j++)
-            for (int i = 0; i <= N; i++) {
-                double *x = xyz + 3 * node_at(i, j, k);
-                int c[3] = {i, j, k};
-                for (int a = 0; a < 3; a++) {
-                    int inner = c[a] > 0 && c[a] < N;
-                    x[a] = (c[a] + (inner ? 0.1 * (rnd() / 4294967296.0 - 0.5)
-                                          : 0.0)) / N;
-                }
-            }
-    static const int perm[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
-                                   {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-    int e = 0;
-    for (int k = 0; k < N; k++)
-        for (int j = 0; j < N; j++)
-            for (int i = 0; i < N; i++)
-                for (int p = 0; p < 6; p++) {
-                    int c[3] = {i, j, k};
-                    tet[e][0] = node_at(c[0], c[1], c[2]);
-                    for (int s = 0; s < 3; s++) {
-                        c[perm[p][s]]++;
-                        tet[e][s + 1] = node_at(c[0], c[1], c[2]);
-                    }
-                    const double *a = xyz + 3 * tet[e][0];
-                    double u[3][3];
-                    for (int s = 0; s < 3; s++)
-                        for (int d = 0; d < 3; d++)
-                            u[s][d] = xyz[3 * tet[e][s + 1] + d] - a[d];
-                    double v = u[0][0] * (u[1][1] * u[2][2] - u[1][2] * u[2][1]) -
-                               u[0][1] * (u[1][0] * u[2][2] - u[1][2] * u[2][0]) +
-                               u[0][2] * (u[1][0] * u[2][1] - u[1][1] * u[2][0]);
-                    if (v < 0) {
-                        int32_t t = tet[e][2];
-                        tet[e][2] = tet[e][3];
-                        tet[e][3] = t;
-                    }
-                    e++;
-                }
-}
 
 /* ---- writing ------------------------------------------------------------- */
 
@@ -183,7 +121,7 @@ int main(void)
 {
     const char *path = "binpar.msh";
     long data[2];
-    make_mesh();
+    make_mesh(11);
     damage d = {{-1, -1}, {0, 0}, 0};
     CHECK(write_msh(path, &d, data) > 0);
     doc_read plain = doc_read_file(path, 1);
