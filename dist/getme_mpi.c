@@ -83,6 +83,10 @@ static int parse(int argc, char **argv, args *a)
     }
     if (!a->o.params.num_threads) /* per rank: ranks already share cores */
         a->o.params.num_threads = 1;
+    /* rank 0's measures, statistics and worst lists and every rank's
+       part measures run on the OpenMP default team: make it --threads,
+       as getme smooth does, not every core of a machine the ranks share */
+    omp_set_num_threads(a->o.params.num_threads);
     return 0;
 }
 
