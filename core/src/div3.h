@@ -70,4 +70,20 @@ static inline uint64_t getme__div3_u64(uint64_t b)
     return (uint64_t)(uint32_t)h * UINT64_C(0x55555555) + (uint64_t)r;
 }
 
+/* getme__div3_u64 without integer <-> double conversion instructions
+   (AVX2 has none for 64-bit integers), for the same bits: n = h + l <
+   2^33 < 2^52 becomes a double exactly as the bits of 2^52 + n less 2^52;
+   floor(RN(n C)) = n / 3 as above (floor, a vector instruction, instead of
+   the truncation, the same for n C >= 0); and that integer k < 2^32 comes
+   back as the bits of 2^52 + k (exact) less those of 2^52.  The unions
+   rather than memcpy: gcc 12 vectorises them (quality.c). */
+static inline uint64_t getme__div3_u64_bits(uint64_t b)
+{
+    const uint64_t two52 = UINT64_C(0x4330000000000000); /* bits of 2^52 */
+    uint64_t h = b >> 32, n = h + (b & UINT64_C(0xffffffff));
+    union { uint64_t u; double d; } c = {n | two52}, r;
+    r.d = floor((c.d - 0x1p52) * (1.0 / 3.0)) + 0x1p52;
+    return h * UINT64_C(0x55555555) + (r.u - two52);
+}
+
 #endif /* GETME_DIV3_H */

@@ -81,25 +81,30 @@ static inline int add_sum(const getme_run *run, getme_fx *a, int64_t wf,
     return 0;
 }
 
-/* add_sum's bound test and conversions for the nv nodes of a batch of
+/* add_sum's bound test and scaling for the nv nodes of a batch of
    GETME_LANES transformed elements (y as the lane kernels write it), in
-   vector instructions instead of 3 nv scalar conversions per element:
-   the same integers, yf (0 where a coordinate is out of bounds, out = 1:
-   add_sum would add nothing there). */
+   vector instructions: yd = y pscale, and out = 1 where a coordinate is
+   out of bounds (add_sum would add nothing there).  The caller converts
+   yd to the integers add_sum adds, trunc(y pscale), only for the nodes it
+   adds (never where out is set): AVX2 has no vector double -> int64
+   conversion, and with the conversion in this loop gcc 12 left the whole
+   loop scalar there (round 10: bound tests as compare-and-branch). */
 __attribute__((always_inline)) static inline void
 fixed_lanes(const getme_run *run, int nv, const double (*y)[GETME_LANES],
-            int64_t (*yf)[GETME_LANES], int64_t (*out)[GETME_LANES])
+            double (*yd)[GETME_LANES], int64_t (*out)[GETME_LANES])
 {
     double b = run->xbound, ps = run->pscale;
     for (int i = 0; i < nv; i++) {
 #pragma omp simd
         for (int l = 0; l < GETME_LANES; l++) {
             double y0 = y[3 * i][l], y1 = y[3 * i + 1][l], y2 = y[3 * i + 2][l];
-            int in = (fabs(y0) < b) & (fabs(y1) < b) & (fabs(y2) < b);
+            /* int64_t like the doubles: with 8-bit flags gcc found no
+               vector type for the loop */
+            int64_t in = (fabs(y0) < b) & (fabs(y1) < b) & (fabs(y2) < b);
             out[i][l] = !in;
-            yf[3 * i][l] = (int64_t)(in ? y0 * ps : 0.0);
-            yf[3 * i + 1][l] = (int64_t)(in ? y1 * ps : 0.0);
-            yf[3 * i + 2][l] = (int64_t)(in ? y2 * ps : 0.0);
+            yd[3 * i][l] = y0 * ps;
+            yd[3 * i + 1][l] = y1 * ps;
+            yd[3 * i + 2][l] = y2 * ps;
         }
     }
 }
@@ -211,14 +216,17 @@ weights_3d(int t, const getme_run *run, int32_t e0, int32_t e1,
                 (uint64_t)getme__fx64(q[e], qs), nf);
             den[e - c0] = (double)adj->count[e] * q[e];
         }
-        int64_t wv[WEIGHT_CHUNK];
+        /* getme__fx64(w, wscale) in two steps: AVX2 has no vector
+           double -> int64 conversion, and with it in the loop gcc left the
+           divisions and square roots scalar too (as in fixed_lanes) */
+        double wv[WEIGHT_CHUNK];
         const double wscale = run->wscale;
 #pragma omp simd
         for (int i = 0; i < WEIGHT_CHUNK; i++)
-            wv[i] = getme__fx64(sqrt(num[i] / den[i]), wscale);
+            wv[i] = sqrt(num[i] / den[i]) * wscale;
         for (int32_t e = c0; e < c1; e++) {
             int k = kind[e - c0];
-            wfs[e - e0] = k == 1 ? wv[e - c0]
+            wfs[e - e0] = k == 1 ? (int64_t)wv[e - c0]
                         : k == 2 ? getme__fx64(getme__weight_union(run, t, e),
                                                run->wscale)
                                  : -1;
@@ -331,9 +339,9 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
             else
                 getme__transform_hex_lanes((const double(*)[GETME_LANES])x,
                                            sigma, y);
-            int64_t yf[3 * GETME_MAX_NV][GETME_LANES];
+            double yd[3 * GETME_MAX_NV][GETME_LANES];
             int64_t out[GETME_MAX_NV][GETME_LANES];
-            fixed_lanes(run, nv, (const double(*)[GETME_LANES])y, yf, out);
+            fixed_lanes(run, nv, (const double(*)[GETME_LANES])y, yd, out);
             for (int l = 0; l < GETME_LANES && j + l < n; l++) {
                 int32_t e = list[j + l];
                 const uint16_t *lc = getme__blocks_lnodes(blk, ws, t, e);
@@ -344,8 +352,9 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
                     if (out[i][l])
                         o = 1;
                     else
-                        add_fixed(acc + 4 * k, wfs[e - e0], yf[3 * i][l],
-                                  yf[3 * i + 1][l], yf[3 * i + 2][l]);
+                        add_fixed(acc + 4 * k, wfs[e - e0], (int64_t)yd[3 * i][l],
+                                  (int64_t)yd[3 * i + 1][l],
+                                  (int64_t)yd[3 * i + 2][l]);
                     flag[k] = 2;
                 }
             }

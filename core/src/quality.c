@@ -19,6 +19,18 @@
  * Non-finite coordinates give a NaN det or q, which fails the "> 0" tests
  * and so also yields 0.
  */
+/* Without trapping math gcc 12 if-converts the lane loops into AVX2
+   vector instructions (selects with a division or square root on either
+   side); with it, several stayed scalar on AVX2 (AVX-512 has masked
+   instructions, so there they vectorised either way).  Before the
+   includes, so the header kernels inlined here get it too (gcc does not
+   inline across differing trapping-math settings).  No value changes: the
+   IEEE results are the same, only the exception flags, which nothing
+   reads, may differ (as in transform_tet.c and measures.c). */
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC optimize("no-trapping-math")
+#endif
+
 #include "div3.h"
 #include "internal.h"
 
@@ -122,15 +134,24 @@ double getme__cube_root(double x)
    with a floor() in div3 (it becomes lfloor, which has no vector form).
    Without AVX-512 DQ (the portable build's dispatched copies) the 64-bit
    integer <-> double conversions have no vector instruction either, and
-   div3 measured 5 % slower there than bits / 3u: that build keeps it. */
+   div3 measured 5 % slower there than bits / 3u: that build keeps it.
+   A native AVX2 build (Zen 3: no AVX-512) uses getme__div3_u64_bits, the
+   same integer from bit tricks and a vector floor: bits / 3u kept this
+   loop scalar there, 40 % of the hex mean ratio's samples (round 10).
+   Only for the lane kernels (lanes, a constant where it is inlined): one
+   hex's 8 values measured 10-15 % slower with it (bench/kernels.sh). */
 static inline void cube_root_n(const double *restrict x, double *restrict y,
-                               int n)
+                               int n, int lanes)
 {
+    (void)lanes; /* used only in the AVX2 branch below */
 #pragma omp simd
     for (int i = 0; i < n; i++) {
         union { double d; uint64_t u; } v = {x[i]};
 #ifdef __AVX512DQ__
         v.u = getme__div3_u64(v.u) + UINT64_C(0x2A9F7893782DA1CE);
+#elif defined(__AVX2__)
+        v.u = (lanes ? getme__div3_u64_bits(v.u) : v.u / 3u) +
+              UINT64_C(0x2A9F7893782DA1CE);
 #else
         v.u = v.u / 3u + UINT64_C(0x2A9F7893782DA1CE);
 #endif
@@ -254,7 +275,7 @@ quality_hex_n(const double *restrict x, double *restrict q, const int L)
                                l2[hex_corner_edges[k][2]][l];
         }
     }
-    cube_root_n(det, c, 8 * L);
+    cube_root_n(det, c, 8 * L, L > 1);
 #pragma omp simd
     for (int l = 0; l < L; l++) {
         double s = 0.0;
@@ -311,7 +332,7 @@ quality_tet_lanes(const double (*x)[GETME_LANES], double *q)
                    (s2x * s2x + s2y * s2y + s2z * s2z) +
                    (s3x * s3x + s3y * s3y + s3z * s3z);
     }
-    cube_root_n(det, c, L);
+    cube_root_n(det, c, L, 1);
 #pragma omp simd
     for (int l = 0; l < L; l++)
         q[l] = valid_or_zero(det[l] > 0.0, 3.0 * c[l] * c[l] / frob2[l]);

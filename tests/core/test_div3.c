@@ -2,7 +2,8 @@
  * test_div3.c -- the exact divisions by 3 of div3.h give the bits of the
  * division they replace: getme__div3_fma (two fused multiply-adds) against
  * s / 3 on doubles of every exponent (normal, subnormal, the extremes,
- * infinities, NaN), and getme__div3_u64 (32-bit products and a double)
+ * infinities, NaN), and getme__div3_u64 and getme__div3_u64_bits (32-bit
+ * products and a double, from conversion instructions or from bits)
  * against b / 3 on 64-bit integers of every size and on the values next
  * to multiples of 3, of powers of 2 and of the 2^32 boundary its split
  * uses.  The hex transformation's node means and the cube roots' initial
@@ -89,7 +90,8 @@ static void check_double(void)
 static int u64_ok(uint64_t b)
 {
     volatile uint64_t three = 3;
-    return getme__div3_u64(b) == b / three;
+    return getme__div3_u64(b) == b / three &&
+           getme__div3_u64_bits(b) == b / three;
 }
 
 static void check_u64(void)
