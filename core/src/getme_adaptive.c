@@ -498,10 +498,118 @@ struct some_ctx {
     getme_ufx *tally; /* update_after: per thread, 4 apart (a cache line) */
 };
 
+/* Ring elements per chunk of some_chunk and update_chunk. */
+#define SOME_CHUNK 32
+
+/* The contributions of the ring elements g->pos[j0..j1) of one block (all
+   of type t, a constant in each copy; 3-D), as add_transformed and
+   add_untransformed add them, in three passes over chunks of SOME_CHUNK
+   elements.  perf annotate of the element-at-a-time loop: most of its time
+   went to the scattered loads of the Eq. 9 weights (the nodes' S_v, the
+   edges' S_e, the face neighbours' q), one element's chain after the
+   other's.  So the first pass only loads each element's connectivity and
+   edge ids and prefetches those; the second sums them (weights_3d's
+   arithmetic: the same integers and the same correctly rounded division
+   and square root, hence the same bits as weight()) and prefetches the
+   sums of the nodes in I_T; the third adds the contributions. */
+__attribute__((always_inline)) /* one copy per type: t is a constant */
+static inline void some_chunks(int t, const struct some_ctx *s, int32_t j0,
+                               int32_t j1, int *ovf)
+{
+    getme_run *run = s->run;
+    const getme_ws *ws = run->ws;
+    const getme_adj *adj = run->adj;
+    const int32_t *pos = adj->blk.group.pos;
+    const double *q = run->q, qt = s->qt;
+    const uint8_t *in_t = run->in_t;
+    const int nv = getme__nv[t], ned = getme__edges[t].num_edges;
+    const int nf = getme__faces[t].num_faces;
+    const double qs = adj->qscale, wscale = run->wscale;
+    int o = 0;
+    for (int32_t c0 = j0; c0 < j1; c0 += SOME_CHUNK) {
+        int32_t n = c0 + SOME_CHUNK < j1 ? SOME_CHUNK : j1 - c0;
+        int32_t el[SOME_CHUNK], eid[SOME_CHUNK][12];
+        /* bit 0 transformed, bit 1 untransformed (adds its I_T nodes),
+           bit 2 irregular (the union walk's weight) */
+        uint8_t kind[SOME_CHUNK];
+        for (int32_t i = 0; i < n; i++) {
+            int32_t e = run->elems[pos[c0 + i]];
+            el[i] = e;
+            int k = (run->tflag[e] != 0) |
+                    (q[e] > qt && getme__owned(run, e)) << 1;
+            if (k && adj->irregular[e])
+                k |= 4;
+            kind[i] = (uint8_t)k;
+            if (k == 0 || (k & 4))
+                continue;
+            const int32_t *c = getme__ws_nodes(ws, t, e);
+            for (int v = 0; v < nv; v++)
+                __builtin_prefetch(adj->nsum + c[v], 0, 3);
+            getme__adj_edge_ids(adj, c, t, getme__adj_slots(adj, ws, t, e),
+                                eid[i]);
+            for (int j = 0; j < ned; j++)
+                __builtin_prefetch(adj->esum + eid[i][j], 0, 3);
+            const int32_t *f = getme__adj_faces(adj, ws, t, e);
+            for (int j = 0; j < nf; j++) /* no neighbour (-1): e itself */
+                __builtin_prefetch(q + (f[j] >= 0 ? f[j] : e), 0, 3);
+        }
+        double num[SOME_CHUNK], den[SOME_CHUNK];
+        for (int32_t i = 0; i < SOME_CHUNK; i++)
+            num[i] = 0.0, den[i] = 1.0;
+        for (int32_t i = 0; i < n; i++) {
+            if (kind[i] == 0 || (kind[i] & 4))
+                continue;
+            int32_t e = el[i];
+            const int32_t *c = getme__ws_nodes(ws, t, e);
+            const int32_t *f = getme__adj_faces(adj, ws, t, e);
+            uint64_t sv = 0, se = 0;
+            for (int v = 0; v < nv; v++) {
+                sv += (uint64_t)adj->nsum[c[v]];
+                if (in_t[c[v]])
+                    __builtin_prefetch(run->facc + 4 * (int64_t)c[v], 1, 3);
+            }
+            for (int j = 0; j < ned; j++) /* -1: irregular, not here */
+                se += (uint64_t)adj->esum[eid[i][j]];
+            num[i] = getme__adj_nsum_3d(adj, sv, se,
+                                        getme__adj_face_q(adj, q, f, nf),
+                                        (uint64_t)getme__fx64(q[e], qs), nf);
+            den[i] = (double)adj->count[e] * q[e];
+        }
+        int64_t wv[SOME_CHUNK];
+#pragma omp simd
+        for (int32_t i = 0; i < SOME_CHUNK; i++)
+            wv[i] = getme__fx64(sqrt(num[i] / den[i]), wscale);
+        for (int32_t i = 0; i < n; i++) {
+            int k = kind[i];
+            if (k == 0)
+                continue;
+            int32_t e = el[i];
+            int64_t wf = k & 4 ? getme__fx64(getme__weight_union(run, t, e),
+                                             wscale)
+                               : wv[i];
+            const int32_t *c = getme__ws_nodes(ws, t, e);
+            if (k & 1) { /* add_transformed */
+                double x[3 * GETME_MAX_NV], y[3 * GETME_MAX_NV];
+                getme__ws_gather(ws, ws->x, t, e, x);
+                getme__transform(t, x, s->sigma, y);
+                for (int v = 0; v < nv; v++)
+                    if (!ws->fixed[c[v]])
+                        o |= add_node(run, c[v], wf, y + 3 * v);
+            }
+            if (k & 2) /* add_untransformed */
+                for (int v = 0; v < nv; v++)
+                    if (in_t[c[v]])
+                        o |= add_node(run, c[v], wf, ws->x + 3 * (int64_t)c[v]);
+        }
+    }
+    *ovf |= o;
+}
+
 /* The contributions of the elements of block b that are in run->elems
    (grouped: getme__blocks_group): those in run->tlist (tflag) transformed,
    those above q_t with their nodes in I_T untransformed, as scatter_some
-   adds them serially.  Returns 1 on a bound overflow (add_node). */
+   adds them serially (3-D: some_chunks).  Returns 1 on a bound overflow
+   (add_node). */
 static int64_t scatter_some_block(void *ctx, int32_t b)
 {
     const struct some_ctx *s = ctx;
@@ -511,6 +619,10 @@ static int64_t scatter_some_block(void *ctx, int32_t b)
         return 0;
     int t = getme__ws_type(run->ws, run->ws->block_start[b]);
     int ovf = 0;
+    if (run->ws->dim == 3) {
+        GETME_FOR_TYPE(t, some_chunks, s, g->ptr[b], g->ptr[b + 1], &ovf);
+        return ovf;
+    }
     for (int32_t j = g->ptr[b]; j < g->ptr[b + 1]; j++) {
         int32_t e = run->elems[g->pos[j]];
         if (run->tflag[e])
@@ -519,6 +631,75 @@ static int64_t scatter_some_block(void *ctx, int32_t b)
             ovf |= add_untransformed(run, t, e);
     }
     return ovf;
+}
+
+/* A ring whose stars hold at least ne / RING_SWEEP_DIV element entries is
+   listed by a sweep over the element flags (ring_sweep) instead of in
+   first-occurrence order (a sweep over every element would cost more than
+   it saves on a small ring). */
+#define RING_SWEEP_DIV 32
+#ifdef GETME_CHECK_SUMS
+/* Test builds: 2 threads always sweep, other counts never, so that
+   tests/core/test_adjacency.c's comparison of 1, 2 and 3 threads compares
+   the two orders of run->elems (and the serial and block-grouped sums). */
+#define RING_SWEEP(ws, stars) ((ws)->nt == 2)
+#else
+#define RING_SWEEP(ws, stars) ((stars) >= (ws)->ne / RING_SWEEP_DIV)
+#endif
+/* Elements per chunk of ring_sweep's parallel count and placement. */
+#define RING_CHUNK 16384
+
+/* The elements marked in run->eflag, in ascending order, into run->elems,
+   clearing the marks; returns how many.  Why ascending: scatter_some's
+   and update_after's block sweeps and the relaxation's first pass then
+   walk each block's elements in memory order, so the per-element arrays
+   (q, connectivity, face neighbours, edge slots) stream and neighbouring
+   elements share their nodes' and edges' cache lines; in first-occurrence
+   order (a node's star after another's) nearly every element was a miss.
+   The order of run->elems changes no result: the scatter's and the sums'
+   integer additions are exact, the relaxation treats each element and
+   node alone and its step rounds are sets, and update_after sorts the
+   transformation list.  A parallel count per chunk, then each chunk
+   places its elements (serial if the counts have no room: the same
+   list). */
+static int32_t ring_sweep(getme_run *run)
+{
+    const getme_ws *ws = run->ws;
+    uint8_t *eflag = run->eflag;
+    int32_t *out = run->elems, n = ws->ne;
+    int32_t nc = (n + RING_CHUNK - 1) / RING_CHUNK;
+    int32_t *cnt = malloc(((size_t)nc + 1) * sizeof *cnt);
+    if (!cnt) {
+        int32_t m = 0;
+        for (int32_t e = 0; e < n; e++)
+            if (eflag[e]) {
+                eflag[e] = 0;
+                out[m++] = e;
+            }
+        return m;
+    }
+#pragma omp parallel for schedule(static) num_threads(ws->nt)
+    for (int32_t c = 0; c < nc; c++) {
+        int32_t end = c < nc - 1 ? (c + 1) * RING_CHUNK : n, m = 0;
+        for (int32_t e = c * RING_CHUNK; e < end; e++)
+            m += eflag[e] != 0;
+        cnt[c + 1] = m;
+    }
+    cnt[0] = 0;
+    for (int32_t c = 0; c < nc; c++)
+        cnt[c + 1] += cnt[c];
+#pragma omp parallel for schedule(static) num_threads(ws->nt)
+    for (int32_t c = 0; c < nc; c++) {
+        int32_t end = c < nc - 1 ? (c + 1) * RING_CHUNK : n, m = cnt[c];
+        for (int32_t e = c * RING_CHUNK; e < end; e++)
+            if (eflag[e]) {
+                eflag[e] = 0;
+                out[m++] = e;
+            }
+    }
+    int32_t total = cnt[nc];
+    free(cnt);
+    return total;
 }
 
 /* q*_min stage: only the elements in run->tlist (q <= q_t) are transformed,
@@ -550,17 +731,28 @@ static int32_t scatter_some(getme_run *run, double qt, double sigma)
             if (run->in_t[i])
                 run->nodes[nn++] = i;
     }
-    for (int32_t k = 0; k < nn; k++) /* the elements around I_T */
-        for (int64_t j = ws->star_ptr[run->nodes[k]];
-             j < ws->star_ptr[run->nodes[k] + 1]; j++) {
-            int32_t e = ws->star[j];
-            if (!run->eflag[e]) {
-                run->eflag[e] = 1;
-                run->elems[ne++] = e;
+    int64_t stars = 0; /* the elements around I_T, with repeats */
+    for (int32_t k = 0; k < nn; k++)
+        stars += ws->star_ptr[run->nodes[k] + 1] - ws->star_ptr[run->nodes[k]];
+    if (RING_SWEEP(ws, stars)) { /* marked, then in order */
+        for (int32_t k = 0; k < nn; k++)
+            for (int64_t j = ws->star_ptr[run->nodes[k]];
+                 j < ws->star_ptr[run->nodes[k] + 1]; j++)
+                run->eflag[ws->star[j]] = 1;
+        ne = ring_sweep(run);
+    } else {
+        for (int32_t k = 0; k < nn; k++)
+            for (int64_t j = ws->star_ptr[run->nodes[k]];
+                 j < ws->star_ptr[run->nodes[k] + 1]; j++) {
+                int32_t e = ws->star[j];
+                if (!run->eflag[e]) {
+                    run->eflag[e] = 1;
+                    run->elems[ne++] = e;
+                }
             }
-        }
-    for (int32_t k = 0; k < ne; k++)
-        run->eflag[run->elems[k]] = 0;
+        for (int32_t k = 0; k < ne; k++)
+            run->eflag[run->elems[k]] = 0;
+    }
     run->num_nodes = nn;
     run->num_elems = ne;
     run->adj->blk.group.n = -1; /* run->elems changed */
@@ -627,7 +819,11 @@ static inline void sum_change(getme_run *run, int t, int32_t k,
 /* update_after's sums for the elements of block b in run->elems (as
    scatter_some grouped them): a block's elements' nodes and edges are no
    other block's running at the same time; q_mean's sum moves by the
-   thread's total. */
+   thread's total.  3-D, in chunks of SOME_CHUNK: the first pass finds each
+   element's difference and edge ids and prefetches its S_v and S_e, the
+   second adds (sum_change's work; perf annotate of the element-at-a-time
+   loop showed it waiting on those scattered read-modify-writes one
+   element after the other).  Integer sums, so the same bits. */
 static int64_t update_block(void *ctx, int32_t b)
 {
     const struct some_ctx *s = ctx;
@@ -635,10 +831,59 @@ static int64_t update_block(void *ctx, int32_t b)
     const struct getme_block_group *g = &run->adj->blk.group;
     if (g->ptr[b] == g->ptr[b + 1])
         return 0;
-    int t = getme__ws_type(run->ws, run->ws->block_start[b]);
+    const getme_ws *ws = run->ws;
+    int t = getme__ws_type(ws, ws->block_start[b]);
     getme_ufx *tsum = s->tally + 4 * omp_get_thread_num();
-    for (int32_t j = g->ptr[b]; j < g->ptr[b + 1]; j++)
-        sum_change(run, t, g->pos[j], tsum);
+    if (ws->dim != 3) {
+        for (int32_t j = g->ptr[b]; j < g->ptr[b + 1]; j++)
+            sum_change(run, t, g->pos[j], tsum);
+        return 0;
+    }
+    getme_adj *adj = run->adj;
+    const int nv = getme__nv[t], ned = getme__edges[t].num_edges;
+    const double qs = adj->qscale;
+    getme_ufx ts = 0;
+    for (int32_t c0 = g->ptr[b]; c0 < g->ptr[b + 1]; c0 += SOME_CHUNK) {
+        int32_t n = c0 + SOME_CHUNK < g->ptr[b + 1] ? SOME_CHUNK
+                                                    : g->ptr[b + 1] - c0;
+        int32_t el[SOME_CHUNK], eid[SOME_CHUNK][12];
+        uint64_t dd[SOME_CHUNK];
+        for (int32_t i = 0; i < n; i++) {
+            int32_t k = g->pos[c0 + i], e = run->elems[k];
+            double qo = run->qold[k], qn = run->q[e];
+            el[i] = e;
+            dd[i] = 0;
+            if (qn == qo)
+                continue;
+            if (run->tally)
+                ts += getme__tally_diff(qo, qn);
+            dd[i] = (uint64_t)getme__fx64(qn, qs) - (uint64_t)getme__fx64(qo, qs);
+            if (!dd[i])
+                continue;
+            const int32_t *c = getme__ws_nodes(ws, t, e);
+            for (int v = 0; v < nv; v++)
+                __builtin_prefetch(adj->nsum + c[v], 1, 3);
+            getme__adj_edge_ids(adj, c, t, getme__adj_slots(adj, ws, t, e),
+                                eid[i]);
+            for (int j = 0; j < ned; j++)
+                if (eid[i][j] >= 0)
+                    __builtin_prefetch(adj->esum + eid[i][j], 1, 3);
+        }
+        for (int32_t i = 0; i < n; i++) { /* getme__adj_add's sums */
+            uint64_t d = dd[i];
+            if (!d)
+                continue;
+            const int32_t *c = getme__ws_nodes(ws, t, el[i]);
+            for (int v = 0; v < nv; v++)
+                adj->nsum[c[v]] = (int64_t)((uint64_t)adj->nsum[c[v]] + d);
+            for (int j = 0; j < ned; j++)
+                if (eid[i][j] >= 0) {
+                    int64_t *p = &adj->esum[eid[i][j]];
+                    *p = (int64_t)((uint64_t)*p + d);
+                }
+        }
+    }
+    *tsum += ts;
     return 0;
 }
 

@@ -403,6 +403,46 @@ static void check_live_sums(void)
     free_gen(&g);
 }
 
+/* The q*_min stage's lists and sums (getme_adaptive.c): its ring of
+   elements around I_T is listed in ascending order (ring_sweep) or in
+   first-occurrence order, and its Eq. 9 contributions and sum updates run
+   serially (1 thread) or block by block in chunks (some_chunks,
+   update_block).  None of that may change a bit: this test is built with
+   GETME_CHECK_SUMS, where 2 threads always take the sweep and 3 never, so
+   every output coordinate of 1, 2 and 3 threads must be the same bits.
+   Tets, hexes and a mixed mesh (blocks of several types, irregular
+   elements' union weights), each distorted as the benchmark meshes. */
+static void check_ring_orders(const char *kind)
+{
+    N = 10;
+    gen g = make(kind);
+    N = 5;
+    double *ref = NULL;
+    int32_t nn = 0;
+    for (int nt = 1; nt <= 3; nt++) {
+        getme_mesh *mesh = to_mesh(&g);
+        CHECK(getme_mesh_fix_boundary(mesh, GETME_FIX_SKIN, NULL) == GETME_OK);
+        CHECK(getme_mesh_distort(mesh, 3, 0.5, 0.45, 200) == GETME_OK);
+        getme_params p;
+        getme_params_init(&p);
+        p.num_threads = nt;
+        getme_result r;
+        CHECK_EQ_INT(getme_smooth(mesh, &p, &r), GETME_OK);
+        CHECK(r.iterations_min >= 1);
+        nn = getme_mesh_num_nodes(mesh);
+        const double *x = getme_mesh_coords(mesh);
+        if (nt == 1) {
+            ref = malloc((size_t)nn * 3 * sizeof *ref);
+            memcpy(ref, x, (size_t)nn * 3 * sizeof *ref);
+        } else {
+            CHECK(memcmp(ref, x, (size_t)nn * 3 * sizeof *ref) == 0);
+        }
+        getme_mesh_free(mesh);
+    }
+    free(ref);
+    free_gen(&g);
+}
+
 /* What the end of the smoothing keeps by changes instead of sweeps
    (tally.h, best.c, finish.c): q_mean's exact sum and q*_min after each
    q*_min iteration, the qualities after keep_best puts the best mesh back
@@ -808,6 +848,8 @@ int main(void)
     check_block_order();
     check_live_sums();
     check_tail_bookkeeping();
+    check_ring_orders("tet");
+    check_ring_orders("hex");
     for (size_t i = 0; i < sizeof kinds / sizeof *kinds; i++) {
         check_threads(kinds[i], 0);
         check_threads(kinds[i], 1);
