@@ -108,6 +108,24 @@ int cli_parse_double(const char *opt, const char *s, double *out);
 getme_doc *cli_open(const char *path, const getme_doc_options *opts,
                     int allow_invalid, int *code, const cli_log *log);
 
+/* The mesh as read, measured in the sweep that also makes the document's
+   validity check (cli_open_measured). */
+typedef struct cli_measured {
+    cli_measures m; /* valid if ok                                     */
+    int ok;         /* 0: the measures failed (out of memory)          */
+    double *q;      /* every element's quality (the caller frees it);
+                       NULL if it could not be allocated or !ok        */
+} cli_measured;
+
+/* cli_open, but the document's validity check (getme_doc_check) takes
+   its qualities from the measures' sweep, which the caller reports
+   anyway: every element is evaluated once, not twice.  The same
+   messages, codes and statistics as cli_open; out is filled whenever a
+   document is returned. */
+getme_doc *cli_open_measured(const char *path, const getme_doc_options *opts,
+                             int allow_invalid, int *code, const cli_log *log,
+                             cli_measured *out);
+
 /* Mesh summary: "195070 tets, 12 prisms; 37012 nodes (8123 fixed)". */
 void cli_describe_mesh(getme_mesh *mesh, char *buf, size_t size);
 

@@ -88,7 +88,10 @@ int cli_quality(int argc, char **argv)
         return EXIT_USAGE;
     }
     int st;
-    getme_doc *doc = cli_open(input, &opts, 1, &st, &log);
+    /* one sweep evaluates every element: the read's validity check, the
+       measures and the qualities the statistics and the worst lists use */
+    cli_measured mb;
+    getme_doc *doc = cli_open_measured(input, &opts, 1, &st, &log, &mb);
     if (!doc)
         return st;
     getme_mesh *mesh = getme_doc_mesh(doc);
@@ -96,13 +99,10 @@ int cli_quality(int argc, char **argv)
     cli_describe_mesh(mesh, desc, sizeof desc);
     cli_info(&log, "%s (%s): %s", input, getme_format_name(getme_doc_format(doc)), desc);
     int types = 0;
-    cli_measures measures;
-    /* one sweep evaluates every element: the measures and the qualities
-       the statistics and the worst lists use */
-    int32_t ne = getme_mesh_num_elements(mesh);
-    double *q = malloc((size_t)(ne ? ne : 1) * sizeof *q);
-    if (!q || cli_measures_compute(mesh, &measures, q) != 0) {
-        cli_error("%s: %s", input, q ? getme_mesh_error(mesh) : "out of memory");
+    const cli_measures *measures = &mb.m;
+    double *q = mb.q;
+    if (!q) {
+        cli_error("%s: %s", input, mb.ok ? "out of memory" : getme_mesh_error(mesh));
         free(q);
         getme_doc_close(doc);
         return CLI_EXIT_INTERNAL;
@@ -110,7 +110,7 @@ int cli_quality(int argc, char **argv)
     for (int t = 0; t < GETME_NUM_TYPES; t++)
         if (getme_mesh_num_elements_of_type(mesh, (getme_elem_type)t)) {
             print_type(&log, mesh, q, t);
-            cli_print_measure_histograms(&log, &measures, t);
+            cli_print_measure_histograms(&log, measures, t);
             types++;
         }
     if (types > 1)

@@ -66,12 +66,21 @@ static int run(smooth_args *a)
     int code = cli_check_paths(&paths);
     if (code)
         return code;
+    /* the read's validity check with the measures before (below), the
+       statistics and worst lists before and after smoothing run on the
+       OpenMP default team: make it --threads (the reader's and the
+       smoother's own count), not every core */
+    omp_set_num_threads(opts.num_threads);
     double t0 = omp_get_wtime();
     cli_info(log, "Reading '%s'...", a->input);
-    getme_doc *doc = cli_open(a->input, &opts, so->params.untangle, &code,
-                              log);
+    /* the measures before come from the sweep of the read's validity
+       check: every element evaluated once before smoothing */
+    cli_measured mb;
+    getme_doc *doc = cli_open_measured(a->input, &opts, so->params.untangle,
+                                       &code, log, &mb);
     if (!doc)
         return code;
+    free(mb.q); /* the statistics are kept by the document */
     if ((code = cli_check_read_files(&paths, doc)) != 0) {
         getme_doc_close(doc);
         return code;
@@ -84,14 +93,15 @@ static int run(smooth_args *a)
     if (getme_doc_info(doc)[0])
         cli_info(log, "%s", getme_doc_info(doc));
 
-    /* the measures, statistics and worst lists before and after
-       smoothing run on the OpenMP default team: make it --threads (the
-       reader's and the smoother's own count), not every core */
-    omp_set_num_threads(opts.num_threads);
     getme_quality_stats before = *getme_doc_stats(doc);
     cli_print_stats(log, "Quality before", &before);
-    cli_measures mbefore;
-    cli_measures_log(log, mesh, "Measures before", &mbefore);
+    cli_measures mbefore = mb.m;
+    if (mb.ok) {
+        cli_print_measures(log, "Measures before", &mbefore);
+    } else {
+        cli_warning(log, "%s: %s", "Measures before", getme_mesh_error(mesh));
+        memset(&mbefore, 0, sizeof mbefore);
+    }
     cli_ho_ratio ho_before = {0};
     cli_ho_log(log, doc, "before", &ho_before);
     getme_untangle_result ur;

@@ -118,8 +118,24 @@ void cli_describe_mesh(getme_mesh *mesh, char *buf, size_t size)
                  (int)getme_mesh_num_nodes(mesh), (int)getme_mesh_num_fixed(mesh));
 }
 
-getme_doc *cli_open(const char *path, const getme_doc_options *opts,
-                    int allow_invalid, int *code, const cli_log *log)
+/* The measures and qualities of the mesh just read into mb, then the
+   document's validity check from those qualities. */
+static getme_formats_status check_measured(getme_doc *doc, cli_measured *mb)
+{
+    getme_mesh *mesh = getme_doc_mesh(doc);
+    int32_t ne = getme_mesh_num_elements(mesh);
+    mb->q = malloc((size_t)(ne ? ne : 1) * sizeof *mb->q);
+    mb->ok = cli_measures_compute(mesh, &mb->m, mb->q) == 0;
+    if (!mb->ok) {
+        free(mb->q);
+        mb->q = NULL;
+    }
+    return getme_doc_check(doc, mb->q);
+}
+
+static getme_doc *open_doc(const char *path, const getme_doc_options *opts,
+                           int allow_invalid, int *code, const cli_log *log,
+                           cli_measured *mb)
 {
     getme_doc *doc = NULL;
     getme_doc_options with_gmsh;
@@ -132,7 +148,14 @@ getme_doc *cli_open(const char *path, const getme_doc_options *opts,
     const getme_format *adapters[] = {cli_gmsh_adapter(), NULL};
     if (adapters[0])
         with_gmsh.adapters = adapters;
+    with_gmsh.defer_check = mb != NULL;
     getme_formats_status st = getme_doc_open(&doc, path, &with_gmsh);
+    if (mb) {
+        mb->q = NULL;
+        mb->ok = 0;
+        if (st == GETME_FORMATS_OK)
+            st = check_measured(doc, mb);
+    }
     *code = cli_exit_code(st);
     /* allow_invalid: inverted elements found in a complete mesh (to be
        untangled or reported on); not elements an adapter refused as
@@ -147,7 +170,24 @@ getme_doc *cli_open(const char *path, const getme_doc_options *opts,
     }
     cli_error("%s", getme_doc_error(doc));
     getme_doc_close(doc);
+    if (mb) {
+        free(mb->q);
+        mb->q = NULL;
+    }
     return NULL;
+}
+
+getme_doc *cli_open(const char *path, const getme_doc_options *opts,
+                    int allow_invalid, int *code, const cli_log *log)
+{
+    return open_doc(path, opts, allow_invalid, code, log, NULL);
+}
+
+getme_doc *cli_open_measured(const char *path, const getme_doc_options *opts,
+                             int allow_invalid, int *code, const cli_log *log,
+                             cli_measured *out)
+{
+    return open_doc(path, opts, allow_invalid, code, log, out);
 }
 
 void cli_param_range(const getme_param_info *p, char *buf, size_t size)

@@ -155,10 +155,13 @@ int64_t getme_doc_element_id(const getme_doc *doc, int32_t e)
 }
 
 /* Name the first invalid elements by their ids in the file. */
-static getme_formats_status check_valid(getme_doc *doc)
+getme_formats_status getme_doc_check(getme_doc *doc, const double *q)
 {
+    if (!doc || !doc->mesh)
+        return GETME_FORMATS_ERR_INTERNAL;
     getme_quality_stats *sp = &doc->stats;
-    if (getme_mesh_quality_stats(doc->mesh, -1, sp) != GETME_OK)
+    if ((q ? getme_mesh_quality_stats_from(doc->mesh, q, -1, sp)
+           : getme_mesh_quality_stats(doc->mesh, -1, sp)) != GETME_OK)
         return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL, "%s: out of memory",
                               doc->path);
     doc->have_stats = 1;
@@ -283,7 +286,7 @@ getme_formats_status getme_doc_open(getme_doc **out, const char *path,
                               "%s: the %s adapter built no mesh", path,
                               doc->format->name);
     compact_ids(doc);
-    return check_valid(doc);
+    return opts->defer_check ? GETME_FORMATS_OK : getme_doc_check(doc, NULL);
 }
 
 getme_formats_status getme_doc_write(getme_doc *doc, const char *out_path)

@@ -101,6 +101,12 @@ typedef struct getme_doc_options {
     int partition;       /* with one_part, for a file holding several
                             partitions: the one to read (1-based); 0 = all
                             of the file's elements (a split file)         */
+    /* 1: getme_doc_open leaves out its validity check, a sweep evaluating
+       every element; the caller makes it with getme_doc_check from the
+       qualities it computes anyway (the getme command's measures sweep
+       gives them), so that the mesh is not evaluated twice.  0 (default):
+       getme_doc_open checks. */
+    int defer_check;
 } getme_doc_options;
 
 /* Fill options with the defaults (fix skin and interfaces, no names, no
@@ -133,6 +139,13 @@ GETME_FORMATS_API int getme_format_has_extension(const getme_format *format,
  */
 GETME_FORMATS_API getme_formats_status
 getme_doc_open(getme_doc **doc, const char *path, const getme_doc_options *opts);
+/* The validity check of getme_doc_open (see defer_check): the statistics
+   of q, every element's quality with getme_mesh_element_qualities' bits
+   (NULL: computed here), kept for getme_doc_stats; then
+   GETME_FORMATS_ERR_INVALID with getme_doc_open's message if any element
+   is invalid, else GETME_FORMATS_OK. */
+GETME_FORMATS_API getme_formats_status getme_doc_check(getme_doc *doc,
+                                                       const double *q);
 /* Write the document to out_path: refused (GETME_FORMATS_ERR_ARGUMENT) if
    out_path is one of the files read (by device and inode) or is not a
    regular file (see getme_io_output_path: a symbolic link is followed). */
