@@ -8,13 +8,10 @@
  * buffer and flush the consumed part of it to the echo file whenever it
  * is refilled or the echo is switched.
  */
-#define _DEFAULT_SOURCE /* mmap, madvise */
 #include "msh41_internal.h"
 
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
-#include <sys/stat.h>
 
 /* 8 MiB: the ASCII fast path (msh41_fast.c) parses what the buffer holds
    in pieces across threads (linepar.c). */
@@ -24,53 +21,16 @@
    in the cache. */
 #define IN_READ (1u << 20)
 
-/* A regular file is mapped whole: the bytes are read where the page
-   cache holds them, not copied into the buffer by read() first (~130 ms
-   for the 185 MB of 4M binary tets, serial).  0, or -1 (then buffered). */
-static int map_file(msh41_input *in)
-{
-    struct stat sb;
-    if (fstat(fileno(in->f), &sb) != 0 || !S_ISREG(sb.st_mode) ||
-        sb.st_size <= 0 || (uint64_t)sb.st_size > SIZE_MAX / 2)
-        return -1;
-    void *p = mmap(NULL, (size_t)sb.st_size, PROT_READ, MAP_PRIVATE,
-                   fileno(in->f), 0);
-    if (p == MAP_FAILED)
-        return -1;
-    madvise(p, (size_t)sb.st_size, MADV_SEQUENTIAL);
-    in->buf = p;
-    in->len = in->map_len = (size_t)sb.st_size;
-    return 0;
-}
-
 int msh41_in_open(msh41_input *in, const char *path)
 {
     memset(in, 0, sizeof *in);
     in->line = 1;
     in->f = fopen(path, "rb");
-    if (in->f && map_file(in) == 0)
-        return 0;
     in->buf = malloc(IN_CHUNK);
     if (in->f && in->buf)
         return 0;
     msh41_in_close(in);
     return -1;
-}
-
-/* The mapped pages before the next byte are dropped from the process
-   (re-read from the page cache if ever touched again): without this the
-   file's pages would count in the reader's resident size, 185 MB more
-   peak for 4M binary tets than the buffered read. */
-#define RELEASE_STEP (8u << 20)
-static void release_behind(msh41_input *in)
-{
-    if (!in->map_len || in->pos - in->released < RELEASE_STEP)
-        return;
-    size_t to = in->pos & ~(size_t)(RELEASE_STEP - 1);
-    if (to > in->released) {
-        madvise(in->buf + in->released, to - in->released, MADV_DONTNEED);
-        in->released = to;
-    }
 }
 
 static void echo_flush(msh41_input *in)
@@ -87,10 +47,7 @@ void msh41_in_close(msh41_input *in)
     echo_flush(in);
     if (in->f)
         fclose(in->f);
-    if (in->map_len)
-        munmap(in->buf, in->map_len);
-    else
-        free(in->buf);
+    free(in->buf);
     in->f = NULL;
     in->buf = NULL;
 }
@@ -113,8 +70,6 @@ static int refill(msh41_input *in)
     if (in->pos < in->len)
         return 0;
     echo_flush(in);
-    if (in->map_len)
-        return -1; /* the whole file was in buf */
     in->base += (int64_t)in->len;
     in->pos = in->echo_from = 0;
     in->len = in->f ? fread(in->buf, 1, IN_READ, in->f) : 0;
@@ -145,7 +100,6 @@ size_t msh41_in_read_some(msh41_input *in, void *dst, size_t n)
         in->pos += k;
         done += k;
     }
-    release_behind(in);
     return done;
 }
 
@@ -163,7 +117,6 @@ int msh41_in_read(msh41_input *in, void *dst, size_t n)
         in->pos += k;
         n -= k;
     }
-    release_behind(in);
     return 0;
 }
 
@@ -240,7 +193,7 @@ const char *msh41_in_window(msh41_input *in, size_t want, size_t *avail)
        buffer: a refill moves what is left to the front, at most a 16th of
        what it then reads. */
     if (in->len - in->pos < (want < IN_CHUNK / 16 ? want : IN_CHUNK / 16) &&
-        in->f && !in->map_len) {
+        in->f) {
         echo_flush(in);
         size_t tail = in->len - in->pos;
         memmove(in->buf, in->buf + in->pos, tail);
@@ -258,5 +211,4 @@ void msh41_in_consume(msh41_input *in, size_t bytes, long lines)
 {
     in->pos += bytes;
     in->line += lines;
-    release_behind(in);
 }

@@ -36,8 +36,6 @@ typedef struct msh41_input {
     FILE *echo;          /* consumed bytes are copied here if set     */
     size_t echo_from;    /* first byte of buf not yet echoed          */
     int werr;            /* an echo write failed                      */
-    size_t map_len;      /* > 0: buf is the whole file, mapped        */
-    size_t released;     /* mapped bytes before this one dropped      */
 } msh41_input;
 
 int msh41_in_open(msh41_input *in, const char *path);
