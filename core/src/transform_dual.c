@@ -33,17 +33,13 @@
  *    sigma = 2 (docs/kernels.md has the measurements of both variants).
  * The regular element is an exact fixed point up to similarity.
  */
-/* Without trapping math gcc 12 if-converts the lane loops into AVX2
+/* This file is compiled with -fno-trapping-math (core/CMakeLists.txt):
+   without trapping math gcc 12 if-converts the lane loops into AVX2
    vector instructions (selects with a division or square root on either
    side); with it, several stayed scalar on AVX2 (AVX-512 has masked
-   instructions, so there they vectorised either way).  Before the
-   includes, so the header kernels inlined here get it too (gcc does not
-   inline across differing trapping-math settings).  No value changes: the
-   IEEE results are the same, only the exception flags, which nothing
-   reads, may differ (as in transform_tet.c and measures.c). */
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC optimize("no-trapping-math")
-#endif
+   instructions, so there they vectorised either way).  No value changes:
+   the IEEE results are the same, only the exception flags, which nothing
+   reads, may differ (as in transform_tet.c). */
 
 #include "internal.h"
 #include "transform_scale.h"
