@@ -578,7 +578,8 @@ void getme__corner_sj_hex_lanes(const double *restrict x, double *restrict m)
                          a01 * (a12 * a20 - a10 * a22) +
                          a02 * (a10 * a21 - a11 * a20);
             double sj = 1.0 * det / sqrt(len);
-            v[k][l] = len > 0.0 && isfinite(sj) ? sj : -1.0;
+            /* & not &&: a branch would stop the vectoriser */
+            v[k][l] = (len > 0.0) & (isfinite(sj) != 0) ? sj : -1.0;
         }
     }
     for (int l = 0; l < L; l++) {
