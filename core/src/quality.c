@@ -504,6 +504,19 @@ static inline double min_corner(double m, double v)
     return v < m ? v : v == m ? fmin(m, v) : m;
 }
 
+/* min_corner of the 8 values v[k * stride], in corner order, from 1.
+   One copy (noinline) for the one-hex and the lane kernel: -O3 turned
+   the folds of the two into different instructions that disagreed on
+   the sign of a zero minimum (fmin's choice between +0 and -0). */
+__attribute__((noinline)) static double hex_corner_fold(const double *v,
+                                                        int stride)
+{
+    double m = 1.0;
+    for (int k = 0; k < 8; k++)
+        m = min_corner(m, v[k * stride]);
+    return m;
+}
+
 /* corner_sj3 of the 8 hex corners (scale 1), min'd in corner order: the
    12 edges subtracted and squared once (hex_corner_edges), each corner's
    three edge vectors with their signs (negation is exact, so det keeps
@@ -534,10 +547,7 @@ static double corner_sj_hex(const double *x)
         double sj = 1.0 * det / sqrt(l[k]);
         v[k] = l[k] > 0.0 && isfinite(sj) ? sj : -1.0;
     }
-    double m = 1.0;
-    for (int k = 0; k < 8; k++)
-        m = min_corner(m, v[k]);
-    return m;
+    return hex_corner_fold(v, 1);
 }
 
 /* corner_sj_hex of GETME_CORNER_LANES hexes at once, coordinates
@@ -582,12 +592,8 @@ void getme__corner_sj_hex_lanes(const double *restrict x, double *restrict m)
             v[k][l] = (len > 0.0) & (isfinite(sj) != 0) ? sj : -1.0;
         }
     }
-    for (int l = 0; l < L; l++) {
-        double r = 1.0;
-        for (int k = 0; k < 8; k++)
-            r = min_corner(r, v[k][l]);
-        m[l] = r;
-    }
+    for (int l = 0; l < L; l++)
+        m[l] = hex_corner_fold(&v[0][l], L);
 }
 
 static inline double corner_sj2(const double *x, int k, int next, int prev)
