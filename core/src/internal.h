@@ -71,6 +71,12 @@ double getme__quality(int type, const double *x);
    ratio already measures their only corner. */
 double getme__corner_sj(int type, const double *x);
 
+/* getme__corner_sj of GETME_CORNER_LANES hexes, to the bit: coordinates
+   x[(3 i + d) * GETME_CORNER_LANES + l] (node i, coordinate d, hex l),
+   results m[l]. */
+#define GETME_CORNER_LANES 4
+void getme__corner_sj_hex_lanes(const double *x, double *m);
+
 /* A value and the element (or block) it belongs to.  getme__cmp_ranked
    sorts by value, ties by index: a total order, so qsort gives the same
    list whatever it does with equal keys (values are finite: qualities,

@@ -521,6 +521,19 @@ static inline double min_corner(double m, double v)
     return v < m ? v : v == m ? fmin(m, v) : m;
 }
 
+/* min_corner of the 8 values v[k * stride], in corner order, from 1.
+   One copy (noinline) for the one-hex and the lane kernel: -O3 turned
+   the folds of the two into different instructions that disagreed on
+   the sign of a zero minimum (fmin's choice between +0 and -0). */
+__attribute__((noinline)) static double hex_corner_fold(const double *v,
+                                                        int stride)
+{
+    double m = 1.0;
+    for (int k = 0; k < 8; k++)
+        m = min_corner(m, v[k * stride]);
+    return m;
+}
+
 /* corner_sj3 of the 8 hex corners (scale 1), min'd in corner order: the
    12 edges subtracted and squared once (hex_corner_edges), each corner's
    three edge vectors with their signs (negation is exact, so det keeps
@@ -551,10 +564,53 @@ static double corner_sj_hex(const double *x)
         double sj = 1.0 * det / sqrt(l[k]);
         v[k] = l[k] > 0.0 && isfinite(sj) ? sj : -1.0;
     }
-    double m = 1.0;
-    for (int k = 0; k < 8; k++)
-        m = min_corner(m, v[k]);
-    return m;
+    return hex_corner_fold(v, 1);
+}
+
+/* corner_sj_hex of GETME_CORNER_LANES hexes at once, coordinates
+   x[(3 i + d) * GETME_CORNER_LANES + l] (node i, coordinate d, hex l):
+   the same operations in the same order per hex (edges, squared lengths,
+   signed corner edges, det, square root, division, then the minimum in
+   corner order), each a vector instruction over the hexes, so every
+   m[l] has the bits corner_sj_hex gives hex l.  The initial corner
+   minimum computes every hex's corners (nothing is pruned at a fair
+   input's qualities): one at a time, the 12 edges and 12 squared
+   lengths were scalar. */
+void getme__corner_sj_hex_lanes(const double *restrict x, double *restrict m)
+{
+    enum { L = GETME_CORNER_LANES };
+    double e[12][3][L], l2[12][L], v[8][L];
+    for (int k = 0; k < 12; k++) {
+        int a = 3 * hex_edge_nodes[k][0], b = 3 * hex_edge_nodes[k][1];
+        for (int d = 0; d < 3; d++)
+#pragma omp simd
+            for (int l = 0; l < L; l++)
+                e[k][d][l] = x[(b + d) * L + l] - x[(a + d) * L + l];
+#pragma omp simd
+        for (int l = 0; l < L; l++)
+            l2[k][l] = e[k][0][l] * e[k][0][l] + e[k][1][l] * e[k][1][l] +
+                       e[k][2][l] * e[k][2][l];
+    }
+    for (int k = 0; k < 8; k++) {
+        const double s2 = k < 4 ? 1.0 : -1.0;
+        const unsigned char *ce = hex_corner_edges[k];
+#pragma omp simd
+        for (int l = 0; l < L; l++) {
+            double a00 = -e[ce[0]][0][l], a01 = -e[ce[0]][1][l], a02 = -e[ce[0]][2][l];
+            double a10 = e[ce[1]][0][l], a11 = e[ce[1]][1][l], a12 = e[ce[1]][2][l];
+            double a20 = s2 * e[ce[2]][0][l], a21 = s2 * e[ce[2]][1][l],
+                   a22 = s2 * e[ce[2]][2][l];
+            double len = l2[ce[0]][l] * l2[ce[1]][l] * l2[ce[2]][l];
+            double det = a00 * (a11 * a22 - a12 * a21) +
+                         a01 * (a12 * a20 - a10 * a22) +
+                         a02 * (a10 * a21 - a11 * a20);
+            double sj = 1.0 * det / sqrt(len);
+            /* & not &&: a branch would stop the vectoriser */
+            v[k][l] = (len > 0.0) & (isfinite(sj) != 0) ? sj : -1.0;
+        }
+    }
+    for (int l = 0; l < L; l++)
+        m[l] = hex_corner_fold(&v[0][l], L);
 }
 
 static inline double corner_sj2(const double *x, int k, int next, int prev)

@@ -132,6 +132,59 @@ int getme__report(getme_run *run, int iteration, getme_stage stage, int cycle,
     return p->progress(&info, p->progress_data);
 }
 
+/* A hex of quality q cannot lower the corner minimum m (corner_min). */
+static inline int hex_skipped(double q, double m)
+{
+    double k = 8.0 * q - 7.0 - 1e-12;
+    double lb = k > 0.0 ? k * sqrt(k) : 0.0;
+    return lb >= m * (1.0 + 1e-9) + 1e-12;
+}
+
+/* corner_min's hex loop in lanes: each thread takes the range
+   schedule(static) would give it, in the same order, with the same
+   running minimum (the reduction's private copy); the next
+   GETME_CORNER_LANES hexes its bound does not skip are computed together,
+   and each is then taken or skipped by the same test against the minimum
+   at its turn (m only falls, so a hex skipped when the batch was formed
+   would be skipped at its turn too).  Every thread's sequence of minima,
+   and so the value, is the one hex at a time gave. */
+static double hex_corner_min(const getme_ws *ws, const double *q, double m)
+{
+    int32_t h0 = ws->tstart[GETME_HEX], nh = ws->tstart[GETME_HEX + 1] - h0;
+#pragma omp parallel num_threads(ws->nt) reduction(min : m)
+    {
+        /* libgomp's schedule(static) ranges: the first nh % n threads
+           one hex more */
+        int32_t th = omp_get_thread_num(), n = omp_get_num_threads();
+        int32_t len = nh / n, extra = nh % n;
+        int32_t e = h0 + th * len + (th < extra ? th : extra);
+        int32_t e1 = e + len + (th < extra);
+        enum { L = GETME_CORNER_LANES };
+        double x[3 * GETME_MAX_NV * L], s[L];
+        int32_t id[L];
+        while (e < e1) {
+            int nb = 0;
+            for (; e < e1 && nb < L; e++)
+                if (!hex_skipped(q[e], m))
+                    id[nb++] = e;
+            for (int l = 0; l < L && nb > 0; l++) {
+                /* the unused lanes repeat the first hex */
+                const int32_t *c = getme__ws_nodes(ws, GETME_HEX,
+                                                   id[l < nb ? l : 0]);
+                for (int i = 0; i < 8; i++)
+                    for (int d = 0; d < 3; d++)
+                        x[(3 * i + d) * L + l] = ws->x[3 * (int64_t)c[i] + d];
+            }
+            if (nb > 0)
+                getme__corner_sj_hex_lanes(x, s);
+            for (int l = 0; l < nb; l++)
+                if (!hex_skipped(q[id[l]], m))
+                    m = s[l] < m ? s[l] : m;
+        }
+    }
+    return m;
+}
+
 /* The input must be valid: name the first invalid elements if not. */
 /*
  * getme__ws_corner_min's value at qualities q (current at ws->x), without
@@ -149,15 +202,18 @@ static double corner_min(const getme_ws *ws, const double *q)
     for (int t = 0; t < GETME_NUM_TYPES; t++) {
         if (!getme__has_corners(t))
             continue;
-        int hex = t == GETME_HEX, bounded = hex || t == GETME_QUAD;
+        if (t == GETME_HEX) {
+            m = hex_corner_min(ws, q, m);
+            continue;
+        }
+        int bounded = t == GETME_QUAD;
         /* m inside the loop is this thread's minimum so far */
 #pragma omp parallel for schedule(static) num_threads(ws->nt) \
     reduction(min : m)
         for (int32_t e = ws->tstart[t]; e < ws->tstart[t + 1]; e++) {
             if (bounded) {
-                double k = (hex ? 8.0 * q[e] - 7.0 : 4.0 * q[e] - 3.0) - 1e-12;
-                double lb = hex ? (k > 0.0 ? k * sqrt(k) : 0.0) : k;
-                if (lb >= m * (1.0 + 1e-9) + 1e-12)
+                double k = 4.0 * q[e] - 3.0 - 1e-12;
+                if (k >= m * (1.0 + 1e-9) + 1e-12)
                     continue;
             }
             double x[3 * GETME_MAX_NV];
