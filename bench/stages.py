@@ -11,7 +11,10 @@ program, so old builds are measured the same way as new ones:
 
   read      the reader's own "Done reading (..., X s)"
   before    statistics and measures of the input ("Done reading" to
-            "Optimizing mesh")
+            "Optimizing mesh"); since 2026-11-27 (read10) the measures
+            sweep is also the read's validity check and runs before "Done
+            reading", so compare read+before across such builds
+  read+before  the command's start to "Optimizing mesh"
   set-up    workspace, Morton order, stars, colouring, edge/face tables and
             the inclusion-exclusion check: time of iteration 1 minus one
             stage-1 iteration (the CLI's smoothing clock starts before them)
@@ -43,7 +46,8 @@ IT = re.compile(r"It +(\d+) \((q\*?min|qmean) stage.*\(([0-9.]+) s\)")
 READ = re.compile(r"Done reading .*\(\w+, ([0-9.]+) s\)")
 DONE = re.compile(r"Done optimizing mesh \(Wall ([0-9.]+)s\)")
 
-FIELDS = [("read", "read s", 2), ("before", "before s", 2), ("setup", "set-up s", 2),
+FIELDS = [("read", "read s", 2), ("before", "before s", 2),
+          ("read_before", "read+before s", 2), ("setup", "set-up s", 2),
           ("ns1", "stage-1 ns/el-it", 1), ("stage2", "stage 2 s", 2), ("after", "after s", 2),
           ("write", "write s", 2), ("total", "total s", 2), ("cpu", "CPU s", 2),
           ("rss", "peak MiB", 0)]
@@ -83,6 +87,7 @@ def one(exe, mesh, threads, tmp):
     it1 = s1[1] - s1[0] if len(s1) > 1 else 0.0
     return {
         "read": read, "before": arrive["opt"] - arrive["read"],
+        "read_before": arrive["opt"],
         "setup": s1[0] - it1,
         "ns1": (s1[-1] - s1[0]) / (len(s1) - 1) / ne * 1e9 if len(s1) > 1 else float("nan"),
         "stage2": done - s1[-1], "after": arrive["writing"] - arrive["done"],
@@ -146,7 +151,7 @@ def main():
                 for name, _ in runs[1:]:
                     m = med[(name, t)]
                     lines.append(f"| {short} | {t} | ratio {runs[0][0]}/{name} | " + " | ".join(
-                        f"{b[f] / m[f]:.2f}" if m[f] else "-" for f, _, _ in FIELDS) + " | | | |")
+                        f"{b[f] / m[f]:.2f}" if m[f] >= 0.005 else "-" for f, _, _ in FIELDS) + " | | | |")
             if len(threads) > 1:
                 for name, _ in runs:
                     a1, a2 = med[(name, threads[0])], med[(name, threads[-1])]
