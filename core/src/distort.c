@@ -99,11 +99,13 @@ getme_status getme_mesh_distort(getme_mesh *mesh, uint64_t seed, double amount,
     getme__ws_qualities(&ws, q);
     for (int32_t e = 0; e < ws.ne; e++)
         if (!(q[e] > 0.0)) {
+            /* the caller's index, read before the workspace is freed */
+            int32_t orig = ws.elem_orig[e];
             free(q);
             getme__ws_free(&ws);
             return getme__fail(mesh, GETME_ERR_INVALID_MESH,
                                "element %d is invalid before distortion",
-                               (int)ws.elem_orig[e]);
+                               (int)orig);
         }
     uint64_t rng = seed;
     for (int round = 0; round < max_rounds; round++) {

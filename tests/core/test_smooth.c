@@ -110,6 +110,12 @@ static void check_errors(void)
        untangled (its nodes are free), then smoothed. */
     int32_t inv[4] = {0, 2, 1, 3};
     CHECK(getme_mesh_add_elements(m, GETME_TET, 1, inv, NULL) == GETME_OK);
+    /* the distortion refuses it too, naming the element (the message
+       once read the freed workspace: a crash, not an error) */
+    CHECK(getme_mesh_distort(m, 1, 0.1, 0.0, 1) == GETME_ERR_INVALID_MESH);
+    CHECK(strstr(getme_mesh_error(m),
+                 "element 0 is invalid before distortion") != NULL);
+    CHECK(!memcmp(getme_mesh_coords(m), xyz, sizeof xyz));
     getme_params off;
     getme_params_init(&off);
     off.untangle = 0;
