@@ -102,7 +102,7 @@ static void mixed_cell(gen *g, int i, int j, int k, const int32_t v[8])
         int32_t c = add_node(g, i + 0.5, j + 0.5, k + 0.5);
         /* each base counter-clockwise seen from the apex (the centre),
            as Gmsh orders a pyramid; listed seen from outside, all six
-           were inverted, and the mixed cases ran with 20-45 % of their
+           were inverted, and the mixed cases ran with about half of their
            elements invalid */
         static const int8_t faces[6][4] = {{0, 1, 2, 3}, {4, 7, 6, 5}, {0, 4, 5, 1},
                                            {1, 5, 6, 2}, {2, 6, 7, 3}, {3, 7, 4, 0}};
