@@ -1,9 +1,11 @@
 /*
  * random_geometry.h -- the deterministic random numbers and rigid motions
- * that test_quality.c and test_transform.c draw their elements from.
+ * that test_quality.c, test_transform.c, test_lanes.c and
+ * test_corner_lanes.c draw their elements from.
  *
- * A header of static functions, like regular_elements.h: each test program
- * includes it once and gets its own generator.  Define RANDOM_GEOMETRY_SEED
+ * A header of static inline functions (a program may use only some of
+ * them), like regular_elements.h: each test program includes it once and
+ * gets its own generator.  Define RANDOM_GEOMETRY_SEED
  * before including it; the sequences then are the ones the tests always
  * drew (their expected values do not depend on a seed, their coverage
  * does).
@@ -24,7 +26,7 @@
 /* splitmix64: small, fast, and the same numbers on every platform. */
 static uint64_t rng_state = RANDOM_GEOMETRY_SEED;
 
-static double urand(void) /* in [0, 1) */
+static inline double urand(void) /* in [0, 1) */
 {
     uint64_t z = (rng_state += 0x9e3779b97f4a7c15ULL);
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
@@ -33,10 +35,10 @@ static double urand(void) /* in [0, 1) */
     return (double)(z >> 11) * (1.0 / 9007199254740992.0);
 }
 
-static double srand1(void) { return 2.0 * urand() - 1.0; } /* [-1, 1) */
+static inline double srand1(void) { return 2.0 * urand() - 1.0; } /* [-1, 1) */
 
 /* out = A x + b for every node (A row-major 3x3). */
-static void affine(const double *x, int nv, const double A[9],
+static inline void affine(const double *x, int nv, const double A[9],
                    const double b[3], double *out)
 {
     for (int i = 0; i < nv; i++)
@@ -48,7 +50,7 @@ static void affine(const double *x, int nv, const double A[9],
 /* A random rotation: about z for planar types (which must stay in their
    plane), else from a random unit quaternion (rejection sampling in the
    unit ball, so every orientation is as likely). */
-static void random_rotation(int planar, double R[9])
+static inline void random_rotation(int planar, double R[9])
 {
     if (planar) {
         double a = 2.0 * GETME_TEST_PI * urand(), c = cos(a), s = sin(a);

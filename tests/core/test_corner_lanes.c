@@ -16,16 +16,8 @@
 #include <stdint.h>
 #include <string.h>
 
-static uint64_t rng_state = 0x5eed0c0ffeeULL;
-
-static double srand1(void) /* in [-1, 1) */
-{
-    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    z ^= z >> 31;
-    return 2.0 * (double)(z >> 11) * (1.0 / 9007199254740992.0) - 1.0;
-}
+#define RANDOM_GEOMETRY_SEED 0x5eed0c0ffeeULL
+#include "random_geometry.h"
 
 static const double unit_hex[24] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0,
                                     0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1};
