@@ -765,39 +765,44 @@ static void dihedral_lanes(const dihedral_ends *d, const double (*x)[L],
                            double *lo, double *hi)
 {
     double cmin[L], cmax[L];
-    /* u, v of the largest and of the smallest cosine so far; 0 while no
-       end is ranked (NaN cosines), as dihedral3 has it */
-    double ua[3][L] = {{0}}, va[3][L] = {{0}}, ui[3][L] = {{0}},
-           vi[3][L] = {{0}};
+    /* u, v of the largest (a) and of the smallest (i) cosine so far; 0
+       while no end is ranked (NaN cosines), as dihedral3 has it.  Two
+       copies, read from one and written to the other at each end: written
+       in place, `a = up ? u : a` became a conditional store that gcc 12
+       vectorised as a branch around 24 masked stores (vmaskmovpd, slow on
+       Zen 3); into the other copy it is a plain blend and store. */
+    double uv[2][12][L];
+    memset(uv[0], 0, sizeof uv[0]);
     for (int l = 0; l < L; l++)
         cmin[l] = INFINITY, cmax[l] = -INFINITY;
     for (int k = 0; k < d->n; k++) {
+        double (*o)[L] = uv[k & 1];
+        double (*w)[L] = uv[(k + 1) & 1];
 #pragma omp simd
         for (int l = 0; l < L; l++) {
             v3 u, v;
             double cs = end_lane(d, x, k, l, &u, &v);
             int up = cs > cmax[l], down = cs < cmin[l];
-            /* the selects written out: through a helper taking the
-               arrays, gcc 12 left this loop scalar (2x slower sweep) */
             cmax[l] = up ? cs : cmax[l];
-            ua[0][l] = up ? u.x : ua[0][l];
-            ua[1][l] = up ? u.y : ua[1][l];
-            ua[2][l] = up ? u.z : ua[2][l];
-            va[0][l] = up ? v.x : va[0][l];
-            va[1][l] = up ? v.y : va[1][l];
-            va[2][l] = up ? v.z : va[2][l];
             cmin[l] = down ? cs : cmin[l];
-            ui[0][l] = down ? u.x : ui[0][l];
-            ui[1][l] = down ? u.y : ui[1][l];
-            ui[2][l] = down ? u.z : ui[2][l];
-            vi[0][l] = down ? v.x : vi[0][l];
-            vi[1][l] = down ? v.y : vi[1][l];
-            vi[2][l] = down ? v.z : vi[2][l];
+            w[0][l] = up ? u.x : o[0][l];
+            w[1][l] = up ? u.y : o[1][l];
+            w[2][l] = up ? u.z : o[2][l];
+            w[3][l] = up ? v.x : o[3][l];
+            w[4][l] = up ? v.y : o[4][l];
+            w[5][l] = up ? v.z : o[5][l];
+            w[6][l] = down ? u.x : o[6][l];
+            w[7][l] = down ? u.y : o[7][l];
+            w[8][l] = down ? u.z : o[8][l];
+            w[9][l] = down ? v.x : o[9][l];
+            w[10][l] = down ? v.y : o[10][l];
+            w[11][l] = down ? v.z : o[11][l];
         }
     }
+    double (*f)[L] = uv[d->n & 1];
     double ylo[L], xlo[L], yhi[L], xhi[L];
-    atan2_args_lanes(ua, va, ylo, xlo);
-    atan2_args_lanes(ui, vi, yhi, xhi);
+    atan2_args_lanes(f, f + 3, ylo, xlo);
+    atan2_args_lanes(f + 6, f + 9, yhi, xhi);
     for (int l = 0; l < L; l++) {
         lo[l] = atan2(ylo[l], xlo[l]) * RAD2DEG;
         hi[l] = atan2(yhi[l], xhi[l]) * RAD2DEG;
@@ -896,9 +901,9 @@ static void sicn_lanes(int type, const double (*x)[L], double *out)
 }
 
 /* Every measure of the GETME_LANES 3-D elements of type t in x into
-   v[l * GETME_NUM_MEASURES + m] (NaN where not defined for the type). */
+   v[m * stride + l] (NaN where not defined for the type). */
 static void measures3_lanes(int t, const dihedral_ends *de,
-                            const double (*x)[L], double *v)
+                            const double (*x)[L], double *v, int64_t stride)
 {
     double q[L], lo[L], hi[L], sj[L], g[L], s[L], cu[8][L];
     if (!getme__quality_lanes(t, x, q))
@@ -940,22 +945,20 @@ static void measures3_lanes(int t, const dihedral_ends *de,
         }
     }
     sicn_lanes(t, x, s);
-    for (int l = 0; l < L; l++) {
-        double *o = v + l * GETME_NUM_MEASURES;
-        o[GETME_MEASURE_MEAN_RATIO] = q[l];
-        o[GETME_MEASURE_MIN_DIHEDRAL] = lo[l];
-        o[GETME_MEASURE_MAX_DIHEDRAL] = hi[l];
-        o[GETME_MEASURE_SCALED_JACOBIAN] = sj[l];
-        o[GETME_MEASURE_GAMMA] = g[l];
-        o[GETME_MEASURE_SICN] = s[l];
-    }
+    memcpy(v + GETME_MEASURE_MEAN_RATIO * stride, q, sizeof q);
+    memcpy(v + GETME_MEASURE_MIN_DIHEDRAL * stride, lo, sizeof lo);
+    memcpy(v + GETME_MEASURE_MAX_DIHEDRAL * stride, hi, sizeof hi);
+    memcpy(v + GETME_MEASURE_SCALED_JACOBIAN * stride, sj, sizeof sj);
+    memcpy(v + GETME_MEASURE_GAMMA * stride, g, sizeof g);
+    memcpy(v + GETME_MEASURE_SICN * stride, s, sizeof s);
 }
 
 /* Gather the n <= GETME_LANES elements from e of block bl into lanes
-   (unused lanes repeat the last one) and measure them into v. */
+   (unused lanes repeat the last one) and measure them into v[m * stride
+   + l], l < n. */
 static void measure_group(const getme_mesh *mesh, const getme_block *bl,
                           int32_t e, int32_t n, double ysign,
-                          const dihedral_ends *de, double *v)
+                          const dihedral_ends *de, double *v, int64_t stride)
 {
     double x[3 * GETME_MAX_NV][L];
     int nv = getme__nv[bl->type];
@@ -970,19 +973,21 @@ static void measure_group(const getme_mesh *mesh, const getme_block *bl,
         }
     }
     if (n == L) {
-        measures3_lanes(bl->type, de, (const double(*)[L])x, v);
+        measures3_lanes(bl->type, de, (const double(*)[L])x, v, stride);
         return;
     }
-    double w[L * GETME_NUM_MEASURES];
-    measures3_lanes(bl->type, de, (const double(*)[L])x, w);
-    memcpy(v, w, (size_t)n * GETME_NUM_MEASURES * sizeof *v);
+    double w[GETME_NUM_MEASURES * L];
+    measures3_lanes(bl->type, de, (const double(*)[L])x, w, L);
+    for (int m = 0; m < GETME_NUM_MEASURES; m++)
+        memcpy(v + m * stride, w + m * L, (size_t)n * sizeof *v);
 }
 
 /* Elements per tile of getme_mesh_measure_all: the tile's values of every
-   measure (6 doubles per element, 1.5 MiB) are computed in parallel, each
-   thread reducing its contiguous part at once (counts, extremes,
-   histograms: exact, merged in thread order), then the sums of the means
-   are added serially in element order. */
+   measure (6 doubles per element, 1.5 MiB, measure by measure:
+   v[m * MEASURE_TILE + i]) are computed in parallel, each thread reducing
+   its contiguous part at once (counts, extremes, histograms: exact,
+   merged in thread order), then the sums of the means are added serially
+   in element order. */
 enum { MEASURE_TILE = 32768 };
 
 /* Every measure of element e of block bl into v[GETME_NUM_MEASURES] (NaN
@@ -1042,9 +1047,92 @@ static void merge_part(getme_measure_stats *s, const getme_measure_stats *p)
         s->histogram[b] += p->histogram[b];
 }
 
-/* The measures of n elements from e0 of block bl into v (n *
-   GETME_NUM_MEASURES), their mean ratios into q + bl->first + e0 if q,
-   and each thread's reduction into part[thread * GETME_NUM_MEASURES...]. */
+/*
+ * One measure's statistics of a thread's full groups of GETME_LANES 3-D
+ * elements, kept per lane so that the reduction is vector instructions
+ * (the scalar add_stat per element and measure cost as much as half the
+ * lane kernels): in lane l, the elements l, l + L, ... of the groups in
+ * order, each lane's extremes the first of its elements to reach them.
+ * lanes_into turns them into add_stat's statistics: the extreme of the
+ * lanes, on ties the element first in the mesh, is the serial sweep's.
+ * The histogram bins are counted from the lanes' bin numbers, bin
+ * GETME_HIST_BINS for values not in the histogram.
+ */
+typedef struct lane_stats {
+    double min[L], max[L];
+    int64_t min_element[L], max_element[L]; /* -1: no element yet */
+    int64_t num_elements[L], num_negative[L], num_below[L];
+    int64_t histogram[GETME_HIST_BINS + 1];
+} lane_stats;
+
+static void lanes_init(lane_stats *ls)
+{
+    memset(ls, 0, sizeof *ls);
+    for (int l = 0; l < L; l++)
+        ls->min_element[l] = ls->max_element[l] = -1;
+}
+
+/* add_stat of the values v[l] of elements g + l, as the serial sweep
+   computes each element's bin (t / w only where w is not 1). */
+static void lanes_add(lane_stats *ls, const double *v, int32_t g, double lo,
+                      double w)
+{
+    int32_t bin[L];
+    int scale = w != 1.0;
+#pragma omp simd
+    for (int l = 0; l < L; l++) {
+        double x = v[l];
+        int64_t e = (int64_t)g + l;
+        int64_t ok = x == x; /* not NaN: counted */
+        int64_t first = ok & (ls->min_element[l] < 0);
+        int64_t down = (x < ls->min[l]) | first, up = (x > ls->max[l]) | first;
+        ls->min[l] = down ? x : ls->min[l];
+        ls->min_element[l] = down ? e : ls->min_element[l];
+        ls->max[l] = up ? x : ls->max[l];
+        ls->max_element[l] = up ? e : ls->max_element[l];
+        ls->num_elements[l] += ok;
+        ls->num_negative[l] += x < 0.0;
+        int64_t below = x < lo;
+        ls->num_below[l] += below;
+        /* NaN and values below lo get no bin number from the conversion
+           (out of range) */
+        double t = ok & !below ? x - lo : 0.0;
+        t = scale ? t / w : t;
+        int32_t k = (int32_t)(t * GETME_HIST_BINS);
+        k = k >= GETME_HIST_BINS ? GETME_HIST_BINS - 1 : k;
+        bin[l] = ok & !below ? k : GETME_HIST_BINS;
+    }
+    for (int l = 0; l < L; l++)
+        ls->histogram[bin[l]]++;
+}
+
+/* The statistics of ls into s (init_stats'd, no element yet). */
+static void lanes_into(const lane_stats *ls, getme_measure_stats *s)
+{
+    for (int l = 0; l < L; l++) {
+        s->num_elements += ls->num_elements[l];
+        s->num_negative += ls->num_negative[l];
+        s->num_below += ls->num_below[l];
+        int64_t e = ls->min_element[l];
+        if (e >= 0 && (s->min_element < 0 || ls->min[l] < s->min ||
+                       (ls->min[l] == s->min && e < s->min_element))) {
+            s->min = ls->min[l];
+            s->min_element = (int32_t)e;
+        }
+        e = ls->max_element[l];
+        if (e >= 0 && (s->max_element < 0 || ls->max[l] > s->max ||
+                       (ls->max[l] == s->max && e < s->max_element))) {
+            s->max = ls->max[l];
+            s->max_element = (int32_t)e;
+        }
+    }
+    for (int b = 0; b < GETME_HIST_BINS; b++)
+        s->histogram[b] += ls->histogram[b];
+}
+
+/* The measures of n elements from e0 of block bl into v (v[m *
+   MEASURE_TILE + i]), their mean ratios into q + bl->first + e0 if q, and
+   each thread's reduction into part[thread * GETME_NUM_MEASURES...]. */
 static void tile_measures(const getme_mesh *mesh, const getme_block *bl,
                           int32_t e0, int32_t n, double ysign,
                           const dihedral_ends *de, const uint8_t *defined,
@@ -1058,33 +1146,55 @@ static void tile_measures(const getme_mesh *mesh, const getme_block *bl,
         init_stats(&part[k], k % GETME_NUM_MEASURES);
 #pragma omp parallel num_threads(nt)
     {
-        getme_measure_stats p[GETME_NUM_MEASURES];
-        for (int m = 0; m < GETME_NUM_MEASURES; m++)
+        /* p: the elements reduced one at a time (planar types, a last
+           group of fewer than L), which come after the full groups of
+           the thread's part */
+        getme_measure_stats p[GETME_NUM_MEASURES], r[GETME_NUM_MEASURES];
+        lane_stats ls[GETME_NUM_MEASURES];
+        double lo[GETME_NUM_MEASURES], w[GETME_NUM_MEASURES];
+        for (int m = 0; m < GETME_NUM_MEASURES; m++) {
             init_stats(&p[m], m);
+            lanes_init(&ls[m]);
+            lo[m] = p[m].hist_lo;
+            w[m] = p[m].hist_hi - p[m].hist_lo;
+        }
         /* static: thread k's groups come before thread k + 1's */
 #pragma omp for schedule(static)
         for (int32_t i = 0; i < n; i += step) {
             int32_t k = n - i < step ? n - i : step;
-            double *vi = v + (int64_t)i * GETME_NUM_MEASURES;
+            int32_t g = bl->first + e0 + i;
             if (dim3) {
                 getme__prefetch_local(mesh, bl, e0 + i + PREFETCH_GROUPS * L, L);
-                measure_group(mesh, bl, e0 + i, k, ysign, de, vi);
+                measure_group(mesh, bl, e0 + i, k, ysign, de, v + i,
+                              MEASURE_TILE);
             } else {
+                double vi[GETME_NUM_MEASURES];
                 getme__prefetch_local(mesh, bl, e0 + i + GETME_PREFETCH_AHEAD, 1);
                 element_measures(mesh, bl, e0 + i, ysign, de, defined, vi);
-            }
-            int32_t g = bl->first + e0 + i;
-            for (int32_t j = 0; j < k; j++) {
-                const double *vj = vi + j * GETME_NUM_MEASURES;
-                if (q)
-                    q[g + j] = vj[GETME_MEASURE_MEAN_RATIO];
                 for (int m = 0; m < GETME_NUM_MEASURES; m++)
-                    if (!isnan(vj[m]))
-                        add_part(&p[m], vj[m], g + j);
+                    v[(int64_t)m * MEASURE_TILE + i] = vi[m];
+            }
+            if (q)
+                memcpy(q + g, v + (int64_t)GETME_MEASURE_MEAN_RATIO * MEASURE_TILE + i,
+                       (size_t)k * sizeof *q);
+            for (int m = 0; m < GETME_NUM_MEASURES; m++) {
+                const double *vm = v + (int64_t)m * MEASURE_TILE + i;
+                if (k == L && dim3) {
+                    lanes_add(&ls[m], vm, g, lo[m], w[m]);
+                    continue;
+                }
+                for (int32_t j = 0; j < k; j++)
+                    if (!isnan(vm[j]))
+                        add_part(&p[m], vm[j], g + j);
             }
         }
-        memcpy(part + (int64_t)omp_get_thread_num() * GETME_NUM_MEASURES, p,
-               sizeof p);
+        for (int m = 0; m < GETME_NUM_MEASURES; m++) {
+            init_stats(&r[m], m);
+            lanes_into(&ls[m], &r[m]);
+            merge_part(&r[m], &p[m]);
+        }
+        memcpy(part + (int64_t)omp_get_thread_num() * GETME_NUM_MEASURES, r,
+               sizeof r);
     }
 }
 
@@ -1131,12 +1241,12 @@ getme_status getme_mesh_measure_all_qualities(getme_mesh *mesh,
                     merge_part(&s[m], &part[k * GETME_NUM_MEASURES + m]);
             /* the sums in element order, as one serial sweep adds them
                (six independent chains) */
-            for (int32_t i = 0; i < n; i++) {
-                const double *vi = v + (int64_t)i * GETME_NUM_MEASURES;
-                for (int m = 0; m < GETME_NUM_MEASURES; m++)
-                    if (!isnan(vi[m]))
-                        st[m] += vi[m];
-            }
+            for (int32_t i = 0; i < n; i++)
+                for (int m = 0; m < GETME_NUM_MEASURES; m++) {
+                    double x = v[(int64_t)m * MEASURE_TILE + i];
+                    if (!isnan(x))
+                        st[m] += x;
+                }
         }
     }
     for (int t = 0; t < GETME_NUM_TYPES; t++)
