@@ -295,9 +295,9 @@ static int trial(getme_patch *p, double cur, const int32_t *mv)
        that evaluate the whole patch, so the per-element bookkeeping
        matters next to the lane kernel: the arrays are read through locals
        (stores to qt could alias the fields otherwise, so they were
-       reloaded per element), and a cached group that needs no worst
-       corner and no second-order check takes the kernel's qualities
-       directly (group_q's result there, bit for bit). */
+       reloaded per element), and a cached group of a first-order patch
+       takes the kernel's qualities directly, with group_q's worst corner
+       only where the corner guard needs it (its result, bit for bit). */
     const double *pq = p->q, *psj = p->sj;
     double *qt = p->qt;
     const int ho = p->ws && p->ws->ho, guard = p->guard;
@@ -306,16 +306,25 @@ static int trial(getme_patch *p, double cur, const int32_t *mv)
         int32_t n = p->n - i0 < GETME_LANES ? p->n - i0 : GETME_LANES;
         double qg[GETME_LANES], sj[GETME_LANES];
         int t = p->type[i0];
-        if (p->cached && p->lok[i0 / GETME_LANES] && !ho &&
-            !(guard && getme__has_corners(t))) {
+        if (p->cached && p->lok[i0 / GETME_LANES] && !ho) {
             const double(*cx)[GETME_LANES] =
                 (const double(*)[GETME_LANES])(p->lx + (int64_t)(i0 / GETME_LANES) *
                                                            LX_GROUP);
             getme__quality_lanes(t, cx, qg);
+            const int corners = guard && getme__has_corners(t);
+            const double skip = p->skip_q[t];
             for (int32_t l = 0; l < n; l++) {
                 double q = qg[l];
                 if (!(q > cur))
                     return 0;
+                if (corners && !(q >= skip)) { /* group_q's worst corner */
+                    double x[3 * GETME_MAX_NV], c = 1.0;
+                    for (int j = 0; j < 3 * getme__nv[t]; j++)
+                        x[j] = cx[j][l];
+                    q = elem_finish(p, i0 + l, x, q, &c);
+                    if (c < psj[i0 + l] && c < floor)
+                        return 0;
+                }
                 qt[i0 + l] = q;
                 m = q < m ? q : m;
                 sum_new += q;
