@@ -49,7 +49,10 @@
  * loss * gain below the budget then (the budget did not matter), the same
  * climb fails again, so it is skipped.  Later passes and the second sweep
  * of the next pass revisit many unchanged stars; the moves made, and so
- * the output, are exactly those without the memo.
+ * the output, are exactly those without the memo.  A node keeps one
+ * failure per loss (the first sweep's 0 and the second's
+ * GETME_PATCH_LOSS): with one record, each sweep overwrote the other's,
+ * and the next pass's same sweep never found its own.
  */
 typedef struct fail_record {
     uint32_t stamp; /* moves kept before the failure */
@@ -62,8 +65,12 @@ typedef struct fail_record {
 typedef struct memo_slot {
     int32_t node;   /* -1: empty */
     uint32_t moved; /* stamp of its last kept move, 0: none */
-    uint32_t rec;   /* 1 + its failure's index in rec, 0: none */
+    uint32_t rec[2]; /* per loss (loss_slot): 1 + its failure's index in
+                        rec, 0: none */
 } memo_slot;
+
+/* Which of a node's two records a climb with this loss uses. */
+static int loss_slot(double loss) { return loss != 0.0; }
 
 typedef struct climb_memo {
     uint32_t stamp; /* moves kept so far */
@@ -85,7 +92,7 @@ static int memo_alloc(climb_memo *m, uint32_t cap)
     if (!m->slot)
         return -1;
     for (uint32_t i = 0; i < cap; i++)
-        m->slot[i] = (memo_slot){-1, 0, 0};
+        m->slot[i] = (memo_slot){-1, 0, {0, 0}};
     m->cap = cap, m->used = 0;
     return 0;
 }
@@ -133,7 +140,7 @@ static memo_slot *memo_at(climb_memo *m, int32_t node)
         return memo_at(m, node);
     }
     m->used++;
-    m->slot[i] = (memo_slot){node, 0, 0};
+    m->slot[i] = (memo_slot){node, 0, {0, 0}};
     return &m->slot[i];
 }
 
@@ -158,7 +165,8 @@ static void memo_failed(climb_memo *m, int32_t node, fail_record f)
     memo_slot *s = memo_at(m, node);
     if (!s)
         return; /* not remembered: it is climbed again */
-    if (!s->rec) {
+    uint32_t *idx = &s->rec[loss_slot(f.loss)];
+    if (!*idx) {
         if (m->num_rec == m->cap_rec) {
             uint32_t cap = m->cap_rec ? 2 * m->cap_rec : 1024;
             fail_record *r = realloc(m->rec, cap * sizeof *r);
@@ -166,10 +174,10 @@ static void memo_failed(climb_memo *m, int32_t node, fail_record f)
                 return;
             m->rec = r, m->cap_rec = cap;
         }
-        s->rec = ++m->num_rec;
+        *idx = ++m->num_rec;
     }
     f.stamp = m->stamp;
-    m->rec[s->rec - 1] = f;
+    m->rec[*idx - 1] = f;
 }
 
 /* 1 if climbing node alone is known to keep no step (see above); the nl
@@ -180,9 +188,10 @@ static int memo_fails(const climb_memo *m, const getme_ws *ws,
                       const int32_t *local, int nl)
 {
     const memo_slot *s = m ? memo_find(m, node) : NULL;
-    if (!s || !s->rec)
+    uint32_t idx = s ? s->rec[loss_slot(p->loss)] : 0;
+    if (!idx)
         return 0;
-    const fail_record *r = &m->rec[s->rec - 1];
+    const fail_record *r = &m->rec[idx - 1];
     if (r->loss != p->loss ||
         !(p->budget <= r->budget || r->allowed_max <= r->budget))
         return 0;

@@ -291,9 +291,47 @@ static int trial(getme_patch *p, double cur, const int32_t *mv)
     double m = INFINITY, sum_new = 0.0, sum_old = 0.0;
     if (p->cached)
         lane_cache_move(p, mv);
+    /* Most trials of the finishing step are failed line-search halvings
+       that evaluate the whole patch, so the per-element bookkeeping
+       matters next to the lane kernel: the arrays are read through locals
+       (stores to qt could alias the fields otherwise, so they were
+       reloaded per element), and a cached group of a first-order patch
+       takes the kernel's qualities directly, with group_q's worst corner
+       only where the corner guard needs it (its result, bit for bit). */
+    const double *pq = p->q, *psj = p->sj;
+    double *qt = p->qt;
+    const int ho = p->ws && p->ws->ho, guard = p->guard;
+    const double floor = p->floor;
     for (int32_t i0 = 0; i0 < p->n; i0 += GETME_LANES) {
         int32_t n = p->n - i0 < GETME_LANES ? p->n - i0 : GETME_LANES;
         double qg[GETME_LANES], sj[GETME_LANES];
+        int t = p->type[i0];
+        if (p->cached && p->lok[i0 / GETME_LANES] && !ho) {
+            const double(*cx)[GETME_LANES] =
+                (const double(*)[GETME_LANES])(p->lx + (int64_t)(i0 / GETME_LANES) *
+                                                           LX_GROUP);
+            getme__quality_lanes(t, cx, qg);
+            const int corners = guard && getme__has_corners(t);
+            const double skip = p->skip_q[t];
+            for (int32_t l = 0; l < n; l++) {
+                double q = qg[l];
+                if (!(q > cur))
+                    return 0;
+                if (corners && !(q >= skip)) { /* group_q's worst corner */
+                    double x[3 * GETME_MAX_NV], c = 1.0;
+                    for (int j = 0; j < 3 * getme__nv[t]; j++)
+                        x[j] = cx[j][l];
+                    q = elem_finish(p, i0 + l, x, q, &c);
+                    if (c < psj[i0 + l] && c < floor)
+                        return 0;
+                }
+                qt[i0 + l] = q;
+                m = q < m ? q : m;
+                sum_new += q;
+                sum_old += pq[i0 + l];
+            }
+            continue;
+        }
         for (int32_t l = 0; l < n; l++)
             sj[l] = 1.0;
         group_q(p, i0, n, qg, sj);
@@ -302,12 +340,12 @@ static int trial(getme_patch *p, double cur, const int32_t *mv)
             double q = qg[l];
             if (!(q > cur))
                 return 0;
-            if (sj[l] < p->sj[i] && sj[l] < p->floor && p->guard)
+            if (sj[l] < psj[i] && sj[l] < floor && guard)
                 return 0;
-            p->qt[i] = q;
+            qt[i] = q;
             m = q < m ? q : m; /* q > cur: not NaN (fmin was a call) */
             sum_new += q;
-            sum_old += p->q[i];
+            sum_old += pq[i];
         }
     }
     double change = sum_new - sum_old, allowed = (m - cur) * p->loss;
