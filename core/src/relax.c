@@ -7,6 +7,7 @@
  * number of threads.
  */
 #include "adjacency.h"
+#include "gather_lanes.h"
 #include "smooth_internal.h"
 
 #include <omp.h>
@@ -115,12 +116,10 @@ static inline void trial_batch(int t, getme_run *run, const int32_t *elems,
     for (int32_t l = 0; l < n; l++)
         same &= elems[l] >= ws->tstart[t] && elems[l] < ws->tstart[t + 1];
     if (same) {
-        for (int l = 0; l < GETME_LANES; l++) {
-            const int32_t *c = getme__ws_nodes(ws, t, elems[l < n ? l : 0]);
-            for (int i = 0; i < getme__nv[t]; i++)
-                for (int d = 0; d < 3; d++)
-                    x[3 * i + d][l] = ws->x[3 * (int64_t)c[i] + d];
-        }
+        const int32_t *c[GETME_LANES];
+        for (int l = 0; l < GETME_LANES; l++)
+            c[l] = getme__ws_nodes(ws, t, elems[l < n ? l : 0]);
+        getme__gather_lanes(ws->x, c, getme__nv[t], x);
         if (getme__quality_lanes(t, (const double(*)[GETME_LANES])x, q)) {
             set_q_lanes(run, t, elems, n, q);
             return;
