@@ -25,6 +25,7 @@
  */
 #include "adjacency.h"
 #include "best.h"
+#include "gather_lanes.h"
 #include "revert.h"
 #include "smooth_internal.h"
 #include "tally.h"
@@ -325,14 +326,12 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
                 list[n++] = e;
         for (int32_t j = 0; j < n; j += GETME_LANES) {
             double x[3 * GETME_MAX_NV][GETME_LANES], y[3 * GETME_MAX_NV][GETME_LANES];
-            for (int l = 0; l < GETME_LANES; l++) {
-                /* a short last batch repeats its first element */
-                int32_t e = list[j + l < n ? j + l : j];
-                const uint16_t *lc = getme__blocks_lnodes(blk, ws, t, e);
-                for (int i = 0; i < nv; i++)
-                    for (int d = 0; d < 3; d++)
-                        x[3 * i + d][l] = xl[3 * lc[i] + d];
-            }
+            const uint16_t *lcs[GETME_LANES];
+            /* a short last batch repeats its first element */
+            for (int l = 0; l < GETME_LANES; l++)
+                lcs[l] = getme__blocks_lnodes(blk, ws, t,
+                                              list[j + l < n ? j + l : j]);
+            getme__gather_lanes16(xl, lcs, nv, x);
             if (t == GETME_TET)
                 getme__transform_tet_lanes((const double(*)[GETME_LANES])x,
                                            sigma, y);

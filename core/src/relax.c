@@ -7,6 +7,7 @@
  * number of threads.
  */
 #include "adjacency.h"
+#include "gather_lanes.h"
 #include "smooth_internal.h"
 
 #include <omp.h>
@@ -74,6 +75,33 @@ static inline void set_q(getme_run *run, int t, int32_t e, double v)
     run->q[e] = v;
 }
 
+/* set_q of the n <= GETME_LANES elements elems[0..n) (all of type t), given
+   their mean ratios q: as n calls of set_q, in phases across the batch
+   (checks, then the fixed-point differences, then the sums' updates), so
+   the lanes' conversions and loads are independent of the previous
+   element's scattered read-modify-writes.  No phase reads what a later
+   one writes (trial_check reads the coordinates only). */
+__attribute__((always_inline))
+static inline void set_q_lanes(getme_run *run, int t, const int32_t *elems,
+                               int32_t n, double *q)
+{
+    getme_adj *adj = run->live;
+    for (int32_t l = 0; l < n; l++)
+        q[l] = trial_check(run, elems[l], t, q[l]);
+    if (adj) {
+        uint64_t d[GETME_LANES];
+        for (int32_t l = 0; l < n; l++)
+            d[l] = (uint64_t)getme__fx64(q[l], adj->qscale) -
+                   (uint64_t)getme__fx64(run->q[elems[l]], adj->qscale);
+        for (int32_t l = 0; l < n; l++)
+            if (d[l])
+                getme__adj_add(adj, run->ws, t, elems[l],
+                               getme__ws_nodes(run->ws, t, elems[l]), d[l]);
+    }
+    for (int32_t l = 0; l < n; l++)
+        run->q[elems[l]] = q[l];
+}
+
 /* trial_quality of the n <= GETME_LANES elements elems[0..n) into run->q
    (set_q), their mean ratios in one lane kernel (quality.c) when they are
    all of type t and t has one: the same bits, several times faster.  A
@@ -88,15 +116,12 @@ static inline void trial_batch(int t, getme_run *run, const int32_t *elems,
     for (int32_t l = 0; l < n; l++)
         same &= elems[l] >= ws->tstart[t] && elems[l] < ws->tstart[t + 1];
     if (same) {
-        for (int l = 0; l < GETME_LANES; l++) {
-            const int32_t *c = getme__ws_nodes(ws, t, elems[l < n ? l : 0]);
-            for (int i = 0; i < getme__nv[t]; i++)
-                for (int d = 0; d < 3; d++)
-                    x[3 * i + d][l] = ws->x[3 * (int64_t)c[i] + d];
-        }
+        const int32_t *c[GETME_LANES];
+        for (int l = 0; l < GETME_LANES; l++)
+            c[l] = getme__ws_nodes(ws, t, elems[l < n ? l : 0]);
+        getme__gather_lanes(ws->x, c, getme__nv[t], x);
         if (getme__quality_lanes(t, (const double(*)[GETME_LANES])x, q)) {
-            for (int32_t l = 0; l < n; l++)
-                set_q(run, t, elems[l], trial_check(run, elems[l], t, q[l]));
+            set_q_lanes(run, t, elems, n, q);
             return;
         }
     }
