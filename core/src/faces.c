@@ -125,12 +125,17 @@ faces_at(int tf, const getme_ws *ws,
         for (int i = 1; i < nv; i++)
             li |= (c[i] == u) * i;
         const corner_faces *cf = &table[t][li];
-        for (int k = 0; k < cf->num; k++) {
+        /* In a tet or hex mesh every corner is on 3 faces of 3 or 4
+           nodes: as constants the loop unrolls and the "none" selects
+           fold away. */
+        int nf = tf == GETME_TET || tf == GETME_HEX ? 3 : cf->num;
+        for (int k = 0; k < nf; k++) {
+            int size = tf == GETME_TET ? 2 : tf == GETME_HEX ? 3 : cf->size[k];
             /* INT32_MAX stands for "none" (a face of 2 or 3 nodes): it
                passes the test and sorts last */
             int32_t a = c[cf->other[k][0]];
-            int32_t b = cf->size[k] > 1 ? c[cf->other[k][1]] : INT32_MAX;
-            int32_t d = cf->size[k] > 2 ? c[cf->other[k][2]] : INT32_MAX;
+            int32_t b = size > 1 ? c[cf->other[k][1]] : INT32_MAX;
+            int32_t d = size > 2 ? c[cf->other[k][2]] : INT32_MAX;
             int lowest = (a > u) & (b > u) & (d > u);
             int32_t lo = a < b ? a : b, hi = a < b ? b : a;
             int32_t k0 = lo < d ? lo : d, mid = lo < d ? d : lo;
@@ -139,7 +144,7 @@ faces_at(int tf, const getme_ws *ws,
             r->k[0] = k0;
             r->k[1] = k1 == INT32_MAX ? -1 : k1;
             r->k[2] = k2 == INT32_MAX ? -1 : k2;
-            int8_t ap = cf->apex[k];
+            int8_t ap = tf == GETME_HEX ? -1 : cf->apex[k];
             sides[m] = (face_side){n, cf->face[k], 0, ap >= 0 ? c[ap] : -1};
             m += lowest;
         }

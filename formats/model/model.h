@@ -123,6 +123,9 @@ typedef struct getme__model_in {
     int z_plane_only;              /* planar: stop (declined = 1) instead of
                                       rotating a mesh outside z = const    */
     unsigned fix_flags;            /* GETME_FIX_SKIN | GETME_FIX_INTERFACES */
+    int nodes_distinct;            /* 1: the caller refused, with its own
+                                      message, every element that has a node
+                                      twice; the builder does not look again */
 } getme__model_in;
 
 typedef struct getme__frame {

@@ -247,6 +247,9 @@ static getme_formats_status make_input(msh41_reader *r, getme__model_in *in,
         .phys = *phys,
         .num_phys = *nphys,
         .z_plane_only = 1,
+        /* msh41_store_element refused every kept element with a node
+           twice, naming the element and the node */
+        .nodes_distinct = 1,
         .fix_flags = r->partitioned ? 0u /* the caller's, across parts */
                      : (o && !o->fix_skin ? 0u : GETME_FIX_SKIN) |
                        (o && !o->fix_interfaces ? 0u : GETME_FIX_INTERFACES)};

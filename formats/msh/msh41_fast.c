@@ -26,6 +26,7 @@
 #include "msh41_internal.h"
 #include "linepar.h"
 #include "numparse.h"
+#include "msh41_digits.h"
 
 #include <math.h>
 #include <string.h>
@@ -55,20 +56,9 @@ static const char *line_end(const char *p)
     return *p == '\n' ? p + 1 : NULL;
 }
 
-static int fast_u64(const char **p, uint64_t *v)
+static int fast_u64(const char **p, const char *end, uint64_t *v)
 {
-    const char *s = skip_blanks(*p), *d = s;
-    uint64_t x = 0;
-    for (; *s >= '0' && *s <= '9'; s++) {
-        if (s - d == 18)
-            return -1;
-        x = 10 * x + (uint64_t)(*s - '0');
-    }
-    if (s == d || !(is_blank(*s) || *s == '\n'))
-        return -1;
-    *v = x;
-    *p = s;
-    return 0;
+    return msh41_digits(skip_blanks(*p), end, p, v);
 }
 
 static int fast_double(const char **p, double *v)
@@ -97,8 +87,7 @@ static const char *tag_line(void *vc, const char *p, const char *end,
 {
     fast_ctx *c = vc;
     uint64_t t;
-    (void)end;
-    if (fast_u64(&p, &t) || !(p = line_end(p)))
+    if (fast_u64(&p, end, &t) || !(p = line_end(p)))
         return NULL;
     c->job->tags[c->base + i] = t;
     return p;
@@ -128,9 +117,8 @@ static const char *element_line(void *vc, const char *p, const char *end,
     fast_ctx *c = vc;
     const msh41_fast_job *job = c->job;
     uint64_t rec[MSH41_MAX_REC];
-    (void)end;
     for (int k = 0; k <= job->nv; k++)
-        if (fast_u64(&p, &rec[k]))
+        if (fast_u64(&p, end, &rec[k]))
             return NULL;
     if (!(p = line_end(p)) ||
         msh41_store_element(c->r, job->b, c->base + i, rec, job->nv,

@@ -90,11 +90,44 @@ int msh41_in_getc(msh41_input *in)
     return c;
 }
 
+/* A large read once the buffer is used up goes straight into the caller's
+   array: a copy less (the binary elements and nodes are most of a binary
+   file).  The echo then writes the bytes from there, after the buffer's
+   consumed part, so it still sees every byte once and in order.  Returns
+   the bytes read (fewer than n only at the end of the file or an error:
+   the caller's next refill then fails as it would have). */
+static size_t read_direct(msh41_input *in, unsigned char *d, size_t n)
+{
+    echo_flush(in);
+    in->base += (int64_t)in->len;
+    in->pos = in->len = in->echo_from = 0;
+    size_t got = fread(d, 1, n, in->f);
+    if (in->echo && got && fwrite(d, 1, got, in->echo) != got)
+        in->werr = 1;
+    in->base += (int64_t)got;
+    return got;
+}
+
+static int wants_direct(const msh41_input *in, size_t n)
+{
+    return in->f && in->pos >= in->len && n >= IN_READ;
+}
+
 size_t msh41_in_read_some(msh41_input *in, void *dst, size_t n)
 {
     unsigned char *d = dst;
     size_t done = 0;
-    while (done < n && !refill(in)) {
+    while (done < n) {
+        size_t want = n - done;
+        if (wants_direct(in, want)) {
+            size_t got = read_direct(in, d + done, want);
+            done += got;
+            if (got < want)
+                break; /* end of file or error */
+            continue;
+        }
+        if (refill(in))
+            break;
         size_t k = in->len - in->pos < n - done ? in->len - in->pos : n - done;
         memcpy(d + done, in->buf + in->pos, k);
         in->pos += k;
@@ -105,15 +138,14 @@ size_t msh41_in_read_some(msh41_input *in, void *dst, size_t n)
 
 int msh41_in_read(msh41_input *in, void *dst, size_t n)
 {
-    unsigned char *d = dst;
+    /* skipping (dst NULL) goes through the buffer: the echo copies the
+       skipped bytes from there */
+    if (dst)
+        return msh41_in_read_some(in, dst, n) == n ? 0 : -1;
     while (n) {
         if (refill(in))
             return -1;
         size_t k = in->len - in->pos < n ? in->len - in->pos : n;
-        if (d) {
-            memcpy(d, in->buf + in->pos, k);
-            d += k;
-        }
         in->pos += k;
         n -= k;
     }
