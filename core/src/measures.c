@@ -12,14 +12,9 @@
  */
 #include "internal.h"
 
-/* This file is compiled with -fno-trapping-math (core/CMakeLists.txt):
-   without trapping math gcc may evaluate both sides of a select (a
-   division or square root on a lane whose result is then discarded), so
-   the lane loops below are if-converted into AVX2 vector instructions;
-   with it, gcc 12 left most of them scalar on AVX2 machines (AVX-512 has
-   masked instructions, so there they vectorised either way).  No value
-   changes: IEEE results are the same, only the exception flags, which
-   nothing here reads, may differ. */
+/* Compiled with -fno-trapping-math (core/CMakeLists.txt says why): the
+   measures' lane loops, where a division or square root is evaluated on
+   a lane whose result a select then discards. */
 
 #include <math.h>
 #include <omp.h>

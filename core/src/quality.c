@@ -19,13 +19,9 @@
  * Non-finite coordinates give a NaN det or q, which fails the "> 0" tests
  * and so also yields 0.
  */
-/* This file is compiled with -fno-trapping-math (core/CMakeLists.txt):
-   without trapping math gcc 12 if-converts the lane loops into AVX2
-   vector instructions (selects with a division or square root on either
-   side); with it, several stayed scalar on AVX2 (AVX-512 has masked
-   instructions, so there they vectorised either way).  No value changes:
-   the IEEE results are the same, only the exception flags, which nothing
-   reads, may differ (as in transform_tet.c). */
+/* Compiled with -fno-trapping-math (core/CMakeLists.txt says why): the
+   mean ratio and corner lane loops, whose selects have a division or a
+   square root on a side. */
 
 #include "div3.h"
 #include "internal.h"

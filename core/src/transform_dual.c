@@ -33,13 +33,9 @@
  *    sigma = 2 (docs/kernels.md has the measurements of both variants).
  * The regular element is an exact fixed point up to similarity.
  */
-/* This file is compiled with -fno-trapping-math (core/CMakeLists.txt):
-   without trapping math gcc 12 if-converts the lane loops into AVX2
-   vector instructions (selects with a division or square root on either
-   side); with it, several stayed scalar on AVX2 (AVX-512 has masked
-   instructions, so there they vectorised either way).  No value changes:
-   the IEEE results are the same, only the exception flags, which nothing
-   reads, may differ (as in transform_tet.c). */
+/* Compiled with -fno-trapping-math (core/CMakeLists.txt says why): the
+   hex, prism and pyramid transformation lanes, whose selects have a
+   division or a square root on a side. */
 
 #include "internal.h"
 #include "transform_scale.h"

@@ -16,17 +16,13 @@
  * point (all four pushes are equal and radial); every valid tetrahedron
  * converges to it (docs/kernels.md has the measurements).
  */
-/* This file is compiled with -fno-trapping-math (core/CMakeLists.txt):
-   without trapping math gcc 12 if-converts the lane loops into AVX2
-   vector instructions; with it, the square roots and the division of each
-   normal's scale factor, sunk by gcc into the two sides of
-   getme__at_least's select, kept the whole loop scalar on AVX2 (AVX-512
-   has masked instructions, so there it vectorised either way).  gcc does
-   not inline across differing trapping-math settings, so the header
-   kernels inlined here are compiled with it too, and the lane kernels are
-   called out of line from the other files.  No value changes: the IEEE
-   results are the same, only the exception flags, which nothing reads,
-   may differ. */
+/* Compiled with -fno-trapping-math (core/CMakeLists.txt says why): the
+   square roots and the division of each normal's scale factor, sunk by
+   gcc into the two sides of getme__at_least's select, kept the whole lane
+   loop scalar on AVX2.  gcc does not inline across differing
+   trapping-math settings, so the header kernels inlined here are compiled
+   with it too, and the lane kernels are called out of line from the other
+   files. */
 
 #include "internal.h"
 #include "transform_scale.h"
