@@ -297,7 +297,10 @@ static int trial(getme_patch *p, double cur, const int32_t *mv)
        (stores to qt could alias the fields otherwise, so they were
        reloaded per element), and a cached group of a first-order patch
        takes the kernel's qualities directly, with group_q's worst corner
-       only where the corner guard needs it (its result, bit for bit). */
+       only where the corner guard needs it and the element passed the
+       minimum (its result, bit for bit).  A corner not computed stays 1,
+       as in group_q: the floor is at most 1 (params.c), so it rejects
+       nothing. */
     const double *pq = p->q, *psj = p->sj;
     double *qt = p->qt;
     const int ho = p->ws && p->ws->ho, guard = p->guard;
@@ -305,41 +308,31 @@ static int trial(getme_patch *p, double cur, const int32_t *mv)
     for (int32_t i0 = 0; i0 < p->n; i0 += GETME_LANES) {
         int32_t n = p->n - i0 < GETME_LANES ? p->n - i0 : GETME_LANES;
         double qg[GETME_LANES], sj[GETME_LANES];
-        int t = p->type[i0];
-        if (p->cached && p->lok[i0 / GETME_LANES] && !ho) {
-            const double(*cx)[GETME_LANES] =
-                (const double(*)[GETME_LANES])(p->lx + (int64_t)(i0 / GETME_LANES) *
-                                                           LX_GROUP);
-            getme__quality_lanes(t, cx, qg);
-            const int corners = guard && getme__has_corners(t);
-            const double skip = p->skip_q[t];
-            for (int32_t l = 0; l < n; l++) {
-                double q = qg[l];
-                if (!(q > cur))
-                    return 0;
-                if (corners && !(q >= skip)) { /* group_q's worst corner */
-                    double x[3 * GETME_MAX_NV], c = 1.0;
-                    for (int j = 0; j < 3 * getme__nv[t]; j++)
-                        x[j] = cx[j][l];
-                    q = elem_finish(p, i0 + l, x, q, &c);
-                    if (c < psj[i0 + l] && c < floor)
-                        return 0;
-                }
-                qt[i0 + l] = q;
-                m = q < m ? q : m;
-                sum_new += q;
-                sum_old += pq[i0 + l];
-            }
-            continue;
-        }
         for (int32_t l = 0; l < n; l++)
-            sj[l] = 1.0;
-        group_q(p, i0, n, qg, sj);
+            sj[l] = 1.0; /* no corner: above any floor, rejects nothing */
+        int t = p->type[i0];
+        const double(*cx)[GETME_LANES] = NULL;
+        if (p->cached && p->lok[i0 / GETME_LANES] && !ho) {
+            cx = (const double(*)[GETME_LANES])(p->lx + (int64_t)(i0 / GETME_LANES) *
+                                                            LX_GROUP);
+            getme__quality_lanes(t, cx, qg);
+        } else {
+            group_q(p, i0, n, qg, sj);
+        }
+        /* the lane path's worst corners, where group_q computes them */
+        const int corners = cx && guard && getme__has_corners(t);
+        const double skip = p->skip_q[t];
         for (int32_t l = 0; l < n; l++) {
             int32_t i = i0 + l;
             double q = qg[l];
             if (!(q > cur))
                 return 0;
+            if (corners && !(q >= skip)) {
+                double x[3 * GETME_MAX_NV];
+                for (int j = 0; j < 3 * getme__nv[t]; j++)
+                    x[j] = cx[j][l];
+                q = elem_finish(p, i, x, q, &sj[l]);
+            }
             if (sj[l] < psj[i] && sj[l] < floor && guard)
                 return 0;
             qt[i] = q;
