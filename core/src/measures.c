@@ -619,6 +619,19 @@ getme_status getme_mesh_element_measures(getme_mesh *mesh,
     return GETME_OK;
 }
 
+/* The histogram bin of a value t = v - hist_lo >= 0 (or NaN, or below:
+   then any number, which the callers do not use) in a range of width w.
+   Most ranges are [0, 1]: dividing by 1 changes no bit, so it is skipped
+   (a scalar division per element and measure).  KERNEL: inlined into
+   lanes_add's vector loop. */
+KERNEL int32_t hist_bin(double t, double w)
+{
+    if (w != 1.0)
+        t /= w;
+    int32_t k = (int32_t)(t * GETME_HIST_BINS);
+    return k >= GETME_HIST_BINS ? GETME_HIST_BINS - 1 : k;
+}
+
 static void add_stat(getme_measure_stats *s, double v, int32_t e, double *sum)
 {
     if (s->num_elements == 0 || v < s->min) {
@@ -636,13 +649,7 @@ static void add_stat(getme_measure_stats *s, double v, int32_t e, double *sum)
         s->num_below++;
         return;
     }
-    /* most ranges are [0, 1]: dividing by 1 changes no bit, so it is
-       skipped (a scalar division per element and measure) */
-    double w = s->hist_hi - s->hist_lo, t = v - s->hist_lo;
-    if (w != 1.0)
-        t /= w;
-    int bin = (int)(t * GETME_HIST_BINS);
-    s->histogram[bin >= GETME_HIST_BINS ? GETME_HIST_BINS - 1 : bin]++;
+    s->histogram[hist_bin(v - s->hist_lo, s->hist_hi - s->hist_lo)]++;
 }
 
 static void init_stats(getme_measure_stats *s, int m)
@@ -1073,7 +1080,6 @@ static void lanes_add(lane_stats *ls, const double *v, int32_t g, double lo,
                       double w)
 {
     int32_t bin[L];
-    int scale = w != 1.0;
 #pragma omp simd
     for (int l = 0; l < L; l++) {
         double x = v[l];
@@ -1091,10 +1097,7 @@ static void lanes_add(lane_stats *ls, const double *v, int32_t g, double lo,
         ls->num_below[l] += below;
         /* NaN and values below lo get no bin number from the conversion
            (out of range) */
-        double t = ok & !below ? x - lo : 0.0;
-        t = scale ? t / w : t;
-        int32_t k = (int32_t)(t * GETME_HIST_BINS);
-        k = k >= GETME_HIST_BINS ? GETME_HIST_BINS - 1 : k;
+        int32_t k = hist_bin(ok & !below ? x - lo : 0.0, w);
         bin[l] = ok & !below ? k : GETME_HIST_BINS;
     }
     for (int l = 0; l < L; l++)
