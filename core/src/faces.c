@@ -89,7 +89,7 @@ typedef struct face_side {
    of a prism or pyramid are never the same element. */
 static inline int same_simplex(const face_side *a, const face_side *b)
 {
-    return a->apex >= 0 && a->apex == b->apex;
+    return (a->apex >= 0) & (a->apex == b->apex);
 }
 
 /* The faces whose lowest node is u: every side in sides, grouped by its
@@ -110,17 +110,29 @@ faces_at(int tf, const getme_ws *ws,
          int *ng)
 {
     int m = 0, g = 0;
+    /* Local copies: the stores into sides and groups may alias anything,
+       so ws's fields were reloaded for every star entry (getme__ws_nodes
+       alone was ~15 % of the walk's instructions). */
+    const int32_t *star = ws->star;
+    int32_t s0 = ws->star_ptr[u], s1 = ws->star_ptr[u + 1];
     int32_t kend = ws->star_ptr[ws->nn];
+    int tc = tf >= 0 ? tf : 0;
+    const int32_t *conn_tf = ws->conn + ws->coff[tc];
+    int32_t t0 = ws->tstart[tc];
     /* groups[] doubles as the candidates' key store: a candidate's key
        goes to groups[m].k until the second pass moves it into its group
        (groups are numbered in first-seen order, so group q <= candidate
        m and is written only after candidate m was read). */
-    for (int32_t s = ws->star_ptr[u]; s < ws->star_ptr[u + 1]; s++) {
-        int32_t n = ws->star[s];
+    for (int32_t s = s0; s < s1; s++) {
+        int32_t n = star[s];
+        /* the mesh's one type: its corner count a constant, so the local
+           index loop below unrolls */
+        int t = tf >= 0 ? tf : getme__ws_type(ws, n);
+        int nv = tf == GETME_TET ? 4 : tf == GETME_HEX ? 8 : getme__nv[t];
         if (tf >= 0 && s + GETME_STAR_AHEAD < kend)
-            __builtin_prefetch(getme__ws_nodes(ws, tf, ws->star[s + GETME_STAR_AHEAD]));
-        int t = tf >= 0 ? tf : getme__ws_type(ws, n), nv = getme__nv[t];
-        const int32_t *c = getme__ws_nodes(ws, t, n);
+            __builtin_prefetch(conn_tf + (int64_t)(star[s + GETME_STAR_AHEAD] - t0) * nv);
+        const int32_t *c = tf >= 0 ? conn_tf + (int64_t)(n - t0) * nv
+                                   : getme__ws_nodes(ws, t, n);
         int li = 0;
         for (int i = 1; i < nv; i++)
             li |= (c[i] == u) * i;
@@ -144,8 +156,10 @@ faces_at(int tf, const getme_ws *ws,
             r->k[0] = k0;
             r->k[1] = k1 == INT32_MAX ? -1 : k1;
             r->k[2] = k2 == INT32_MAX ? -1 : k2;
+            /* a tet's faces all have an apex: no test */
             int8_t ap = tf == GETME_HEX ? -1 : cf->apex[k];
-            sides[m] = (face_side){n, cf->face[k], 0, ap >= 0 ? c[ap] : -1};
+            int32_t apn = tf == GETME_TET ? c[ap] : ap >= 0 ? c[ap] : -1;
+            sides[m] = (face_side){n, cf->face[k], 0, apn};
             m += lowest;
         }
     }
@@ -157,23 +171,42 @@ faces_at(int tf, const getme_ws *ws,
         h = (h ^ (h >> 15)) & mask;
         /* Probing past a slot taken by another face is rare (the table
            is at least 8 times the sides); whether the face is new or
-           seen before is a coin toss, so that is decided by selects. */
-        while (hash[h] >= 0 && !(groups[hash[h]].k[0] == o0 &&
-                                 groups[hash[h]].k[1] == o1 &&
-                                 groups[hash[h]].k[2] == o2))
+           seen before is a coin toss, so that is decided by selects.
+           The probe's test too: `hash[h] >= 0 && !same key` branched
+           on the empty slot first (a coin toss, half the sides
+           mispredicted); here the key is compared against group 0 when
+           the slot is empty (groups[0] always exists) and only "taken by
+           another face" branches. */
+        int32_t q0;
+        for (;;) {
+            q0 = hash[h];
+            /* all ones if the slot is taken, by a shift: with a compare
+               gcc rebuilt the coin-toss branch */
+            uint32_t occ = -((~(uint32_t)q0) >> 31);
+            const face_group *p = &groups[q0 & (int32_t)occ];
+            uint32_t diff = ((uint32_t)p->k[0] ^ (uint32_t)o0) |
+                            ((uint32_t)p->k[1] ^ (uint32_t)o1) |
+                            ((uint32_t)p->k[2] ^ (uint32_t)o2);
+            if (__builtin_expect((diff & occ) == 0, 1))
+                break;
             h = (h + 1) & mask;
-        int32_t q0 = hash[h];
-        int fresh = q0 < 0;
-        int32_t q = fresh ? g : q0;
+        }
+        /* The group's update by masks (fm: all ones if the face is new,
+           n0 == 1: its second side): gcc turned each select on "new"
+           back into a coin-toss branch.  A new group's old fields are
+           read and masked away. */
+        int32_t fm = -(int32_t)((uint32_t)q0 >> 31);
+        int32_t q = (g & fm) | (q0 & ~fm);
         face_group *r = &groups[q];
-        int32_t n0 = fresh ? 0 : r->n;
-        r->second = n0 == 1 ? i : fresh ? -1 : r->second;
-        r->first = fresh ? i : r->first;
+        int32_t n0 = r->n & ~fm;
+        int32_t m1 = -(int32_t)(n0 == 1);
+        r->second = (i & m1) | (r->second & ~m1) | fm;
+        r->first = (i & fm) | (r->first & ~fm);
         r->k[0] = o0, r->k[1] = o1, r->k[2] = o2;
         r->n = n0 + 1;
         r->slot = (int32_t)h;
         hash[h] = q;
-        g += fresh;
+        g -= fm;
         sides[i].group = q;
     }
     for (int i = 0; i < g; i++)
@@ -198,7 +231,9 @@ faces_node(int tf, const getme_ws *ws,
         if (r->n > 2) {
             v = GETME_FACE_IRREGULAR;
         } else if (r->n == 2) {
-            const face_side *other = &sd[r->first == i ? r->second : r->first];
+            /* i is first or second: the other one without a branch
+               (which one is a coin toss) */
+            const face_side *other = &sd[r->first ^ r->second ^ i];
             v = same_simplex(&sd[i], other) ? GETME_FACE_IRREGULAR
                                             : other->elem;
         }
