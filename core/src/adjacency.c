@@ -374,16 +374,17 @@ static void check_element(getme_adj *adj, const getme_ws *ws,
         nb += f[k] >= 0;
         bad |= f[k] == GETME_FACE_IRREGULAR;
     }
+    /* the edge ids once, for the counts and the check sums, every
+       node's eptr loaded side by side (getme__adj_edge_ids) */
+    int32_t id[12];
     if (ws->dim == 2) {
         fcnt -= (nv - 1) + nb;
     } else {
-        const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
+        getme__adj_edge_ids(adj, c, t, getme__adj_slots(adj, ws, t, e), id);
         for (int j = 0; j < getme__edges[t].num_edges; j++) {
-            bad |= slot[j] == GETME_NO_SLOT;
+            bad |= id[j] < 0; /* GETME_NO_SLOT */
             /* a missing slot's id is not read */
-            fcnt -= slot[j] == GETME_NO_SLOT
-                        ? 0
-                        : edeg[getme__adj_edge(adj, c, t, j, slot[j])];
+            fcnt -= id[j] < 0 ? 0 : edeg[id[j]];
         }
         fcnt += (ft->num_faces - 1) + nb;
     }
@@ -415,14 +416,13 @@ static void check_element(getme_adj *adj, const getme_ws *ws,
         }
     uint64_t fs = 0;
     for (int j = 0; j < ft->num_faces; j++)
-        fs += f[j] >= 0 ? check_value(f[j]) : 0;
-    uint64_t self = check_value(e);
+        fs += f[j] >= 0 ? cv[f[j]] : 0;
+    uint64_t self = cv[e];
     if (ws->dim == 2) {
         formula -= (uint64_t)(nv - 1) * self + fs;
     } else {
-        const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
         for (int j = 0; j < getme__edges[t].num_edges; j++)
-            formula -= re[getme__adj_edge(adj, c, t, j, slot[j])];
+            formula -= re[id[j]];
         formula += (uint64_t)(ft->num_faces - 1) * self + fs;
     }
     if (formula != truth || cnt > UINT16_MAX)
