@@ -199,6 +199,13 @@ int main(int argc, char **argv)
             return 1;
         t[4] = cpu();
         if (check) {
+#ifdef GETME_ADJ_LOCAL_PROOF
+            void *scr = malloc(check_scratch_bytes(&ws));
+            if (!scr || check_all(&adj, &ws, adj.eslot ? re : NULL, edeg, scr) !=
+                            GETME_OK)
+                return 1;
+            free(scr);
+#else
             uint64_t *rn = malloc((size_t)ws.nn * sizeof *rn);
             node_checks(&ws, rn);
 #ifdef GETME_ADJ_LENT_SCRATCH
@@ -212,6 +219,7 @@ int main(int argc, char **argv)
                 return 1;
 #endif
             free(rn);
+#endif
         }
         t[5] = cpu();
         getme_blocks blk;

@@ -18,6 +18,9 @@
 /* bench/setup.c times the phases below on their own: their signatures
    take a lent scratch since this was set (round 9). */
 #define GETME_ADJ_LENT_SCRATCH 1
+/* ... and check_all takes no nodes' check sums since this was set
+   (round 12: summed in its walk) */
+#define GETME_ADJ_LOCAL_PROOF 1
 
 void getme__adj_free(getme_adj *adj)
 {
@@ -304,18 +307,6 @@ done:
     return st;
 }
 
-/* Check-value sums of every node's star. */
-static void node_checks(const getme_ws *ws, uint64_t *rn)
-{
-#pragma omp parallel for schedule(static) num_threads(ws->nt)
-    for (int32_t u = 0; u < ws->nn; u++) {
-        uint64_t r = 0;
-        for (int64_t k = ws->star_ptr[u]; k < ws->star_ptr[u + 1]; k++)
-            r += check_value(ws->star[k]);
-        rn[u] = r;
-    }
-}
-
 /* |N(E)| by the same inclusion-exclusion, with element counts (node and
    edge degrees) in place of qualities; and irregular = a face the formula
    cannot handle. */
@@ -365,7 +356,7 @@ typedef struct union_scratch {
    pseudo-random integers in place of q (exact arithmetic), and take the
    union's exact count where they disagree. */
 static void check_element(getme_adj *adj, const getme_ws *ws,
-                          const uint64_t *rn, const uint64_t *re,
+                          const uint64_t *re,
                           const int32_t *edeg, int32_t e, union_scratch *sc)
 {
     int t = getme__ws_type(ws, e), nv = getme__nv[t];
@@ -383,16 +374,17 @@ static void check_element(getme_adj *adj, const getme_ws *ws,
         nb += f[k] >= 0;
         bad |= f[k] == GETME_FACE_IRREGULAR;
     }
+    /* the edge ids once, for the counts and the check sums, every
+       node's eptr loaded side by side (getme__adj_edge_ids) */
+    int32_t id[12];
     if (ws->dim == 2) {
         fcnt -= (nv - 1) + nb;
     } else {
-        const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
+        getme__adj_edge_ids(adj, c, t, getme__adj_slots(adj, ws, t, e), id);
         for (int j = 0; j < getme__edges[t].num_edges; j++) {
-            bad |= slot[j] == GETME_NO_SLOT;
+            bad |= id[j] < 0; /* GETME_NO_SLOT */
             /* a missing slot's id is not read */
-            fcnt -= slot[j] == GETME_NO_SLOT
-                        ? 0
-                        : edeg[getme__adj_edge(adj, c, t, j, slot[j])];
+            fcnt -= id[j] < 0 ? 0 : edeg[id[j]];
         }
         fcnt += (ft->num_faces - 1) + nb;
     }
@@ -403,7 +395,7 @@ static void check_element(getme_adj *adj, const getme_ws *ws,
     }
     uint32_t now = ++sc->now;
     int32_t cnt = 0;
-    uint64_t truth = 0;
+    uint64_t truth = 0, formula = 0;
     /* Branch-free: whether an element was seen already is a coin toss
        (a hex's 8 stars hold ~64 entries, ~27 of them distinct). */
     uint32_t *restrict stamp = sc->stamp;
@@ -416,20 +408,21 @@ static void check_element(getme_adj *adj, const getme_ws *ws,
             stamp[n] = now;
             /* masked, not selected: gcc made the select a branch again */
             truth += cv[n] & (0 - (uint64_t)fresh);
+            /* the formula's S_v of e's nodes: the sum over the same
+               entries, repeats included (a pass of its own over every
+               star, ~0.04 s of the full hexes, before this) */
+            formula += cv[n];
             cnt += (int32_t)fresh;
         }
-    uint64_t formula = 0, fs = 0;
-    for (int i = 0; i < nv; i++)
-        formula += rn[c[i]];
+    uint64_t fs = 0;
     for (int j = 0; j < ft->num_faces; j++)
-        fs += f[j] >= 0 ? check_value(f[j]) : 0;
-    uint64_t self = check_value(e);
+        fs += f[j] >= 0 ? cv[f[j]] : 0;
+    uint64_t self = cv[e];
     if (ws->dim == 2) {
         formula -= (uint64_t)(nv - 1) * self + fs;
     } else {
-        const uint8_t *slot = getme__adj_slots(adj, ws, t, e);
         for (int j = 0; j < getme__edges[t].num_edges; j++)
-            formula -= re[getme__adj_edge(adj, c, t, j, slot[j])];
+            formula -= re[id[j]];
         formula += (uint64_t)(ft->num_faces - 1) * self + fs;
     }
     if (formula != truth || cnt > UINT16_MAX)
@@ -449,7 +442,7 @@ static size_t check_scratch_bytes(const getme_ws *ws)
 /* scratch: check_scratch_bytes(ws) bytes, any contents (getme__adj_build
    lends the pages the blocks' build used: already faulted in). */
 static getme_status check_all(getme_adj *adj, const getme_ws *ws,
-                              const uint64_t *rn, const uint64_t *re,
+                              const uint64_t *re,
                               const int32_t *edeg, void *scratch)
 {
     int nt = ws->nt;
@@ -475,7 +468,7 @@ static getme_status check_all(getme_adj *adj, const getme_ws *ws,
             cv[e] = check_value(e);
 #pragma omp parallel for schedule(dynamic, 2048) num_threads(nt)
         for (int32_t e = 0; e < ws->ne; e++)
-            check_element(adj, ws, rn, re, edeg, e, &sc[omp_get_thread_num()]);
+            check_element(adj, ws, re, edeg, e, &sc[omp_get_thread_num()]);
     }
     free(sc);
     return ok ? GETME_OK : GETME_ERR_NOMEM;
@@ -514,12 +507,12 @@ getme_status getme__adj_build(getme_adj *adj, getme_ws *ws)
     /* The temporaries live in arrays the run needs anyway, or share
        pages: a fresh page costs ~3 ms per MiB to fault in on the VMs
        measured (the CLI maps every block of 1 MiB or more afresh), ~0.3 s
-       of the full hexes' set-up.  The nodes' check sums (rn) are built in
-       S_v's array, the edges' (re) become S_e's, and without checks the
+       of the full hexes' set-up.  The edges' check sums (re) become S_e's
+       array, and without checks the
        edges' element counts' buffer does (8 bytes per edge reserved):
        getme__adj_sums_all overwrites both before any sum is read.  The
        blocks' build and the check share one scratch. */
-    uint64_t *rn = check ? (uint64_t *)(void *)adj->nsum : NULL, *re = NULL;
+    uint64_t *re = NULL;
     int32_t *edeg = NULL;
     size_t sbytes = getme__blocks_scratch_bytes(ws);
     if (check && check_scratch_bytes(ws) > sbytes)
@@ -532,8 +525,6 @@ getme_status getme__adj_build(getme_adj *adj, getme_ws *ws)
         (st = build_edges(adj, ws, &edeg, check, &re)) != GETME_OK)
         goto fail;
     st = GETME_ERR_NOMEM;
-    if (check)
-        node_checks(ws, rn);
     if (!have_faces &&
         (st = getme__ws_faces(ws, adj->foff, adj->fnb)) != GETME_OK)
         goto fail;
@@ -552,7 +543,7 @@ getme_status getme__adj_build(getme_adj *adj, getme_ws *ws)
         goto fail;
     if ((st = getme__blocks_build(&adj->blk, ws, scratch)) != GETME_OK)
         goto fail;
-    if (check && (st = check_all(adj, ws, rn, (const uint64_t *)adj->esum,
+    if (check && (st = check_all(adj, ws, (const uint64_t *)adj->esum,
                                  edeg, scratch)) != GETME_OK)
         goto fail;
     free(edeg), edeg = NULL;
