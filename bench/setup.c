@@ -142,7 +142,16 @@ static uint64_t adj_hash(const getme_adj *adj, const getme_ws *ws)
     const getme_blocks *b = &adj->blk;
     h = fnv(h, b->nptr, ((size_t)ws->num_blocks + 1) * 8);
     h = fnv(h, b->nodes, (size_t)b->nptr[ws->num_blocks] * 4);
-    h = fnv(h, b->lconn, (size_t)conn_len(ws) * 2);
+    /* the local connectivity as the kernels rebuild it, block by block
+       (blocks hold consecutive elements: the bytes of the array it was) */
+    for (int32_t k = 0; k < ws->num_blocks; k++) {
+        int32_t e0 = ws->block_start[k], e1 = ws->block_start[k + 1];
+        if (e1 <= e0)
+            continue;
+        getme__blocks_localise(b, ws, k, &b->scratch[0]);
+        h = fnv(h, b->scratch[0].lconn,
+                (size_t)(e1 - e0) * getme__nv[getme__ws_type(ws, e0)] * 2);
+    }
     h = fnv(h, &b->max_nodes, 4);
     h = fnv(h, &b->max_elems, 4);
     return h;

@@ -4,8 +4,10 @@
  *
  * Two parallel passes over the blocks, each block writing only its own
  * entries: count each block's distinct nodes, then list them in the order
- * its elements first use them and renumber its elements' nodes into that
- * list.  A per-thread mark array (the block's number + 1 per node seen)
+ * its elements first use them (the local connectivity, the elements'
+ * nodes renumbered into that list, is rebuilt when a block runs:
+ * getme__blocks_localise).  A per-thread mark array (the block's number
+ * + 1 per node seen)
  * finds the distinct nodes, so the result does not depend on the threads.
  */
 #include "block_local.h"
@@ -23,7 +25,7 @@ void getme__blocks_free(getme_blocks *blk)
     free(blk->scratch);
     free(blk->nptr);
     free(blk->nodes);
-    free(blk->lconn);
+    free(blk->local);
     free(blk->order);
     free(blk->part_ptr);
     free(blk->col_ptr);
@@ -37,35 +39,31 @@ void getme__blocks_free_local(getme_blocks *blk)
 {
     free(blk->nptr);
     free(blk->nodes);
-    free(blk->lconn);
+    free(blk->local);
     blk->nptr = NULL;
     blk->nodes = NULL;
-    blk->lconn = NULL;
+    blk->local = NULL;
 }
 
 /* Block b's distinct nodes: with list == NULL only counted; else listed
-   into list and each element node's local index written to lconn. */
+   into list. */
 static int32_t block_nodes(const getme_ws *ws, int32_t b, int32_t *mark,
-                           uint16_t *local, int32_t *list, uint16_t *lconn)
+                           int32_t *list)
 {
     int32_t e0 = ws->block_start[b], e1 = ws->block_start[b + 1];
     if (e1 <= e0)
         return 0;
     int t = getme__ws_type(ws, e0), nv = getme__nv[t];
     const int32_t *c = getme__ws_nodes(ws, t, e0);
-    int64_t off = c - ws->conn;
     int32_t m = 0;
     for (int64_t k = 0; k < (int64_t)(e1 - e0) * nv; k++) {
         int32_t n = c[k];
         if (mark[n] != b + 1) {
             mark[n] = b + 1;
-            local[n] = (uint16_t)m;
             if (list)
                 list[m] = n;
             m++;
         }
-        if (lconn)
-            lconn[off + k] = local[n];
     }
     return m;
 }
@@ -79,7 +77,8 @@ static getme_status alloc_scratch(getme_blocks *blk, int nt)
     size_t me = (size_t)(blk->max_elems ? blk->max_elems : 1);
     size_t per = m * (4 * sizeof(getme_fx) + 3 * sizeof(double) +
                       sizeof(int64_t) + 1) +
-                 me * (sizeof(int64_t) + sizeof(int32_t));
+                 me * (sizeof(int64_t) + sizeof(int32_t) +
+                       GETME_MAX_NV * sizeof(uint16_t));
     per = (per + 63) & ~(size_t)63;
     blk->scratch = calloc((size_t)nt, sizeof *blk->scratch);
     char *p = aligned_alloc(64, per * (size_t)nt);
@@ -99,6 +98,8 @@ static getme_status alloc_scratch(getme_blocks *blk, int nt)
         q += me * sizeof(int64_t);
         blk->scratch[k].list = (int32_t *)(void *)q;
         q += me * sizeof(int32_t);
+        blk->scratch[k].lconn = (uint16_t *)(void *)q;
+        q += me * GETME_MAX_NV * sizeof(uint16_t);
         blk->scratch[k].flag = (uint8_t *)q;
     }
     return GETME_OK;
@@ -254,7 +255,7 @@ int64_t getme__blocks_run(const getme_blocks *blk, const getme_ws *ws,
 size_t getme__blocks_scratch_bytes(const getme_ws *ws)
 {
     size_t nn = (size_t)(ws->nn ? ws->nn : 1);
-    return (size_t)ws->nt * nn * (sizeof(int32_t) + sizeof(uint16_t));
+    return (size_t)ws->nt * nn * sizeof(int32_t);
 }
 
 getme_status getme__blocks_build(getme_blocks *blk, const getme_ws *ws,
@@ -263,30 +264,25 @@ getme_status getme__blocks_build(getme_blocks *blk, const getme_ws *ws,
     memset(blk, 0, sizeof *blk);
     blk->group.n = -1;
     int nt = ws->nt;
-    int64_t nconn = ws->coff[GETME_NUM_TYPES - 1] +
-                    (int64_t)(ws->tstart[GETME_NUM_TYPES] -
-                              ws->tstart[GETME_NUM_TYPES - 1]) *
-                        getme__nv[GETME_NUM_TYPES - 1];
     size_t nn = (size_t)(ws->nn ? ws->nn : 1);
     blk->nptr = malloc(((size_t)ws->num_blocks + 1) * sizeof *blk->nptr);
-    blk->lconn = malloc((size_t)(nconn ? nconn : 1) * sizeof *blk->lconn);
-    /* The marks and local indices in the caller's scratch if it lends
+    blk->local = malloc(nn * sizeof *blk->local);
+    /* The marks in the caller's scratch if it lends
        one (getme__adj_build: the same pages serve the inclusion-exclusion
        check next, and a fresh page costs ~3 ms per MiB to fault in on the
        VMs measured), else our own. */
     void *own = scratch ? NULL : malloc(getme__blocks_scratch_bytes(ws));
     void *mem = scratch ? scratch : own;
     int32_t *mark = mem;
-    uint16_t *local = mem ? (uint16_t *)(void *)(mark + (size_t)nt * nn) : NULL;
     getme_status st = GETME_ERR_NOMEM;
-    if (!blk->nptr || !blk->lconn || !mem)
+    if (!blk->nptr || !blk->local || !mem)
         goto done;
     memset(mark, 0, (size_t)nt * nn * sizeof *mark);
     blk->nptr[0] = 0;
 #pragma omp parallel for schedule(dynamic, 16) num_threads(nt)
     for (int32_t b = 0; b < ws->num_blocks; b++) {
         size_t o = (size_t)omp_get_thread_num() * nn;
-        blk->nptr[b + 1] = block_nodes(ws, b, mark + o, local + o, NULL, NULL);
+        blk->nptr[b + 1] = block_nodes(ws, b, mark + o, NULL);
     }
     int32_t big = 0, bige = 0;
     for (int32_t b = 0; b < ws->num_blocks; b++) {
@@ -318,8 +314,7 @@ getme_status getme__blocks_build(getme_blocks *blk, const getme_ws *ws,
 #pragma omp parallel for schedule(dynamic, 16) num_threads(nt)
     for (int32_t b = 0; b < ws->num_blocks; b++) {
         size_t o = (size_t)omp_get_thread_num() * nn;
-        block_nodes(ws, b, mark + o, local + o, blk->nodes + blk->nptr[b],
-                    blk->lconn);
+        block_nodes(ws, b, mark + o, blk->nodes + blk->nptr[b]);
     }
     st = build_order(blk, ws, mark);
 done:

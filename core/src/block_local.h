@@ -16,9 +16,14 @@
  * the result stays the same bits for any thread count.
  *
  * Built once per smoothing run from the workspace (getme__blocks_build).
- * Memory: 2 bytes per element node (tets 8 B, hexes 16 B per element)
- * plus 4 bytes per (block, node) pair (~1.5 B per tet), plus per-thread
- * scratch for the largest block.
+ * Memory: 4 bytes per (block, node) pair (~1.5 B per tet, ~9 B per hex)
+ * and 2 bytes per node, plus per-thread scratch for the largest block.
+ * The local connectivity itself is not kept: a block's is rebuilt in its
+ * thread's scratch when the block runs (getme__blocks_localise), from
+ * ws->conn, which the kernels read anyway.  Kept, it was 2 bytes per
+ * element node (tets 8 B, hexes 16 B per element) at the peak of memory;
+ * rebuilding it costs a pass over the block's node list and its
+ * connectivity, both in cache for the block's work right after.
  *
  * The order the sweeps visit the blocks in (getme__blocks_run): the
  * colours alone are race-free, but a colour's blocks are spread over the
@@ -50,8 +55,13 @@ typedef struct getme_blocks {
                         a GETMe adaptive run the sign bit marks a node's
                         last block (getme_adaptive.c mark_last): read
                         them as nodes[k] & INT32_MAX                      */
-    uint16_t *lconn; /* like ws->conn, but each entry the node's index in
-                        its block's list (< 8 * 512, fits 16 bits)        */
+    uint16_t *local; /* nn: node n's index in the list of the block that
+                        last ran getme__blocks_localise with it (< 8 * 512,
+                        fits 16 bits); garbage for a node until then.
+                        Shared by the threads: blocks that run at the
+                        same time share no node, so they write and read
+                        different entries, and the blocks holding a node
+                        run one after another (getme__blocks_run)        */
     int32_t max_nodes; /* the largest block's node count                  */
     int32_t max_elems; /* the largest block's element count               */
     /* Per-thread scratch for one block at a time (max_nodes entries each):
@@ -63,6 +73,10 @@ typedef struct getme_blocks {
         uint8_t *flag;  /* 1: fixed node; 2: in I_T                       */
         int64_t *wf;    /* max_elems: the elements' integer weights       */
         int32_t *list;  /* max_elems: the elements transformed            */
+        uint16_t *lconn; /* max_elems GETME_MAX_NV: the running block's
+                            local connectivity (getme__blocks_localise):
+                            like ws->conn from the block's first element,
+                            each entry the node's index in its list       */
     } *scratch;         /* ws->nt                                         */
     /* The visiting order (see above): at level l, part p's interior
        blocks are order[part_ptr[l np + p] .. part_ptr[l np + p + 1]); then
@@ -100,8 +114,8 @@ getme_status getme__blocks_build(getme_blocks *blk, const getme_ws *ws,
                                  void *scratch);
 size_t getme__blocks_scratch_bytes(const getme_ws *ws);
 void getme__blocks_free(getme_blocks *blk);
-/* Free only the blocks' node lists and local connectivity (nptr, nodes,
-   lconn: ~10 B per tet, ~18 B per hex), which only the q_mean stage's
+/* Free only the blocks' node lists and local indices (nptr, nodes,
+   local: ~2 B per tet, ~11 B per hex), which only the q_mean stage's
    block kernel reads; the visiting order and the scratch stay for the
    sweeps of the q*_min stage (getme__blocks_run). */
 void getme__blocks_free_local(getme_blocks *blk);
@@ -126,12 +140,37 @@ static inline int32_t getme__blocks_of(const getme_blocks *blk,
 getme_status getme__blocks_group(getme_blocks *blk, const getme_ws *ws,
                                  const int32_t *list, int32_t n);
 
-/* The local node indices of element e (type t). */
-static inline const uint16_t *getme__blocks_lnodes(const getme_blocks *blk,
-                                                   const getme_ws *ws, int t,
-                                                   int32_t e)
+/* Block b's local connectivity into scr->lconn (the scratch of the
+   thread that runs b): each of its nodes' index in its list into
+   blk->local, then each element node's through it.  The block's node
+   list holds every node of its elements (getme__blocks_build), so every
+   entry read was written just before, by this block. */
+static inline void getme__blocks_localise(const getme_blocks *blk,
+                                          const getme_ws *ws, int32_t b,
+                                          struct getme_block_scratch *scr)
 {
-    return blk->lconn + ws->coff[t] + (int64_t)(e - ws->tstart[t]) * getme__nv[t];
+    const int32_t *gn = blk->nodes + blk->nptr[b];
+    int32_t m = (int32_t)(blk->nptr[b + 1] - blk->nptr[b]);
+    uint16_t *local = blk->local;
+    for (int32_t k = 0; k < m; k++) /* the sign bit: mark_last */
+        local[gn[k] & INT32_MAX] = (uint16_t)k;
+    int32_t e0 = ws->block_start[b], e1 = ws->block_start[b + 1];
+    if (e1 <= e0)
+        return;
+    int t = getme__ws_type(ws, e0);
+    const int32_t *c = getme__ws_nodes(ws, t, e0);
+    int64_t len = (int64_t)(e1 - e0) * getme__nv[t];
+    uint16_t *lc = scr->lconn;
+    for (int64_t k = 0; k < len; k++)
+        lc[k] = local[c[k]];
+}
+
+/* The local node indices of the j-th element (nv nodes) of the block
+   last localised into scr. */
+static inline const uint16_t *
+getme__blocks_lnodes(const struct getme_block_scratch *scr, int nv, int32_t j)
+{
+    return scr->lconn + (int64_t)j * nv;
 }
 
 #endif /* GETME_BLOCK_LOCAL_H */

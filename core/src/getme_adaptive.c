@@ -167,11 +167,11 @@ static inline int add_untransformed(getme_run *run, int t, int32_t e)
    and prefetching them needs the edge ids, which the first pass keeps. */
 __attribute__((always_inline)) static inline void
 weights_3d(int t, const getme_run *run, int32_t e0, int32_t e1,
-           const int64_t *ls, int64_t *wfs)
+           const struct getme_block_scratch *scr, const int64_t *ls,
+           int64_t *wfs)
 {
     const getme_ws *ws = run->ws;
     const getme_adj *adj = run->adj;
-    const getme_blocks *blk = &adj->blk;
     const double *q = run->q;
     const int nv = getme__nv[t], ned = getme__edges[t].num_edges;
     const int nf = getme__faces[t].num_faces;
@@ -204,7 +204,7 @@ weights_3d(int t, const getme_run *run, int32_t e0, int32_t e1,
         for (int32_t e = c0; e < c1; e++) {
             if (kind[e - c0] != 1)
                 continue;
-            const uint16_t *lc = getme__blocks_lnodes(blk, ws, t, e);
+            const uint16_t *lc = getme__blocks_lnodes(scr, nv, e - e0);
             const int32_t *f = getme__adj_faces(adj, ws, t, e);
             uint64_t sv = 0, se = 0;
             for (int i = 0; i < nv; i++)
@@ -271,6 +271,7 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
     getme_fx *acc = scr->acc;
     int64_t *ls = scr->nsum;
     uint8_t *flag = scr->flag;
+    getme__blocks_localise(blk, ws, b, scr);
     /* The node list is known: prefetch the scattered node data a few
        nodes ahead, here and in the final addition (perf annotate: those
        loads missed). */
@@ -297,7 +298,7 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
        eptr and fnb again only for it cost 14 % of the scatter). */
     int64_t *wfs = scr->wf;
     if (ws->dim == 3)
-        weights_3d(t, run, e0, e1, ls, wfs);
+        weights_3d(t, run, e0, e1, scr, ls, wfs);
     else
         for (int32_t e = e0; e < e1; e++) {
             int64_t wf = -1;
@@ -306,7 +307,7 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
                 if (adj->irregular[e]) {
                     w = getme__weight_union(run, t, e);
                 } else {
-                    const uint16_t *lc = getme__blocks_lnodes(blk, ws, t, e);
+                    const uint16_t *lc = getme__blocks_lnodes(scr, nv, e - e0);
                     uint64_t sv = 0;
                     for (int i = 0; i < nv; i++)
                         sv += (uint64_t)ls[lc[i]];
@@ -329,8 +330,8 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
             const uint16_t *lcs[GETME_LANES];
             /* a short last batch repeats its first element */
             for (int l = 0; l < GETME_LANES; l++)
-                lcs[l] = getme__blocks_lnodes(blk, ws, t,
-                                              list[j + l < n ? j + l : j]);
+                lcs[l] = getme__blocks_lnodes(scr, nv,
+                                              list[j + l < n ? j + l : j] - e0);
             getme__gather_lanes16(xl, lcs, nv, x);
             if (t == GETME_TET)
                 getme__transform_tet_lanes((const double(*)[GETME_LANES])x,
@@ -343,7 +344,7 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
             fixed_lanes(run, nv, (const double(*)[GETME_LANES])y, yd, out);
             for (int l = 0; l < GETME_LANES && j + l < n; l++) {
                 int32_t e = list[j + l];
-                const uint16_t *lc = getme__blocks_lnodes(blk, ws, t, e);
+                const uint16_t *lc = getme__blocks_lnodes(scr, nv, e - e0);
                 for (int i = 0; i < nv; i++) {
                     int k = lc[i];
                     if (flag[k] & 1) /* fixed */
@@ -363,7 +364,7 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
             int64_t wf = wfs[e - e0];
             if (wf < 0)
                 continue;
-            const uint16_t *lc = getme__blocks_lnodes(blk, ws, t, e);
+            const uint16_t *lc = getme__blocks_lnodes(scr, nv, e - e0);
             double x[3 * GETME_MAX_NV], y[3 * GETME_MAX_NV];
             for (int i = 0; i < nv; i++) {
                 const double *p = xl + 3 * lc[i];

@@ -206,10 +206,12 @@ static void check_blocks(const getme_blocks *blk, const getme_ws *ws)
             seen[gn[k]] = (uint32_t)b + 1;
         }
         int32_t used = 0;
+        getme__blocks_localise(blk, ws, b, &blk->scratch[0]);
         for (int32_t e = ws->block_start[b]; e < ws->block_start[b + 1]; e++) {
             int t = getme__ws_type(ws, e);
             const int32_t *c = getme__ws_nodes(ws, t, e);
-            const uint16_t *lc = getme__blocks_lnodes(blk, ws, t, e);
+            const uint16_t *lc = getme__blocks_lnodes(
+                &blk->scratch[0], getme__nv[t], e - ws->block_start[b]);
             for (int i = 0; i < getme__nv[t]; i++) {
                 ok &= lc[i] < m && gn[lc[i]] == c[i];
                 used = lc[i] + 1 > used ? lc[i] + 1 : used;
@@ -685,7 +687,8 @@ static void same_setup(const getme_ws *a, const getme_adj *aa,
         SAME(a->colour_blocks, b->colour_blocks, a->num_blocks);
         SAME(aa->blk.nptr, ab->blk.nptr, a->num_blocks + 1);
         SAME(aa->blk.nodes, ab->blk.nodes, aa->blk.nptr[a->num_blocks]);
-        SAME(aa->blk.lconn, ab->blk.lconn, nc);
+        /* the local connectivity follows from these and conn (it is
+           rebuilt per block: getme__blocks_localise) */
     }
     SAME(aa->fnb, ab->fnb, nf);
     SAME(aa->count, ab->count, a->ne);
