@@ -20,7 +20,7 @@
 #define GETME_ADJ_LENT_SCRATCH 1
 /* ... and check_all takes no nodes' check sums since this was set
    (round 12: summed in its walk) */
-#define GETME_ADJ_LOCAL_PROOF 1
+#define GETME_ADJ_CHECK_SUMS_IN_WALK 1
 
 void getme__adj_free(getme_adj *adj)
 {
