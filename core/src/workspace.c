@@ -358,10 +358,11 @@ static getme_status number_nodes(getme_ws *ws, const getme_mesh *mesh,
     }
     int32_t next = 0;
     int32_t *c = ws->conn;
-    getme_status st = ws->nt > 1 && renumber
-                          ? first_touch_parallel(ws, c, total, newid, &next)
-                          : GETME_ERR_NOMEM;
-    if (st != GETME_OK) {
+    /* One thread, the caller's numbering (newid is the identity), or no
+       memory for the ranges' lists: the serial stream. */
+    int parallel = ws->nt > 1 && renumber &&
+                   first_touch_parallel(ws, c, total, newid, &next) == GETME_OK;
+    if (!parallel) {
         /* First-touch numbering, serial: a stream over the copied rows
            (the node ids it looks up fetched a little ahead). */
         for (int64_t k = 0; k < total; k++) {
