@@ -31,6 +31,7 @@
 
 #include <math.h>
 #include <stdint.h>
+#include <string.h>
 
 __extension__ typedef __int128 getme_fx;
 __extension__ typedef unsigned __int128 getme_ufx;
@@ -65,6 +66,40 @@ static inline double getme__fx_double(getme_fx n, double inv)
 {
     int64_t s = (int64_t)n;
     return ((getme_fx)s == n ? (double)s : (double)n) * inv;
+}
+
+/* (double)n, the same correctly rounded (to nearest, ties to even)
+   value, without libgcc's soft-float __floattidf (perf: 2.4 % of the
+   medium hexes' run, from node_phat's four conversions per node and
+   iteration).  |n| < 2^64 converts in one step (int64, or uint64, which gcc
+   converts exactly rounded also without AVX-512).  Above, a = |n| =
+   hi 2^64 + lo with hi > 0: m = floor(a / 2^sh), sh = 64 - clz(hi) in
+   [1, 64], has its top bit at 63, so a double keeps m's bits 63..11 and
+   rounds at bit 10.  The bits of a below 2^sh can only decide a tie or
+   not: OR-ing "any of them set" into m's bit 0 (below bit 10, never bit 10
+   itself) leaves RN(m') = RN(a / 2^sh).  Scaling by 2^sh (sh <= 64,
+   |n| <= 2^127) is exact, and RN is odd, so the sign goes on last. */
+static inline double getme__fx_to_double(getme_fx n)
+{
+    int64_t s = (int64_t)n;
+    if ((getme_fx)s == n)
+        return (double)s;
+    getme_ufx a = n < 0 ? -(getme_ufx)n : (getme_ufx)n;
+    uint64_t hi = (uint64_t)(a >> 64), lo = (uint64_t)a;
+    double d;
+    if (hi == 0) {
+        d = (double)lo;
+    } else {
+        int sh = 64 - __builtin_clzll(hi);
+        uint64_t m = (uint64_t)(a >> sh);
+        uint64_t below = sh == 64 ? lo : lo & ((UINT64_C(1) << sh) - 1u);
+        m |= below != 0;
+        uint64_t eb = (uint64_t)(1023 + sh) << 52; /* 2^sh */
+        double scale;
+        memcpy(&scale, &eb, sizeof scale);
+        d = (double)m * scale;
+    }
+    return n < 0 ? -d : d;
 }
 
 /* A quality as a fixed-point term at scale 2^90 (q_mean's sums). */

@@ -242,10 +242,10 @@ weights_3d(int t, const getme_run *run, int32_t e0, int32_t e1,
    transform_block), so the same bits. */
 static inline void node_phat(const getme_fx *f, double back, double a[3])
 {
-    double inv = 1.0 / (double)f[3];
-    a[0] = (double)f[0] * inv * back;
-    a[1] = (double)f[1] * inv * back;
-    a[2] = (double)f[2] * inv * back;
+    double inv = 1.0 / getme__fx_to_double(f[3]);
+    a[0] = getme__fx_to_double(f[0]) * inv * back;
+    a[1] = getme__fx_to_double(f[1]) * inv * back;
+    a[2] = getme__fx_to_double(f[2]) * inv * back;
 }
 
 /* The free elements of block b (all of type t, a constant in each copy,
