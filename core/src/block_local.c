@@ -72,7 +72,10 @@ static int32_t block_nodes(const getme_ws *ws, int32_t b, int32_t *mark,
    exact sums start on a cache line, and the four of a node fill one. */
 static getme_status alloc_scratch(getme_blocks *blk, int nt)
 {
-    size_t m = (size_t)(blk->max_nodes ? blk->max_nodes : 1);
+    /* + 1: the slot after a block's nodes takes its fixed nodes'
+       contributions (transform_block: an index select instead of a
+       branch per element node) */
+    size_t m = (size_t)blk->max_nodes + 1;
     m = (m + 7) & ~(size_t)7; /* every part a multiple of 64 bytes */
     size_t me = (size_t)(blk->max_elems ? blk->max_elems : 1);
     size_t per = m * (4 * sizeof(getme_fx) + 3 * sizeof(double) +

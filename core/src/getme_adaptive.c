@@ -90,7 +90,7 @@ static inline int add_sum(const getme_run *run, getme_fx *a, int64_t wf,
    adds (never where out is set): AVX2 has no vector double -> int64
    conversion, and with the conversion in this loop gcc 12 left the whole
    loop scalar there (round 10: bound tests as compare-and-branch). */
-__attribute__((always_inline)) static inline void
+__attribute__((always_inline)) static inline int
 fixed_lanes(const getme_run *run, int nv, const double (*y)[GETME_LANES],
             double (*yd)[GETME_LANES], int64_t (*out)[GETME_LANES])
 {
@@ -108,6 +108,30 @@ fixed_lanes(const getme_run *run, int nv, const double (*y)[GETME_LANES],
             yd[3 * i + 2][l] = y2 * ps;
         }
     }
+    /* a separate loop: as a reduction in the one above (or with yd
+       selected by the test), gcc 12 left the bound tests scalar
+       compare-and-branch */
+    int64_t any = 0;
+    for (int i = 0; i < nv; i++)
+        for (int l = 0; l < GETME_LANES; l++)
+            any |= out[i][l];
+    return any != 0;
+}
+
+/* add_fixed for the lanes' loop: the same integers, added in wrapping
+   unsigned arithmetic, because the spare slot after a block's nodes
+   (transform_block) collects all its fixed nodes' terms, whose sum no
+   bound covers; a real node's sums are the same bits either way (its
+   signed sum is representable).  wf >= 0 (a transformed element's weight):
+   zero-extended, the weight's high half is a carry only. */
+static inline void add_fixed_wrap(getme_fx *a, int64_t wf, int64_t x0,
+                                  int64_t x1, int64_t x2)
+{
+    getme_ufx *u = (getme_ufx *)a;
+    u[0] += (getme_ufx)((getme_fx)wf * x0);
+    u[1] += (getme_ufx)((getme_fx)wf * x1);
+    u[2] += (getme_ufx)((getme_fx)wf * x2);
+    u[3] += (uint64_t)wf;
 }
 
 /* add_sum into node n's global sums. */
@@ -288,6 +312,9 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
         flag[k] = ws->fixed[g] != 0;
         acc[4 * k] = acc[4 * k + 1] = acc[4 * k + 2] = acc[4 * k + 3] = 0;
     }
+    /* the spare slot (lanes' loop): never fixed, its sums never read */
+    flag[m] = 0;
+    acc[4 * m] = acc[4 * m + 1] = acc[4 * m + 2] = acc[4 * m + 3] = 0;
     int nv = getme__nv[t];
     int32_t e0 = ws->block_start[b], e1 = ws->block_start[b + 1];
     /* The weights first, in a loop of loads with little arithmetic, so the
@@ -341,20 +368,38 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
                                            sigma, y);
             double yd[3 * GETME_MAX_NV][GETME_LANES];
             int64_t out[GETME_MAX_NV][GETME_LANES];
-            fixed_lanes(run, nv, (const double(*)[GETME_LANES])y, yd, out);
+            int bo = fixed_lanes(run, nv, (const double(*)[GETME_LANES])y, yd,
+                                 out);
             for (int l = 0; l < GETME_LANES && j + l < n; l++) {
                 int32_t e = list[j + l];
                 const uint16_t *lc = getme__blocks_lnodes(scr, nv, e - e0);
+                int64_t wf = wfs[e - e0];
+                if (__builtin_expect(bo, 0)) { /* never seen in practice */
+                    for (int i = 0; i < nv; i++) {
+                        int k = lc[i];
+                        if (flag[k] & 1) /* fixed */
+                            continue;
+                        if (out[i][l])
+                            o = 1;
+                        else
+                            add_fixed(acc + 4 * k, wf, (int64_t)yd[3 * i][l],
+                                      (int64_t)yd[3 * i + 1][l],
+                                      (int64_t)yd[3 * i + 2][l]);
+                        flag[k] = 2;
+                    }
+                    continue;
+                }
+                /* no branch per element node: a fixed node's terms go to
+                   the spare slot m (perf annotate of the base: the fixed
+                   flag's test-and-branch was this loop's hottest spot) */
                 for (int i = 0; i < nv; i++) {
                     int k = lc[i];
-                    if (flag[k] & 1) /* fixed */
-                        continue;
-                    if (out[i][l])
-                        o = 1;
-                    else
-                        add_fixed(acc + 4 * k, wfs[e - e0], (int64_t)yd[3 * i][l],
-                                  (int64_t)yd[3 * i + 1][l],
-                                  (int64_t)yd[3 * i + 2][l]);
+                    /* k, or m for a fixed node (gcc made the plain select
+                       a branch) */
+                    k += (m - k) & -(int)(flag[k] & 1);
+                    add_fixed_wrap(acc + 4 * k, wf, (int64_t)yd[3 * i][l],
+                                   (int64_t)yd[3 * i + 1][l],
+                                   (int64_t)yd[3 * i + 2][l]);
                     flag[k] = 2;
                 }
             }
