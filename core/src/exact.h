@@ -59,15 +59,6 @@ static inline getme_fx getme__fx(double v, double scale)
     return v < 0.0 ? (getme_fx)(-r) : (getme_fx)r;
 }
 
-/* n * 2^-s as the nearest double (inv = 2^-s, a power of two: exact).
-   Most sums fit 64 bits, where the conversion is one instruction instead
-   of a libgcc call; both round to nearest, so the result is the same. */
-static inline double getme__fx_double(getme_fx n, double inv)
-{
-    int64_t s = (int64_t)n;
-    return ((getme_fx)s == n ? (double)s : (double)n) * inv;
-}
-
 /* (double)n, the same correctly rounded (to nearest, ties to even)
    value, without libgcc's soft-float __floattidf (perf: 2.4 % of the
    medium hexes' run, from node_phat's four conversions per node and
@@ -100,6 +91,12 @@ static inline double getme__fx_to_double(getme_fx n)
         d = (double)m * scale;
     }
     return n < 0 ? -d : d;
+}
+
+/* n * 2^-s as the nearest double (inv = 2^-s, a power of two: exact). */
+static inline double getme__fx_double(getme_fx n, double inv)
+{
+    return getme__fx_to_double(n) * inv;
 }
 
 /* A quality as a fixed-point term at scale 2^90 (q_mean's sums). */

@@ -64,10 +64,15 @@ static inline double weight(const getme_run *run, int t, int32_t e)
 static inline void add_fixed(getme_fx *a, int64_t wf, int64_t x0,
                              int64_t x1, int64_t x2)
 {
-    a[0] += (getme_fx)wf * x0;
-    a[1] += (getme_fx)wf * x1;
-    a[2] += (getme_fx)wf * x2;
-    a[3] += wf;
+    /* In wrapping unsigned arithmetic: the lanes' loop (transform_block)
+       adds every fixed node's terms into one spare slot whose sum no
+       bound covers; a real node's sums are the bits of the signed sums
+       (representable by the bounds), so every caller gets the same. */
+    getme_ufx *u = (getme_ufx *)a;
+    u[0] += (getme_ufx)((getme_fx)wf * x0);
+    u[1] += (getme_ufx)((getme_fx)wf * x1);
+    u[2] += (getme_ufx)((getme_fx)wf * x2);
+    u[3] += (getme_ufx)(getme_fx)wf;
 }
 
 static inline int add_sum(const getme_run *run, getme_fx *a, int64_t wf,
@@ -116,22 +121,6 @@ fixed_lanes(const getme_run *run, int nv, const double (*y)[GETME_LANES],
         for (int l = 0; l < GETME_LANES; l++)
             any |= out[i][l];
     return any != 0;
-}
-
-/* add_fixed for the lanes' loop: the same integers, added in wrapping
-   unsigned arithmetic, because the spare slot after a block's nodes
-   (transform_block) collects all its fixed nodes' terms, whose sum no
-   bound covers; a real node's sums are the same bits either way (its
-   signed sum is representable).  wf >= 0 (a transformed element's weight):
-   zero-extended, the weight's high half is a carry only. */
-static inline void add_fixed_wrap(getme_fx *a, int64_t wf, int64_t x0,
-                                  int64_t x1, int64_t x2)
-{
-    getme_ufx *u = (getme_ufx *)a;
-    u[0] += (getme_ufx)((getme_fx)wf * x0);
-    u[1] += (getme_ufx)((getme_fx)wf * x1);
-    u[2] += (getme_ufx)((getme_fx)wf * x2);
-    u[3] += (uint64_t)wf;
 }
 
 /* add_sum into node n's global sums. */
@@ -397,9 +386,9 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
                     /* k, or m for a fixed node (gcc made the plain select
                        a branch) */
                     k += (m - k) & -(int)(flag[k] & 1);
-                    add_fixed_wrap(acc + 4 * k, wf, (int64_t)yd[3 * i][l],
-                                   (int64_t)yd[3 * i + 1][l],
-                                   (int64_t)yd[3 * i + 2][l]);
+                    add_fixed(acc + 4 * k, wf, (int64_t)yd[3 * i][l],
+                              (int64_t)yd[3 * i + 1][l],
+                              (int64_t)yd[3 * i + 2][l]);
                     flag[k] = 2;
                 }
             }
