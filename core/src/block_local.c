@@ -79,7 +79,7 @@ static getme_status alloc_scratch(getme_blocks *blk, int nt)
     m = (m + 7) & ~(size_t)7; /* every part a multiple of 64 bytes */
     size_t me = (size_t)(blk->max_elems ? blk->max_elems : 1);
     size_t per = m * (4 * sizeof(getme_fx) + 3 * sizeof(double) +
-                      sizeof(int64_t) + 1) +
+                      sizeof(int64_t) + sizeof(int32_t) + 1) +
                  me * (sizeof(int64_t) + sizeof(int32_t) +
                        GETME_MAX_NV * sizeof(uint16_t));
     per = (per + 63) & ~(size_t)63;
@@ -97,6 +97,8 @@ static getme_status alloc_scratch(getme_blocks *blk, int nt)
         q += m * 3 * sizeof(double);
         blk->scratch[k].nsum = (int64_t *)(void *)q;
         q += m * sizeof(int64_t);
+        blk->scratch[k].slot = (int32_t *)(void *)q;
+        q += m * sizeof(int32_t);
         blk->scratch[k].wf = (int64_t *)(void *)q;
         q += me * sizeof(int64_t);
         blk->scratch[k].list = (int32_t *)(void *)q;

@@ -70,6 +70,8 @@ typedef struct getme_blocks {
         double *x;      /* 3 per node                                     */
         getme_fx *acc;  /* 4 per node: sum w x' (3), sum w                */
         int64_t *nsum;  /* S_v                                            */
+        int32_t *slot;  /* the nodes' entries in a pool of sums
+                           (getme_run.slot), if the run has one          */
         uint8_t *flag;  /* 1: fixed node; 2: in I_T                       */
         int64_t *wf;    /* max_elems: the elements' integer weights       */
         int32_t *list;  /* max_elems: the elements transformed            */

@@ -127,7 +127,7 @@ fixed_lanes(const getme_run *run, int nv, const double (*y)[GETME_LANES],
 static inline int add_node(const getme_run *run, int32_t n, int64_t wf,
                            const double *x)
 {
-    return add_sum(run, run->facc + 4 * (int64_t)n, wf, x);
+    return add_sum(run, run->facc + 4 * getme__slot(run, n), wf, x);
 }
 
 /* AddTransformedElementNodesAndWeights for element e (type t); returns 1
@@ -284,6 +284,7 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
     getme_fx *acc = scr->acc;
     int64_t *ls = scr->nsum;
     uint8_t *flag = scr->flag;
+    const int32_t *pslot = run->slot;
     getme__blocks_localise(blk, ws, b, scr);
     /* The node list is known: prefetch the scattered node data a few
        nodes ahead, here and in the final addition (perf annotate: those
@@ -299,6 +300,22 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
         xl[3 * k] = p[0], xl[3 * k + 1] = p[1], xl[3 * k + 2] = p[2];
         ls[k] = adj->nsum[g];
         flag[k] = ws->fixed[g] != 0;
+        if (pslot) {
+            /* A pool's long-lived entries are out of cache (perf: the
+               final addition's first load of an entry was 17 % of the
+               scatter); the block's work gives these time to arrive.
+               The slot is kept for the final addition, whose own load of
+               it missed again (6 % of the scatter). */
+            if (k + PREFETCH_AHEAD < m)
+                __builtin_prefetch(pslot + (gn[k + PREFETCH_AHEAD] & INT32_MAX),
+                                   0, 3);
+            int32_t sl = pslot[g];
+            scr->slot[k] = sl;
+            if (!flag[k]) {
+                __builtin_prefetch(run->facc + 4 * (int64_t)sl, 1, 3);
+                __builtin_prefetch(run->xold + 3 * (int64_t)g, 1, 3);
+            }
+        }
         acc[4 * k] = acc[4 * k + 1] = acc[4 * k + 2] = acc[4 * k + 3] = 0;
     }
     /* the spare slot (lanes' loop): never fixed, its sums never read */
@@ -421,14 +438,23 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
     const double back = 1.0 / run->pscale, rho = run->place_rho;
     double *x = ws->x;
     uint8_t *in_t = run->in_t, *ridx = run->ridx;
+    const int32_t *slot = run->slot ? scr->slot : NULL; /* block-local */
     for (int32_t k = 0; k < m; k++) {
-        if (k + PREFETCH_AHEAD < m)
-            __builtin_prefetch(
-                facc + 4 * (int64_t)(gn[k + PREFETCH_AHEAD] & INT32_MAX), 1, 3);
+        if (k + PREFETCH_AHEAD < m) {
+            /* with a pool again: the block's own work moved the entries
+               the first loop fetched out to L3 (perf: 10 % of the
+               scatter) */
+            int64_t ga = gn[k + PREFETCH_AHEAD] & INT32_MAX;
+            if (slot) {
+                __builtin_prefetch(run->xold + 3 * ga, 1, 3);
+            } else {
+                __builtin_prefetch(facc + 4 * ga, 1, 3);
+            }
+        }
         if (flag[k] == 2) {
             int32_t gk = gn[k];
             int64_t g = gk & INT32_MAX;
-            getme_fx *f = facc + 4 * g;
+            getme_fx *f = facc + 4 * (slot ? (int64_t)slot[k] : g);
             f[0] += acc[4 * k];
             f[1] += acc[4 * k + 1];
             f[2] += acc[4 * k + 2];
@@ -436,10 +462,16 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
             if (early && gk < 0) { /* the node's last block: complete */
                 double a[3];
                 node_phat(f, back, a);
-                unsigned char *p = (unsigned char *)f; /* as compute_new_nodes */
-                memcpy(p, a, sizeof a);
-                getme__place_first(x, p + GETME_XOLD_OFF, ridx, (int32_t)g,
-                                   rho, a);
+                if (slot) { /* the slot goes to the next node, zeroed */
+                    f[0] = f[1] = f[2] = f[3] = 0;
+                    getme__place_first(x, (unsigned char *)(run->xold + 3 * g),
+                                       ridx, (int32_t)g, rho, a);
+                } else {
+                    unsigned char *p = (unsigned char *)f; /* as compute_new_nodes */
+                    memcpy(p, a, sizeof a);
+                    getme__place_first(x, p + GETME_XOLD_OFF, ridx, (int32_t)g,
+                                       rho, a);
+                }
                 in_t[g] = 2;
             } else {
                 in_t[g] = 1;
@@ -488,6 +520,120 @@ static void mark_last(getme_run *run)
         }
     }
     memset(seen, 0, (size_t)ws->nn);
+}
+
+/* Room for need entries in the pool of sums (run->facc with a slot map):
+   a larger zeroed pool, with the leading pool_used entries (p-hats kept
+   by getme__save_phat, or the q*_min stage's sums) copied over.  GETME_OK
+   or GETME_ERR_NOMEM (the pool as it was). */
+static getme_status pool_reserve(getme_run *run, int64_t need)
+{
+    if (need <= run->pool_cap)
+        return GETME_OK;
+    int64_t cap = 2 * run->pool_cap > need ? 2 * run->pool_cap : need;
+    if (cap > run->ws->nn)
+        cap = run->ws->nn > need ? run->ws->nn : need;
+    size_t bytes = (size_t)cap * 4 * sizeof *run->facc;
+    getme_fx *p = aligned_alloc(64, bytes);
+    if (!p)
+        return GETME_ERR_NOMEM;
+    memset(p, 0, bytes);
+    if (run->facc && run->pool_used > 0)
+        memcpy(p, run->facc, (size_t)run->pool_used * 4 * sizeof *p);
+    free(run->facc);
+    run->facc = p;
+    run->phat = (unsigned char *)p;
+    run->pool_cap = cap;
+    return GETME_OK;
+}
+
+getme_status getme__save_phat(getme_run *run, int32_t i)
+{
+    if (pool_reserve(run, (int64_t)run->nsaved + 1) != GETME_OK)
+        return GETME_ERR_NOMEM;
+    int32_t k = run->nsaved++, own = run->slot[i];
+    unsigned char *e = (unsigned char *)(run->facc + 4 * (int64_t)k);
+    memcpy(e, run->ws->x + 3 * (int64_t)i, 3 * sizeof(double));
+    memcpy(e + 3 * sizeof(double), &i, sizeof i);
+    memcpy(e + 3 * sizeof(double) + sizeof i, &own, sizeof own);
+    run->slot[i] = k;
+    run->pool_used = run->nsaved;
+    return GETME_OK;
+}
+
+/* The q_mean stage's slots in the pool of sums (getme_run.slot), once per
+   run after mark_last.  A node's sums are open from its first block to
+   its last, which places the node and zeroes its slot (transform_block);
+   two nodes may share a slot if one's last block surely ends before the
+   other's first begins, whatever the threads' timing.  So this walks
+   getme__blocks_run's order phase by phase (the parts' levels, then the
+   colours), where the lanes of a phase run at the same time and each
+   lane's blocks one after another (a part; a block of a colour; the
+   serial colour as one lane).  A node is in one lane of a phase (blocks
+   running at the same time share no node).  A lane takes a free slot
+   from those its own earlier blocks gave back in this phase, else from
+   those free when the phase began (which it then owns), else a new one;
+   slots given back in a phase are everyone's from the next phase on.
+   The pool's size is the number of slots made: ~3 % of the nodes on one
+   thread, ~8 % on two (full-size tets and hexes), against 64 B for every
+   node without it.  Which slot a node gets changes no bit: the sums are
+   exact integers.  GETME_OK or GETME_ERR_NOMEM. */
+static getme_status assign_slots(getme_run *run)
+{
+    const getme_blocks *blk = &run->adj->blk;
+    const getme_ws *ws = run->ws;
+    size_t nn = (size_t)(ws->nn ? ws->nn : 1);
+    int32_t *avail = malloc(nn * sizeof *avail); /* free at the phase start */
+    int32_t *back = malloc(nn * sizeof *back);   /* given back in the phase */
+    uint8_t *seen = run->in_t;                   /* zero before and after */
+    if (!avail || !back) {
+        free(avail), free(back);
+        return GETME_ERR_NOMEM;
+    }
+    int32_t navail = 0, made = 0;
+    int np = blk->num_parts, nph = GETME_ORDER_LEVELS + ws->num_colours;
+    for (int ph = 0; ph < nph; ph++) {
+        int32_t nback = 0;
+        int c = ph - GETME_ORDER_LEVELS;
+        /* the phase's lanes: [lo, hi) of blk->order each */
+        int32_t k0 = c < 0 ? blk->part_ptr[ph * np] : blk->col_ptr[c];
+        int32_t k1 = c < 0 ? blk->part_ptr[(ph + 1) * np] : blk->col_ptr[c + 1];
+        int32_t k = k0, p = 0;
+        while (k < k1) {
+            int32_t lane_end;
+            if (c < 0) { /* part p's blocks (possibly none) */
+                lane_end = blk->part_ptr[ph * np + p + 1];
+                p++;
+            } else {
+                lane_end = c == ws->serial_colour ? k1 : k + 1;
+            }
+            int32_t base = nback; /* this lane's free slots: back[base..) */
+            for (; k < lane_end; k++) {
+                int32_t b = blk->order[k];
+                for (int64_t j = blk->nptr[b]; j < blk->nptr[b + 1]; j++) {
+                    int32_t g = blk->nodes[j] & INT32_MAX;
+                    if (ws->fixed[g] || seen[g])
+                        continue;
+                    seen[g] = 1;
+                    run->slot[g] = nback > base ? back[--nback]
+                                 : navail > 0   ? avail[--navail]
+                                                : made++;
+                }
+                for (int64_t j = blk->nptr[b]; j < blk->nptr[b + 1]; j++) {
+                    int32_t g = blk->nodes[j] & INT32_MAX;
+                    if (blk->nodes[j] < 0 && !ws->fixed[g])
+                        back[nback++] = run->slot[g];
+                }
+            }
+        }
+        memcpy(avail + navail, back, (size_t)nback * sizeof *back);
+        navail += nback;
+    }
+    memset(seen, 0, nn);
+    free(avail), free(back);
+    run->pool_cap = 0;
+    run->pool_used = 0;
+    return pool_reserve(run, made > 0 ? made : 1);
 }
 
 /* q_mean stage: every free element is transformed, block by block in the
@@ -600,7 +746,8 @@ static inline void some_chunks(int t, const struct some_ctx *s, int32_t j0,
             for (int v = 0; v < nv; v++) {
                 sv += (uint64_t)adj->nsum[c[v]];
                 if (in_t[c[v]])
-                    __builtin_prefetch(run->facc + 4 * (int64_t)c[v], 1, 3);
+                    __builtin_prefetch(run->facc + 4 * getme__slot(run, c[v]),
+                                       1, 3);
             }
             for (int j = 0; j < ned; j++) /* -1: irregular, not here */
                 se += (uint64_t)adj->esum[eid[i][j]];
@@ -743,7 +890,8 @@ static int32_t ring_sweep(getme_run *run)
    with enough elements the contributions are added block by block in the
    blocks' race-free order (block_local.h; blocks running at the same time
    share no node, so no atomics), else in list order on one thread; the
-   same bits either way. */
+   same bits either way.  Returns the number transformed, or -1 if the
+   pool of sums (with a slot map) could not grow to I_T. */
 static int32_t scatter_some(getme_run *run, double qt, double sigma)
 {
     const getme_ws *ws = run->ws;
@@ -764,6 +912,16 @@ static int32_t scatter_some(getme_run *run, double qt, double sigma)
         for (int32_t i = 0; i < ws->nn; i++)
             if (run->in_t[i])
                 run->nodes[nn++] = i;
+    }
+    if (run->slot) { /* node nodes[k] sums into pool entry k */
+        if (pool_reserve(run, nn) != GETME_OK) {
+            for (int32_t k = 0; k < nn; k++)
+                run->in_t[run->nodes[k]] = 0;
+            return -1;
+        }
+        for (int32_t k = 0; k < nn; k++)
+            run->slot[run->nodes[k]] = k;
+        run->pool_used = nn;
     }
     int64_t stars = 0; /* the elements around I_T, with repeats */
     for (int32_t k = 0; k < nn; k++)
@@ -1023,14 +1181,14 @@ static void compute_new_nodes(getme_run *run, double rho0)
         int32_t n = nodes[k];
         if (in_t[n] == 2)
             continue; /* placed by its last block (transform_block) */
-        getme_fx *f = facc + 4 * (int64_t)n;
+        getme_fx *f = facc + 4 * getme__slot(run, n);
         double a[3];
         node_phat(f, back, a);
         /* p-hat over the node's sums (run->phat): getme__reset_nodes
            zeroes them again before the next scatter. */
         unsigned char *p = (unsigned char *)f;
         memcpy(p, a, sizeof a);
-        getme__place_first(x, p + GETME_XOLD_OFF, ridx, n, rho0, a);
+        getme__place_first(x, getme__xold(run, n), ridx, n, rho0, a);
     }
     run->placed = 1;
 }
@@ -1046,7 +1204,8 @@ static void clear_sums(getme_run *run)
             memcpy(run->ws->x + 3 * (int64_t)n, getme__xold(run, n),
                    3 * sizeof(double));
     }
-    memset(run->facc, 0, (size_t)run->ws->nn * 4 * sizeof *run->facc);
+    memset(run->facc, 0, (size_t)run->pool_cap * 4 * sizeof *run->facc);
+    run->pool_used = run->nsaved = 0;
     for (int32_t k = 0; k < run->num_nodes; k++)
         run->in_t[run->nodes[k]] = 0;
 }
@@ -1199,6 +1358,8 @@ static getme_status iterate(getme_run *run, int mean_stage, double qt,
         run->overflow = 0;
         *num_transformed = mean_stage ? scatter_all(run)
                                       : scatter_some(run, qt, sigma);
+        if (*num_transformed < 0) /* no room for the pool's sums */
+            return GETME_ERR_NOMEM;
         if (!getme__dist_any(run, run->overflow))
             break;
         /* A transformed node beyond xbound (never seen in practice): clear
@@ -1214,6 +1375,9 @@ static getme_status iterate(getme_run *run, int mean_stage, double qt,
         getme__dist_node_sum(run, run->facc, 4);
     }
     compute_new_nodes(run, R[0]);
+    /* with a slot map, the q_mean stage's p-hats are in ws->x (R[0] = 1)
+       until a node steps down the table (getme__save_phat) */
+    run->save_phat = mean_stage && run->slot;
     if (!mean_stage) {
         qold_reserve(run);
         for (int32_t k = 0; run->qold && k < run->num_elems; k++)
@@ -1221,6 +1385,7 @@ static getme_status iterate(getme_run *run, int mean_stage, double qt,
     }
     *num_relaxed = getme__relax(run, R, nR);
     run->live = NULL;
+    run->save_phat = 0;
     if (run->comm) { /* counts of the whole mesh, each node once */
         int64_t c[2] = {*num_transformed, 0};
         for (int32_t k = 0; k < run->num_nodes; k++)
@@ -1383,6 +1548,8 @@ double getme__threshold(getme_run *run, double fraction, int32_t min_count)
     return qt;
 }
 
+static getme_status alloc_stamps(getme_run *run);
+
 /* The method's own scratch: the q*_min stage's element flags (its lists
    grow as needed), and the per-thread stamps of the union walk if some
    element needs it. */
@@ -1391,25 +1558,52 @@ static getme_status alloc_adaptive(getme_run *run)
     const getme_ws *ws = run->ws;
     size_t ne = (size_t)(ws->ne ? ws->ne : 1);
     run->tflag = calloc(ne, 1);
+    size_t nn = (size_t)(ws->nn ? ws->nn : 1);
+    /* A pool of sums with a slot map (getme_run.facc, assign_slots), on
+       one process (a distributed run sums every node's entry over the
+       processes) and with a q_mean table from 1 (the p-hat is then the
+       placed position: getme__save_phat). */
+    int pool = !run->comm && run->params->relax_mean[0] == 1.0;
+#ifdef GETME_CHECK_SUMS
+    /* Test builds: 3 threads go without, so that the tests' comparison
+       of 1, 2 and 3 threads (test_adjacency) compares both, bit for bit. */
+    pool = pool && ws->nt != 3;
+#endif
+    if (pool) { /* the pool itself after mark_last (assign_slots) */
+        run->slot = malloc(nn * sizeof *run->slot);
+        run->xold = malloc(nn * 3 * sizeof *run->xold);
+        if (!run->tflag || !run->slot || !run->xold)
+            return GETME_ERR_NOMEM;
+        return alloc_stamps(run);
+    }
     /* 64-byte aligned: a node's four sums are one cache line. */
-    size_t fbytes = (size_t)(ws->nn ? ws->nn : 1) * 4 * sizeof *run->facc;
+    size_t fbytes = nn * 4 * sizeof *run->facc;
     run->facc = aligned_alloc(64, fbytes);
+    run->pool_cap = (int64_t)nn;
     /* Zeroed by every thread in its own share of the nodes, not by one
        memset: the array is fresh pages (the CLI maps every block of 1 MiB
        or more afresh), 172 MB on the full hexes, and faulting them in was
        0.15-0.55 s on one thread while the other waited. */
     if (run->facc) {
-        int64_t nn = ws->nn ? ws->nn : 1;
 #pragma omp parallel num_threads(ws->nt)
         {
             int th = omp_get_thread_num(), n = omp_get_num_threads();
-            int64_t a = nn * th / n, b = nn * (th + 1) / n;
+            int64_t a = (int64_t)nn * th / n, b = (int64_t)nn * (th + 1) / n;
             memset(run->facc + 4 * a, 0, (size_t)(b - a) * 4 * sizeof *run->facc);
         }
     }
     if (!run->tflag || !run->facc)
         return GETME_ERR_NOMEM;
     run->phat = (unsigned char *)run->facc;
+    run->phat_step = 4 * (int64_t)sizeof *run->facc;
+    return alloc_stamps(run);
+}
+
+/* The per-thread stamps of the union walk, if some element needs it. */
+static getme_status alloc_stamps(getme_run *run)
+{
+    const getme_ws *ws = run->ws;
+    size_t ne = (size_t)(ws->ne ? ws->ne : 1);
     run->phat_step = 4 * (int64_t)sizeof *run->facc;
     if (run->adj->num_irregular == 0)
         return GETME_OK;
@@ -1428,7 +1622,13 @@ static void free_adaptive(getme_run *run)
     free(run->tflag);
     free(run->qold);
     free(run->facc);
+    free(run->slot);
+    free(run->xold);
     run->facc = NULL;
+    run->slot = NULL;
+    run->xold = NULL;
+    run->pool_cap = run->pool_used = 0;
+    run->nsaved = 0;
     run->phat = NULL;
     run->qold = NULL, run->cap_qold = 0, run->cap_t = 0;
     if (run->stamps)
@@ -1505,6 +1705,10 @@ getme_status getme__adaptive(getme_run *run)
     set_bounds(run);
     if (!run->comm)
         mark_last(run);
+    if (run->slot && assign_slots(run) != GETME_OK) {
+        st = GETME_ERR_NOMEM;
+        goto done;
+    }
     /* The Eq. 9 sums at the input's qualities; from here on every change of
        run->q updates them (the relaxation, update_after). */
     getme__adj_sums_all(run->adj, ws, run->q);

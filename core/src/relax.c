@@ -19,7 +19,7 @@ static inline void place(getme_run *run, int32_t i, double rho)
 {
     double x[3], ph[3], xn[3];
     memcpy(x, getme__xold(run, i), sizeof x);
-    memcpy(ph, run->phat + i * run->phat_step, sizeof ph);
+    memcpy(ph, getme__phat(run, i), sizeof ph);
     getme__eq10(rho, x, ph, xn);
     memcpy(run->ws->x + 3 * (int64_t)i, xn, sizeof xn);
 }
@@ -279,11 +279,18 @@ static int32_t nodes_to_step(getme_run *run, int nR, const int32_t *bad,
 
 /* Step one node of the list down the table and re-evaluate the elements
    of their stars (m nodes in run->list). */
-static void step_nodes(getme_run *run, const double *R, int32_t m)
+static void step_nodes(getme_run *run, const double *R, int nR, int32_t m)
 {
     const getme_ws *ws = run->ws;
     for (int32_t j = 0; j < m; j++) {
         int32_t i = run->list[j];
+        /* The q_mean stage with a slot map: the p-hat is the position at
+           R[0] = 1 until the first step keeps it.  If the pool cannot
+           grow for it, the node goes straight back to its old position
+           (R's last entry, 0, needs no p-hat): still a valid mesh. */
+        if (run->save_phat && run->ridx[i] == 0 &&
+            getme__save_phat(run, i) != GETME_OK)
+            run->ridx[i] = (uint8_t)(nR - 2);
         run->ridx[i]++;
         place(run, i, R[run->ridx[i]]);
         run->flag[i] = 0;
@@ -309,7 +316,7 @@ static void steps_dist(getme_run *run, const double *R, int nR)
         int32_t m = getme__dist_step_list(run, nR);
         if (!getme__dist_any(run, m > 0))
             break; /* unreachable for a valid input, see getme__relax */
-        step_nodes(run, R, m);
+        step_nodes(run, R, nR, m);
     }
 }
 
@@ -332,7 +339,7 @@ static void steps_local(getme_run *run, const double *R, int nR,
                              : nodes_to_step(run, nR, NULL, 0);
         if (m == 0)
             break; /* unreachable for a valid input, see above */
-        step_nodes(run, R, m);
+        step_nodes(run, R, nR, m);
         if (nbad < 0) {
             nbad = count_invalid(run) > 0 ? -1 : 0;
             continue;
@@ -372,14 +379,11 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
     int32_t invalid; /* elements of the list invalid after the first pass */
 
     if (!run->placed) {
-        unsigned char *phat = run->phat;
-        int64_t step = run->phat_step;
 #pragma omp parallel for schedule(static) num_threads(nt) if (nn > GETME_PAR_MIN)
         for (int32_t k = 0; k < nn; k++) {
             double ph[3];
-            unsigned char *p = phat + nodes[k] * step;
-            memcpy(ph, p, sizeof ph);
-            getme__place_first(ws->x, p + GETME_XOLD_OFF, run->ridx,
+            memcpy(ph, getme__phat(run, nodes[k]), sizeof ph);
+            getme__place_first(ws->x, getme__xold(run, nodes[k]), run->ridx,
                                nodes[k], R[0], ph);
         }
     }

@@ -100,12 +100,25 @@ void getme__collect(getme_run *run)
 
 void getme__reset_nodes(getme_run *run)
 {
+    if (run->slot) { /* a pool (getme_adaptive.c): its used entries */
+        for (int32_t k = 0; k < run->nsaved; k++) { /* getme__save_phat */
+            const unsigned char *e =
+                (const unsigned char *)(run->facc + 4 * (int64_t)k);
+            int32_t i, own;
+            memcpy(&i, e + 3 * sizeof(double), sizeof i);
+            memcpy(&own, e + 3 * sizeof(double) + sizeof i, sizeof own);
+            run->slot[i] = own;
+        }
+        memset(run->facc, 0, (size_t)run->pool_used * 4 * sizeof *run->facc);
+        run->pool_used = run->nsaved = 0;
+    }
+    const int sums = run->facc && !run->slot;
 #pragma omp parallel for schedule(static) num_threads(run->ws->nt) \
     if (run->num_nodes > GETME_PAR_MIN)
     for (int32_t k = 0; k < run->num_nodes; k++) {
         int32_t i = run->nodes[k];
         run->in_t[i] = 0;
-        if (run->facc) { /* stored as sums again: zero as sums */
+        if (sums) { /* stored as sums again: zero as sums */
             getme_fx *f = run->facc + 4 * (int64_t)i;
             f[0] = f[1] = f[2] = f[3] = 0;
         }

@@ -83,8 +83,33 @@ typedef struct getme_run {
                            update_after keeps (tally.h), or NULL            */
     int64_t cap_qold;
     /* GETMe's node sums in exact fixed point (exact.h, getme_adaptive.c):
-       per node sum w x' (3) and sum w, zero between iterations. */
-    getme_fx *facc;     /* 4 * nn                                          */
+       sum w x' (3) and sum w, one entry of four per node, zero between
+       iterations.  Without a slot map (distributed runs, a q_mean table
+       not starting at 1), node i's entry is i: pool_cap = nn.  With one
+       (slot, below) the entries are a pool that only the nodes whose sums
+       are open at the same time share out (getme_adaptive.c
+       assign_slots): in the q_mean stage a node holds its slot from its
+       first block to its last, which places it and zeroes the slot, so
+       the pool is ~3 % of the nodes on one thread, ~8 % on two (full
+       hexes, tets); in the q*_min stage node nodes[k] holds slot k. */
+    getme_fx *facc;     /* 4 * pool_cap                                    */
+    int64_t pool_cap;   /* entries in facc                                 */
+    int32_t *slot;      /* nn: node i's entry in facc, or NULL (i)         */
+    /* With a slot map, the old coordinates during the relaxation
+       (getme__xold) are here, 3 per node, not in the node's entry, which
+       its last block frees; NULL otherwise. */
+    double *xold;
+    /* The q_mean stage with a slot map: the nodes placed at R[0] = 1 have
+       their p-hat in ws->x itself until they step down the table; the
+       first step keeps it in facc entry k < nsaved (getme_adaptive.c
+       getme__save_phat), and slot[i] points there until
+       getme__reset_nodes puts the node's own slot back. */
+    int save_phat;
+    int32_t nsaved;
+    /* The leading entries of facc that hold p-hats or sums between the
+       relaxation and getme__reset_nodes, which zeroes them (with a slot
+       map; without one it zeroes the entries of run->nodes). */
+    int64_t pool_used;
     double xbound;      /* power of two >= |x'| of any transformed node    */
     double star_bound;  /* power of two > any node's number of elements    */
     double pscale, wscale; /* this iteration's scales of sum w x', sum w   */
@@ -142,10 +167,29 @@ void getme__collect(getme_run *run);
    (GETME_XOLD_OFF): the trial qualities gather from the dense coordinate
    array, the end of the relaxation has nothing to copy, and no trial
    array is needed (24 B per node).  Node i's old coordinates: */
+static inline int64_t getme__slot(const getme_run *run, int32_t i)
+{
+    return run->slot ? run->slot[i] : i;
+}
+
 static inline unsigned char *getme__xold(const getme_run *run, int32_t i)
 {
-    return run->phat + i * run->phat_step + GETME_XOLD_OFF;
+    if (run->xold)
+        return (unsigned char *)(run->xold + 3 * (int64_t)i);
+    return run->phat + getme__slot(run, i) * run->phat_step + GETME_XOLD_OFF;
 }
+
+/* Node i's p-hat (3 doubles, memcpy). */
+static inline unsigned char *getme__phat(const getme_run *run, int32_t i)
+{
+    return run->phat + getme__slot(run, i) * run->phat_step;
+}
+
+/* Before node i first steps down the q_mean stage's table with a slot
+   map (save_phat): keep its p-hat, which is its position at R[0] = 1, in
+   facc entry nsaved (getme_adaptive.c).  GETME_OK or GETME_ERR_NOMEM
+   (the pool could not grow). */
+getme_status getme__save_phat(getme_run *run, int32_t i);
 
 /* Eq. 10: the trial position xn at table entry rho between old
    coordinates x and p-hat ph.  rho = 0 and rho = 1 are taken literally so
