@@ -480,6 +480,11 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
                 in_t[g] = 2;
             } else {
                 in_t[g] = 1;
+                /* a bound overflow (o): the iteration starts over, but the
+                   slot still goes back zeroed, or the next node sharing
+                   it would add onto these sums (a signed overflow) */
+                if (slot && gk < 0)
+                    f[0] = f[1] = f[2] = f[3] = 0;
             }
         }
     }
@@ -598,6 +603,13 @@ static getme_status assign_slots(getme_run *run)
         free(avail), free(back);
         return GETME_ERR_NOMEM;
     }
+    /* fixed nodes take no slot: seen already, slot -1 (never read: they
+       are not in I_T); one array less for the walk to look up */
+    for (int32_t g = 0; g < ws->nn; g++)
+        if (ws->fixed[g]) {
+            seen[g] = 1;
+            run->slot[g] = -1;
+        }
     int32_t navail = 0, made = 0;
     int np = blk->num_parts, nph = GETME_ORDER_LEVELS + ws->num_colours;
     for (int ph = 0; ph < nph; ph++) {
@@ -620,7 +632,7 @@ static getme_status assign_slots(getme_run *run)
                 int32_t b = blk->order[k];
                 for (int64_t j = blk->nptr[b]; j < blk->nptr[b + 1]; j++) {
                     int32_t g = blk->nodes[j] & INT32_MAX;
-                    if (ws->fixed[g] || seen[g])
+                    if (seen[g])
                         continue;
                     seen[g] = 1;
                     if (blk->nodes[j] < 0) { /* its only block: no slot */
@@ -633,7 +645,7 @@ static getme_status assign_slots(getme_run *run)
                 }
                 for (int64_t j = blk->nptr[b]; j < blk->nptr[b + 1]; j++) {
                     int32_t g = blk->nodes[j] & INT32_MAX;
-                    if (blk->nodes[j] < 0 && !ws->fixed[g] && run->slot[g] >= 0)
+                    if (blk->nodes[j] < 0 && run->slot[g] >= 0)
                         back[nback++] = run->slot[g];
                 }
             }
