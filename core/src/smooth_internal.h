@@ -32,14 +32,16 @@ typedef struct getme_run {
     getme_result *result;
     double t0;          /* omp_get_wtime() at start                        */
     double *q;          /* ne: quality at ws->x                            */
-    /* The target p-hat of node i: 3 doubles at phat + i * phat_step bytes,
-       and during the relaxation (Eq. 10, relax.c), which moves the nodes
-       of I_T (in_t) in ws->x itself, their old coordinates in the 3
-       doubles after it (GETME_XOLD_OFF); read and written with memcpy.  In
-       GETMe adaptive they are the first 48 bytes of the node's exact sums
-       (facc), which are zero from ComputeNewNodes to getme__reset_nodes,
-       so neither needs an array of its own (56 B per node less); Laplace
-       owns a 6 * nn array. */
+    /* The target p-hat of node i: 3 doubles at getme__phat(run, i), and
+       during the relaxation (Eq. 10, relax.c), which moves the nodes of
+       I_T (in_t) in ws->x itself, their old coordinates at
+       getme__xold(run, i); read and written with memcpy.  Laplace owns a
+       6 * nn array (p-hat, then the old coordinates: GETME_XOLD_OFF).  In
+       GETMe adaptive phat is facc: without a slot map the node's entry
+       holds both from ComputeNewNodes to getme__reset_nodes; with one,
+       the old coordinates are in xold and the p-hat in the node's slot
+       (the q*_min stage) or in ws->x until getme__save_phat (the q_mean
+       stage). */
     unsigned char *phat;
     int64_t phat_step;
     /* The nodes of run->nodes are already at R[0] (getme__place_first,
