@@ -301,20 +301,13 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
         ls[k] = adj->nsum[g];
         flag[k] = ws->fixed[g] != 0;
         if (pslot) {
-            /* A pool's long-lived entries are out of cache (perf: the
-               final addition's first load of an entry was 17 % of the
-               scatter); the block's work gives these time to arrive.
-               The slot is kept for the final addition, whose own load of
-               it missed again (6 % of the scatter). */
+            /* The slots, kept for the final addition, which prefetches
+               their entries from them (its own load of a slot missed:
+               6 % of the scatter) */
             if (k + PREFETCH_AHEAD < m)
                 __builtin_prefetch(pslot + (gn[k + PREFETCH_AHEAD] & INT32_MAX),
                                    0, 3);
-            int32_t sl = pslot[g];
-            scr->slot[k] = sl;
-            if (!flag[k] && sl >= 0) {
-                __builtin_prefetch(run->facc + 4 * (int64_t)sl, 1, 3);
-                __builtin_prefetch(run->xold + 3 * (int64_t)g, 1, 3);
-            }
+            scr->slot[k] = pslot[g];
         }
         acc[4 * k] = acc[4 * k + 1] = acc[4 * k + 2] = acc[4 * k + 3] = 0;
     }
@@ -441,11 +434,14 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
     const int32_t *slot = run->slot ? scr->slot : NULL; /* block-local */
     for (int32_t k = 0; k < m; k++) {
         if (k + PREFETCH_AHEAD < m) {
-            /* with a pool again: the block's own work moved the entries
-               the first loop fetched out to L3 (perf: 10 % of the
-               scatter) */
+            /* with a pool again (its slots block-local): the block's own
+               work moved the entries the first loop fetched out to L3
+               (perf: 10-11 % of the scatter on their first load) */
             int64_t ga = gn[k + PREFETCH_AHEAD] & INT32_MAX;
             if (slot) {
+                if (slot[k + PREFETCH_AHEAD] >= 0)
+                    __builtin_prefetch(
+                        facc + 4 * (int64_t)slot[k + PREFETCH_AHEAD], 1, 3);
                 __builtin_prefetch(run->xold + 3 * ga, 1, 3);
             } else {
                 __builtin_prefetch(facc + 4 * ga, 1, 3);
