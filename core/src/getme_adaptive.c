@@ -463,8 +463,7 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
             if (early && gk < 0) { /* the node's last block: complete */
                 double a[3];
                 node_phat(f, back, a);
-                if (slot) { /* the slot goes to the next node, zeroed */
-                    f[0] = f[1] = f[2] = f[3] = 0;
+                if (slot) {
                     getme__place_first(x, (unsigned char *)(run->xold + 3 * g),
                                        ridx, (int32_t)g, rho, a);
                 } else {
@@ -476,12 +475,12 @@ static inline void transform_block(int t, getme_run *run, int32_t b,
                 in_t[g] = 2;
             } else {
                 in_t[g] = 1;
-                /* a bound overflow (o): the iteration starts over, but the
-                   slot still goes back zeroed, or the next node sharing
-                   it would add onto these sums (a signed overflow) */
-                if (slot && gk < 0)
-                    f[0] = f[1] = f[2] = f[3] = 0;
             }
+            /* the slot goes to the next node zeroed, also after a bound
+               overflow (o: the iteration starts over), or the next node
+               sharing it would add onto these sums (a signed overflow) */
+            if (slot && gk < 0)
+                f[0] = f[1] = f[2] = f[3] = 0;
         }
     }
     *count += n;
@@ -565,6 +564,20 @@ getme_status getme__save_phat(getme_run *run, int32_t i)
     run->slot[i] = k;
     run->pool_used = run->nsaved;
     return GETME_OK;
+}
+
+void getme__pool_reset(getme_run *run)
+{
+    for (int32_t k = 0; k < run->nsaved; k++) { /* getme__save_phat's */
+        const unsigned char *e =
+            (const unsigned char *)(run->facc + 4 * (int64_t)k);
+        int32_t i, own;
+        memcpy(&i, e + 3 * sizeof(double), sizeof i);
+        memcpy(&own, e + 3 * sizeof(double) + sizeof i, sizeof own);
+        run->slot[i] = own;
+    }
+    memset(run->facc, 0, (size_t)run->pool_used * 4 * sizeof *run->facc);
+    run->pool_used = run->nsaved = 0;
 }
 
 /* The q_mean stage's slots in the pool of sums (getme_run.slot), once per
@@ -1568,7 +1581,21 @@ double getme__threshold(getme_run *run, double fraction, int32_t min_count)
     return qt;
 }
 
-static getme_status alloc_stamps(getme_run *run);
+/* The per-thread stamps of the union walk, if some element needs it. */
+static getme_status alloc_stamps(getme_run *run)
+{
+    const getme_ws *ws = run->ws;
+    size_t ne = (size_t)(ws->ne ? ws->ne : 1);
+    if (run->adj->num_irregular == 0)
+        return GETME_OK;
+    run->stamps = calloc((size_t)ws->nt, sizeof *run->stamps);
+    if (!run->stamps)
+        return GETME_ERR_NOMEM;
+    for (int t = 0; t < ws->nt; t++)
+        if (!(run->stamps[t].mark = calloc(ne, sizeof(uint32_t))))
+            return GETME_ERR_NOMEM;
+    return GETME_OK;
+}
 
 /* The method's own scratch: the q*_min stage's element flags (its lists
    grow as needed), and the per-thread stamps of the union walk if some
@@ -1584,6 +1611,7 @@ static getme_status alloc_adaptive(getme_run *run)
        processes) and with a q_mean table from 1 (the p-hat is then the
        placed position: getme__save_phat). */
     int pool = !run->comm && run->params->relax_mean[0] == 1.0;
+    run->phat_step = 4 * (int64_t)sizeof *run->facc;
 #ifdef GETME_CHECK_SUMS
     /* Test builds: 3 threads go without, so that the tests' comparison
        of 1, 2 and 3 threads (test_adjacency) compares both, bit for bit. */
@@ -1615,26 +1643,9 @@ static getme_status alloc_adaptive(getme_run *run)
     if (!run->tflag || !run->facc)
         return GETME_ERR_NOMEM;
     run->phat = (unsigned char *)run->facc;
-    run->phat_step = 4 * (int64_t)sizeof *run->facc;
     return alloc_stamps(run);
 }
 
-/* The per-thread stamps of the union walk, if some element needs it. */
-static getme_status alloc_stamps(getme_run *run)
-{
-    const getme_ws *ws = run->ws;
-    size_t ne = (size_t)(ws->ne ? ws->ne : 1);
-    run->phat_step = 4 * (int64_t)sizeof *run->facc;
-    if (run->adj->num_irregular == 0)
-        return GETME_OK;
-    run->stamps = calloc((size_t)ws->nt, sizeof *run->stamps);
-    if (!run->stamps)
-        return GETME_ERR_NOMEM;
-    for (int t = 0; t < ws->nt; t++)
-        if (!(run->stamps[t].mark = calloc(ne, sizeof(uint32_t))))
-            return GETME_ERR_NOMEM;
-    return GETME_OK;
-}
 
 static void free_adaptive(getme_run *run)
 {

@@ -100,18 +100,8 @@ void getme__collect(getme_run *run)
 
 void getme__reset_nodes(getme_run *run)
 {
-    if (run->slot) { /* a pool (getme_adaptive.c): its used entries */
-        for (int32_t k = 0; k < run->nsaved; k++) { /* getme__save_phat */
-            const unsigned char *e =
-                (const unsigned char *)(run->facc + 4 * (int64_t)k);
-            int32_t i, own;
-            memcpy(&i, e + 3 * sizeof(double), sizeof i);
-            memcpy(&own, e + 3 * sizeof(double) + sizeof i, sizeof own);
-            run->slot[i] = own;
-        }
-        memset(run->facc, 0, (size_t)run->pool_used * 4 * sizeof *run->facc);
-        run->pool_used = run->nsaved = 0;
-    }
+    if (run->slot)
+        getme__pool_reset(run);
     const int sums = run->facc && !run->slot;
 #pragma omp parallel for schedule(static) num_threads(run->ws->nt) \
     if (run->num_nodes > GETME_PAR_MIN)

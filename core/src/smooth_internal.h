@@ -193,6 +193,10 @@ static inline unsigned char *getme__phat(const getme_run *run, int32_t i)
    (the pool could not grow). */
 getme_status getme__save_phat(getme_run *run, int32_t i);
 
+/* With a slot map: the saved nodes' own slots back, and the pool's used
+   entries (pool_used) zeroed (getme__reset_nodes). */
+void getme__pool_reset(getme_run *run);
+
 /* Eq. 10: the trial position xn at table entry rho between old
    coordinates x and p-hat ph.  rho = 0 and rho = 1 are taken literally so
    that a reset node gets its old coordinates bit for bit. */
