@@ -112,8 +112,8 @@ static void rescore(const getme_best *b, getme_run *run)
     int32_t m = 0;
     for (int64_t k = 0; k < b->n; k++) {
         int32_t v = b->node[k];
-        for (int32_t s = ws->star_ptr[v]; s < ws->star_ptr[v + 1]; s++) {
-            int32_t e = ws->star[s];
+        getme_star_it it = getme__star_open(ws, v);
+        for (int32_t e; getme__star_next(&it, &e);) {
             if (run->eflag[e])
                 continue;
             run->eflag[e] = 1;

@@ -195,8 +195,8 @@ static int memo_fails(const climb_memo *m, const getme_ws *ws,
     if (r->loss != p->loss ||
         !(p->budget <= r->budget || r->allowed_max <= r->budget))
         return 0;
-    for (int64_t j = ws->star_ptr[node]; j < ws->star_ptr[node + 1]; j++) {
-        int32_t e = ws->star[j];
+    getme_star_it it = getme__star_open(ws, node);
+    for (int32_t e; getme__star_next(&it, &e);) {
         int t = getme__ws_type(ws, e);
         const int32_t *c = getme__ws_nodes(ws, t, e);
         for (int i = 0; i < getme__nv[t]; i++) {
@@ -444,16 +444,16 @@ static getme_status fill(getme_run *run, getme_patch *p, const int32_t *mv,
     /* bit 0 of eflag: in this patch.  In a levelled sweep the patches of
        one level are disjoint (two that shared an element would conflict:
        it holds a node one of them moves and the other reads) */
-    for (int j = 0; j < k && st == GETME_OK; j++)
-        for (int64_t s = ws->star_ptr[mv[j]];
-             s < ws->star_ptr[mv[j] + 1] && st == GETME_OK; s++) {
-            int32_t e = ws->star[s];
+    for (int j = 0; j < k && st == GETME_OK; j++) {
+        getme_star_it it = getme__star_open(ws, mv[j]);
+        for (int32_t e; st == GETME_OK && getme__star_next(&it, &e);) {
             if (run->eflag[e] & 1)
                 continue;
             run->eflag[e] |= 1;
             int t = getme__ws_type(ws, e);
             st = getme__patch_add(p, t, getme__ws_nodes(ws, t, e), e);
         }
+    }
     for (int32_t i = 0; i < p->n; i++)
         run->eflag[p->id[i]] &= (uint8_t)~1;
     if (!known) {

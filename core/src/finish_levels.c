@@ -84,7 +84,7 @@ static int64_t patch_slots(getme_levels *lv, const getme_ws *ws, int32_t e,
 {
     int64_t refs = 1;
     for (int j = 0; j < k; j++)
-        refs += ws->star_ptr[w[j] + 1] - ws->star_ptr[w[j]];
+        refs += getme__star_size(ws, w[j]);
     if (reserve(lv, refs) != 0)
         return -1;
     int64_t m = 0;
@@ -94,8 +94,11 @@ static int64_t patch_slots(getme_levels *lv, const getme_ws *ws, int32_t e,
 #ifdef GETME_FINISH_MUTANT /* test builds: a broken rule must be caught */
         if (j == 0)
 #endif
-        for (int64_t s = ws->star_ptr[w[j]]; s < ws->star_ptr[w[j] + 1]; s++)
-            lv->slot[m++] = slot_of(lv, ws->star[s]);
+        {
+            getme_star_it it = getme__star_open(ws, w[j]);
+            for (int32_t e; getme__star_next(&it, &e);)
+                lv->slot[m++] = slot_of(lv, e);
+        }
     return m;
 }
 

@@ -20,6 +20,7 @@
 #ifndef GETME_FINISH_LEVELS_H
 #define GETME_FINISH_LEVELS_H
 
+#include "stars.h"
 #include "workspace.h"
 
 typedef struct getme_levels {

@@ -958,23 +958,23 @@ static int32_t scatter_some(getme_run *run, double qt, double sigma)
     }
     int64_t stars = 0; /* the elements around I_T, with repeats */
     for (int32_t k = 0; k < nn; k++)
-        stars += ws->star_ptr[run->nodes[k] + 1] - ws->star_ptr[run->nodes[k]];
+        stars += getme__star_size(ws, run->nodes[k]);
     if (RING_SWEEP(ws, stars)) { /* marked, then in order */
-        for (int32_t k = 0; k < nn; k++)
-            for (int64_t j = ws->star_ptr[run->nodes[k]];
-                 j < ws->star_ptr[run->nodes[k] + 1]; j++)
-                run->eflag[ws->star[j]] = 1;
+        for (int32_t k = 0; k < nn; k++) {
+            getme_star_it it = getme__star_open(ws, run->nodes[k]);
+            for (int32_t e; getme__star_next(&it, &e);)
+                run->eflag[e] = 1;
+        }
         ne = ring_sweep(run);
     } else {
-        for (int32_t k = 0; k < nn; k++)
-            for (int64_t j = ws->star_ptr[run->nodes[k]];
-                 j < ws->star_ptr[run->nodes[k] + 1]; j++) {
-                int32_t e = ws->star[j];
+        for (int32_t k = 0; k < nn; k++) {
+            getme_star_it it = getme__star_open(ws, run->nodes[k]);
+            for (int32_t e; getme__star_next(&it, &e);)
                 if (!run->eflag[e]) {
                     run->eflag[e] = 1;
                     run->elems[ne++] = e;
                 }
-            }
+        }
         for (int32_t k = 0; k < ne; k++)
             run->eflag[run->elems[k]] = 0;
     }
@@ -1276,15 +1276,13 @@ static void set_bounds(getme_run *run)
 {
     const getme_ws *ws = run->ws;
     double m = 0.0;
-    int64_t big = 0;
+    int64_t big = ws->max_star;
 #pragma omp parallel for schedule(static) num_threads(ws->nt) \
-    reduction(max : m, big)
+    reduction(max : m)
     for (int32_t i = 0; i < ws->nn; i++) {
         const double *x = ws->x + 3 * (int64_t)i;
         for (int d = 0; d < 3; d++)
             m = fabs(x[d]) > m ? fabs(x[d]) : m;
-        int64_t s = ws->star_ptr[i + 1] - ws->star_ptr[i];
-        big = s > big ? s : big;
     }
     double neg[2] = {-m, -(double)big}; /* maxima of the whole mesh */
     getme__dist_min(run, neg, 2);

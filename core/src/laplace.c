@@ -34,8 +34,8 @@ static void neighbour_mean(const getme_ws *ws, int32_t i, int32_t *buf,
                            double *m)
 {
     int32_t n = 0;
-    for (int64_t k = ws->star_ptr[i]; k < ws->star_ptr[i + 1]; k++) {
-        int32_t e = ws->star[k];
+    getme_star_it it = getme__star_open(ws, i);
+    for (int32_t e; getme__star_next(&it, &e);) {
         int t = getme__ws_type(ws, e);
         const int32_t *c = getme__ws_nodes(ws, t, e);
         for (int j = 0; j < NUM_EDGES[t]; j++) {
@@ -62,8 +62,9 @@ static void neighbour_mean(const getme_ws *ws, int32_t i, int32_t *buf,
 static double star_quality_at(const getme_ws *ws, int32_t i, const double *p)
 {
     double sum = 0.0;
-    for (int64_t k = ws->star_ptr[i]; k < ws->star_ptr[i + 1]; k++) {
-        int32_t e = ws->star[k];
+    int32_t n = 0;
+    getme_star_it it = getme__star_open(ws, i);
+    for (int32_t e; getme__star_next(&it, &e); n++) {
         int t = getme__ws_type(ws, e);
         double x[3 * GETME_MAX_NV];
         getme__ws_gather(ws, ws->x, t, e, x);
@@ -73,7 +74,7 @@ static double star_quality_at(const getme_ws *ws, int32_t i, const double *p)
                 x[3 * j] = p[0], x[3 * j + 1] = p[1], x[3 * j + 2] = p[2];
         sum += getme__quality(t, x);
     }
-    return sum / (double)(ws->star_ptr[i + 1] - ws->star_ptr[i]);
+    return sum / (double)n;
 }
 
 /* Candidate moves of all free nodes into phat / in_t; returns the count. */
@@ -91,9 +92,11 @@ static int32_t propose(getme_run *run, int32_t *scratch, int32_t per_thread)
             double m[3];
             neighbour_mean(ws, i, buf, m);
             double before = 0.0;
-            for (int64_t k = ws->star_ptr[i]; k < ws->star_ptr[i + 1]; k++)
-                before += run->q[ws->star[k]];
-            before /= (double)(ws->star_ptr[i + 1] - ws->star_ptr[i]);
+            int32_t n = 0;
+            getme_star_it it = getme__star_open(ws, i);
+            for (int32_t e; getme__star_next(&it, &e); n++)
+                before += run->q[e];
+            before /= (double)n;
             if (star_quality_at(ws, i, m) > before) {
                 memcpy(run->phat + i * run->phat_step, m, sizeof m);
                 run->in_t[i] = 1;

@@ -297,10 +297,9 @@ static void step_nodes(getme_run *run, const double *R, int nR, int32_t m)
     }
     for (int32_t j = 0; j < m; j++) {
         int32_t i = run->list[j];
-        for (int64_t k = ws->star_ptr[i]; k < ws->star_ptr[i + 1]; k++) {
-            int32_t e = ws->star[k];
+        getme_star_it it = getme__star_open(ws, i);
+        for (int32_t e; getme__star_next(&it, &e);)
             set_q(run, getme__ws_type(ws, e), e, trial_quality(run, e));
-        }
     }
 }
 
@@ -352,9 +351,9 @@ static void steps_local(getme_run *run, const double *R, int nR,
             fail |= keep_if_invalid(run, bad[k], &next, &n, &cap_next);
         for (int32_t j = 0; j < m; j++) {
             int32_t i = run->list[j];
-            for (int64_t k = ws->star_ptr[i]; k < ws->star_ptr[i + 1]; k++)
-                fail |= keep_if_invalid(run, ws->star[k], &next, &n,
-                                        &cap_next);
+            getme_star_it it = getme__star_open(ws, i);
+            for (int32_t e; getme__star_next(&it, &e);)
+                fail |= keep_if_invalid(run, e, &next, &n, &cap_next);
         }
         for (int32_t k = 0; k < n; k++)
             run->eflag[next[k]] &= 0x7f;

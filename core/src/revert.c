@@ -93,8 +93,8 @@ static int rescore(const getme_input *in, const getme_ws *ws, double *q,
 {
     for (int64_t k = 0; k < nodes->n; k++) {
         int32_t v = nodes->v[k];
-        for (int32_t s = ws->star_ptr[v]; s < ws->star_ptr[v + 1]; s++) {
-            int32_t e = ws->star[s];
+        getme_star_it it = getme__star_open(ws, v);
+        for (int32_t e; getme__star_next(&it, &e);) {
             q[e] = getme__ws_quality(ws, ws->x, e);
             if (ws->free_elem[e] && q[e] < in->q_min_star &&
                 getme__push_i32(&bad->v, &bad->n, &bad->cap, e))

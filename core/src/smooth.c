@@ -377,6 +377,7 @@ getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
     }
     getme__ws_lend_x(&ws, mesh); /* the input is checked: back at store */
     getme__ws_pack_map(&ws);     /* unread until the end */
+    getme__stars_pack(&ws);      /* read node by node from here on */
     st = params->method == GETME_METHOD_SMART_LAPLACE ? getme__laplace(&run)
                                                       : getme__adaptive(&run);
     getme__ws_unpack_map(&ws); /* into the stars' array: no allocation */

@@ -6,6 +6,7 @@
 #define GETME_SMOOTH_INTERNAL_H
 
 #include "exact.h"
+#include "stars.h"
 #include "workspace.h"
 
 #include <string.h>

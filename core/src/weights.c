@@ -43,19 +43,20 @@ static double union_weight(const getme_ws *ws, const getme_adj *adj,
     uint32_t *mark = st->mark;
     int64_t total = 0;
     for (int i = 0; i < nv; i++)
-        total += ws->star_ptr[c[i] + 1] - ws->star_ptr[c[i]];
+        total += getme__star_bound(ws, c[i]);
 
     if (total > MAX_UNION) {
         uint64_t sum = 0; /* < nv 2^61: see getme__adj_nsum */
         int32_t count = 0;
-        for (int i = 0; i < nv; i++)
-            for (int64_t k = ws->star_ptr[c[i]]; k < ws->star_ptr[c[i] + 1]; k++) {
-                int32_t n = ws->star[k];
+        for (int i = 0; i < nv; i++) {
+            getme_star_it it = getme__star_open(ws, c[i]);
+            for (int32_t n; getme__star_next(&it, &n);) {
                 int fresh = mark[n] != now;
                 mark[n] = now;
                 sum += fresh ? (uint64_t)getme__fx64(q[n], qs) : 0;
                 count += fresh;
             }
+        }
         return sqrt((double)sum * adj->qinv / ((double)count * q[e]));
     }
     /* Pass 1: the union's members, each once (branch-free append).
@@ -65,11 +66,9 @@ static double union_weight(const getme_ws *ws, const getme_adj *adj,
     int32_t u[MAX_UNION];
     int32_t count = 0;
     for (int i = 0; i < nv; i++) {
-        const int32_t *s = ws->star + ws->star_ptr[c[i]];
-        const int32_t *end = ws->star + ws->star_ptr[c[i] + 1];
-        for (; s < end; s++) {
-            int32_t n = *s;
-            u[count] = n;
+        getme_star_it it = getme__star_open(ws, c[i]);
+        for (int32_t n; getme__star_next(&it, &n);) {
+            u[count] = n; /* count < total <= MAX_UNION */
             count += mark[n] != now;
             mark[n] = now;
         }

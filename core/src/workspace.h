@@ -41,7 +41,10 @@ typedef struct getme_ws {
     int32_t *star_ptr;   /* nn + 1; 32-bit: the stars hold every element's
                             nodes, so fewer than 2^31 entries (the build
                             fails with GETME_ERR_NOMEM beyond)              */
-    int32_t *star;       /* incident elements of each node, ascending       */
+    int32_t *star;       /* incident elements of each node, ascending; from
+                            the loop on packed (stars.h: star_ptr then
+                            holds byte offsets)                             */
+    int stars_packed;
     int32_t max_star;    /* largest star                                     */
     /* colour-blocks */
     int32_t num_blocks;
