@@ -69,8 +69,9 @@ void getme__stars_pack(getme_ws *ws)
         {
             to[0] = 0;
             for (int t = 0; t < team; t++) {
-                memmove(bytes + to[t], bytes + from[t],
-                        (size_t)(end[t] - from[t]));
+                if (to[t] != from[t]) /* the first range stays put */
+                    memmove(bytes + to[t], bytes + from[t],
+                            (size_t)(end[t] - from[t]));
                 to[t + 1] = to[t] + end[t] - from[t];
             }
             ptr[ws->nn] = (int32_t)to[team];
