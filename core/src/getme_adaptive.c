@@ -681,16 +681,21 @@ static int32_t scatter_all(getme_run *run)
 }
 
 /* The q_mean stage's I_T (every free node in use): the same in every
-   iteration, so built once.  Its element list, every free element, is
-   implicit (relax.c): run->elems stays untouched, so not resident, until
-   the q*_min stage. */
+   iteration.  Both its lists are implicit: the nodes (getme__run_node)
+   and every free element (relax.c), so run->nodes and run->elems stay
+   untouched, so not resident, until the q*_min stage.  A distributed
+   part run lists its nodes (dist.c reads the list). */
 static void lists_all(getme_run *run)
 {
     const getme_ws *ws = run->ws;
     int32_t m = 0;
+    run->nodes_all = !run->comm;
     for (int32_t i = 0; i < ws->nn; i++)
-        if (!ws->fixed[i] && ws->star_ptr[i + 1] > ws->star_ptr[i])
-            run->nodes[m++] = i;
+        if (!ws->fixed[i] && ws->star_ptr[i + 1] > ws->star_ptr[i]) {
+            if (run->comm)
+                run->nodes[m] = i;
+            m++;
+        }
     run->num_nodes = m;
     run->num_elems = (int32_t)ws->num_free_elem;
 }
@@ -929,6 +934,7 @@ static int32_t scatter_some(getme_run *run, double qt, double sigma)
 {
     const getme_ws *ws = run->ws;
     int32_t nn = 0, ne = 0;
+    run->nodes_all = 0;
     for (int32_t k = 0; k < run->num_t; k++) { /* I_T */
         int32_t e = run->tlist[k];
         int t = getme__ws_type(ws, e);
@@ -1206,13 +1212,12 @@ static void compute_new_nodes(getme_run *run, double rho0)
     double *x = run->ws->x;
     uint8_t *ridx = run->ridx;
     const uint8_t *in_t = run->in_t;
-    const int32_t *nodes = run->nodes;
-    int32_t nn = run->num_nodes;
+    int32_t nn = getme__run_nodes_end(run);
 #pragma omp parallel for schedule(static) num_threads(run->ws->nt) \
     if (nn > GETME_PAR_MIN)
     for (int32_t k = 0; k < nn; k++) {
-        int32_t n = nodes[k];
-        if (in_t[n] == 2)
+        int32_t n = getme__run_node(run, k);
+        if (n < 0 || in_t[n] == 2)
             continue; /* placed by its last block (transform_block) */
         getme_fx *f = facc + 4 * getme__slot(run, n);
         double a[3];
@@ -1231,16 +1236,20 @@ static void compute_new_nodes(getme_run *run, double rho0)
    set. */
 static void clear_sums(getme_run *run)
 {
-    for (int32_t k = 0; k < run->num_nodes; k++) {
-        int32_t n = run->nodes[k];
-        if (run->in_t[n] == 2)
+    int32_t end = getme__run_nodes_end(run);
+    for (int32_t k = 0; k < end; k++) {
+        int32_t n = getme__run_node(run, k);
+        if (n >= 0 && run->in_t[n] == 2)
             memcpy(run->ws->x + 3 * (int64_t)n, getme__xold(run, n),
                    3 * sizeof(double));
     }
     memset(run->facc, 0, (size_t)run->pool_cap * 4 * sizeof *run->facc);
     run->pool_used = run->nsaved = 0;
-    for (int32_t k = 0; k < run->num_nodes; k++)
-        run->in_t[run->nodes[k]] = 0;
+    for (int32_t k = 0; k < end; k++) {
+        int32_t n = getme__run_node(run, k);
+        if (n >= 0)
+            run->in_t[n] = 0;
+    }
 }
 
 /* This iteration's fixed-point scales (exact.h), from bounds every term

@@ -372,18 +372,21 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
 {
     getme_ws *ws = run->ws;
     double *q = run->q;
-    const int32_t *nodes = run->nodes, *elems = run->elems;
-    const int32_t nn = run->num_nodes, ne = run->num_elems;
+    const int32_t *elems = run->elems;
+    const int32_t nn = getme__run_nodes_end(run), ne = run->num_elems;
     int nt = ws->nt;
     int32_t invalid; /* elements of the list invalid after the first pass */
 
     if (!run->placed) {
 #pragma omp parallel for schedule(static) num_threads(nt) if (nn > GETME_PAR_MIN)
         for (int32_t k = 0; k < nn; k++) {
+            int32_t i = getme__run_node(run, k);
+            if (i < 0)
+                continue;
             double ph[3];
-            memcpy(ph, getme__phat(run, nodes[k]), sizeof ph);
-            getme__place_first(ws->x, getme__xold(run, nodes[k]), run->ridx,
-                               nodes[k], R[0], ph);
+            memcpy(ph, getme__phat(run, i), sizeof ph);
+            getme__place_first(ws->x, getme__xold(run, i), run->ridx, i,
+                               R[0], ph);
         }
     }
     run->placed = 0;
@@ -415,8 +418,8 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
 #pragma omp parallel for schedule(static) num_threads(nt) \
     reduction(+ : relaxed) if (nn > GETME_PAR_MIN)
     for (int32_t k = 0; k < nn; k++) {
-        int32_t i = nodes[k];
-        relaxed += run->ridx[i] > 0;
+        int32_t i = getme__run_node(run, k);
+        relaxed += i >= 0 && run->ridx[i] > 0;
     }
     return relaxed;
 }

@@ -103,10 +103,13 @@ void getme__reset_nodes(getme_run *run)
     if (run->slot)
         getme__pool_reset(run);
     const int sums = run->facc && !run->slot;
+    int32_t end = getme__run_nodes_end(run);
 #pragma omp parallel for schedule(static) num_threads(run->ws->nt) \
-    if (run->num_nodes > GETME_PAR_MIN)
-    for (int32_t k = 0; k < run->num_nodes; k++) {
-        int32_t i = run->nodes[k];
+    if (end > GETME_PAR_MIN)
+    for (int32_t k = 0; k < end; k++) {
+        int32_t i = getme__run_node(run, k);
+        if (i < 0)
+            continue;
         run->in_t[i] = 0;
         if (sums) { /* stored as sums again: zero as sums */
             getme_fx *f = run->facc + 4 * (int64_t)i;

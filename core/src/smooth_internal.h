@@ -62,7 +62,12 @@ typedef struct getme_run {
     uint8_t *flag;      /* nn: scratch flag, all zero between uses          */
     uint8_t *ridx;      /* nn: index into the relaxation table              */
     uint8_t *eflag;     /* ne: scratch flag                                 */
-    int32_t *nodes;     /* nn: compacted list of I_T                        */
+    int32_t *nodes;     /* nn: compacted list of I_T; implicit while
+                           nodes_all (getme__run_node)                    */
+    int nodes_all;      /* I_T is every free node in use (GETMe adaptive's
+                           q_mean stage, one process): run->nodes stays
+                           untouched, so not resident, until the q*min
+                           stage                                          */
     int32_t *elems;     /* ne: compacted list of elements touching I_T; in
                            GETMe adaptive's q_mean stage (live) every free
                            element, which it then does not hold (relax.c) */
@@ -170,6 +175,25 @@ void getme__collect(getme_run *run);
    (GETME_XOLD_OFF): the trial qualities gather from the dense coordinate
    array, the end of the relaxation has nothing to copy, and no trial
    array is needed (24 B per node).  Node i's old coordinates: */
+static inline int64_t getme__slot(const getme_run *run, int32_t i);
+
+/* I_T node by node: for (k = 0; k < getme__run_nodes_end(run); k++)
+   with n = getme__run_node(run, k), skipping n < 0.  While nodes_all,
+   k runs over every node and n is k if the node is free and in an
+   element, else -1: the same nodes in the same order as the list. */
+static inline int32_t getme__run_nodes_end(const getme_run *run)
+{
+    return run->nodes_all ? run->ws->nn : run->num_nodes;
+}
+
+static inline int32_t getme__run_node(const getme_run *run, int32_t k)
+{
+    if (!run->nodes_all)
+        return run->nodes[k];
+    const getme_ws *ws = run->ws;
+    return !ws->fixed[k] && ws->star_ptr[k + 1] > ws->star_ptr[k] ? k : -1;
+}
+
 static inline int64_t getme__slot(const getme_run *run, int32_t i)
 {
     return run->slot ? run->slot[i] : i;
