@@ -114,7 +114,7 @@ getme_status getme_mesh_distort(getme_mesh *mesh, uint64_t seed, double amount,
         if (target_q_mean > 0.0 && q_mean <= target_q_mean)
             break;
         for (int32_t i = 0; i < ws.nn; i++)
-            if (!ws.fixed[i] && ws.star_ptr[i + 1] > ws.star_ptr[i])
+            if (getme__ws_moves(&ws, i))
                 move_node(&ws, i, amount, &rng);
         getme__ws_qualities(&ws, q);
     }

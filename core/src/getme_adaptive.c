@@ -691,7 +691,7 @@ static void lists_all(getme_run *run)
     int32_t m = 0;
     run->nodes_all = !run->comm;
     for (int32_t i = 0; i < ws->nn; i++)
-        if (!ws->fixed[i] && ws->star_ptr[i + 1] > ws->star_ptr[i]) {
+        if (getme__ws_moves(ws, i)) {
             if (run->comm)
                 run->nodes[m] = i;
             m++;

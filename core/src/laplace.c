@@ -87,7 +87,7 @@ static int32_t propose(getme_run *run, int32_t *scratch, int32_t per_thread)
         int32_t *buf = scratch + (int64_t)omp_get_thread_num() * per_thread;
 #pragma omp for schedule(static)
         for (int32_t i = 0; i < ws->nn; i++) {
-            if (ws->fixed[i] || ws->star_ptr[i + 1] == ws->star_ptr[i])
+            if (!getme__ws_moves(ws, i))
                 continue;
             double m[3];
             neighbour_mean(ws, i, buf, m);

@@ -170,17 +170,11 @@ double getme__weight_union(const getme_run *run, int t, int32_t e);
    I_T), both ascending; deterministic. */
 void getme__collect(getme_run *run);
 
-/* During the relaxation ws->x holds the trial coordinates, and a node
-   that moves (I_T, in_t) keeps its old coordinates after its p-hat
-   (GETME_XOLD_OFF): the trial qualities gather from the dense coordinate
-   array, the end of the relaxation has nothing to copy, and no trial
-   array is needed (24 B per node).  Node i's old coordinates: */
-static inline int64_t getme__slot(const getme_run *run, int32_t i);
-
 /* I_T node by node: for (k = 0; k < getme__run_nodes_end(run); k++)
    with n = getme__run_node(run, k), skipping n < 0.  While nodes_all,
-   k runs over every node and n is k if the node is free and in an
-   element, else -1: the same nodes in the same order as the list. */
+   k runs over every node and n is k if the smoother moves it
+   (getme__ws_moves), else -1: the same nodes in the same order as the
+   list. */
 static inline int32_t getme__run_nodes_end(const getme_run *run)
 {
     return run->nodes_all ? run->ws->nn : run->num_nodes;
@@ -190,10 +184,14 @@ static inline int32_t getme__run_node(const getme_run *run, int32_t k)
 {
     if (!run->nodes_all)
         return run->nodes[k];
-    const getme_ws *ws = run->ws;
-    return !ws->fixed[k] && ws->star_ptr[k + 1] > ws->star_ptr[k] ? k : -1;
+    return getme__ws_moves(run->ws, k) ? k : -1;
 }
 
+/* During the relaxation ws->x holds the trial coordinates, and a node
+   that moves (I_T, in_t) keeps its old coordinates after its p-hat
+   (GETME_XOLD_OFF): the trial qualities gather from the dense coordinate
+   array, the end of the relaxation has nothing to copy, and no trial
+   array is needed (24 B per node).  Node i's old coordinates: */
 static inline int64_t getme__slot(const getme_run *run, int32_t i)
 {
     return run->slot ? run->slot[i] : i;

@@ -9,9 +9,10 @@
  * So getme__stars_pack stores each star as the differences of its
  * ascending elements (the first from 0), each in LEB128 (7 bits per byte,
  * the high bit set on all but a value's last byte).  Elements are in
- * Morton order, so a star's elements are near each other: a hex's star
- * of 8 takes about 14 bytes instead of 32, a tet's about 30 instead of
- * 92.  ws->star_ptr then holds byte offsets.
+ * Morton order, so a star's elements are near each other: on the full
+ * benchmark meshes a hex mesh's star of ~7.7 elements takes ~11 bytes
+ * instead of 31, a tet mesh's of ~22.6 ~27 instead of 90 (docs/bench.md,
+ * session 14).  ws->star_ptr then holds byte offsets.
  *
  * Every reader after the set-up walks a star with getme__star_open and
  * getme__star_next, which read either form: the distributed part runs,

@@ -124,6 +124,13 @@ uint32_t getme__morton(const double *x, const double lo[3],
    lent coordinates are returned (getme__ws_return_x). */
 void getme__ws_store(getme_ws *ws, getme_mesh *mesh);
 
+/* Node i is one the smoother moves: free and in an element (star_ptr's
+   difference is 0 exactly for an empty star, plain or packed). */
+static inline int getme__ws_moves(const getme_ws *ws, int32_t i)
+{
+    return !ws->fixed[i] && ws->star_ptr[i + 1] > ws->star_ptr[i];
+}
+
 static inline int getme__ws_type(const getme_ws *ws, int32_t e)
 {
     int t = 0;
