@@ -134,7 +134,16 @@ static uint64_t adj_hash(const getme_adj *adj, const getme_ws *ws)
         h = fnv(h, adj->eslot, (size_t)ns);
         h = fnv(h, &adj->num_edges, 4);
     }
-    h = fnv(h, adj->fnb, (size_t)nf * 4);
+    /* the face table as int32 entries, whatever its form (facenb.h) */
+    for (int t = 0; t < GETME_NUM_TYPES; t++) {
+        int nft = getme__faces[t].num_faces;
+        for (int32_t e = ws->tstart[t]; e < ws->tstart[t + 1]; e++) {
+            int32_t f[6];
+            getme__adj_faces(adj, ws, t, e, f);
+            h = fnv(h, f, (size_t)nft * 4);
+        }
+    }
+    (void)nf;
     h = fnv(h, adj->count, ne * 2);
     h = fnv(h, adj->irregular, ne);
     h = fnv(h, &adj->num_irregular, 4);
@@ -191,8 +200,11 @@ int main(int argc, char **argv)
         t[1] = cpu();
         int64_t foff[GETME_NUM_TYPES];
         int64_t nf = getme__ws_face_offsets(&ws, foff);
-        ws.faces = malloc((size_t)(nf ? nf : 1) * sizeof *ws.faces);
-        if (!ws.faces || getme__ws_faces(&ws, foff, ws.faces) != GETME_OK)
+        /* the face search and its packing, as getme_mesh_fix_boundary
+           does them (facenb.h) */
+        int32_t *table = malloc((size_t)(nf ? nf : 1) * sizeof *table);
+        if (!table || getme__ws_faces(&ws, foff, table) != GETME_OK ||
+            getme__facenb_pack(&ws.faces, &ws, foff, table) != GETME_OK)
             return 1;
         t[2] = cpu();
         if (getme__adj_build(&adj, &ws) != GETME_OK)

@@ -26,7 +26,7 @@ void getme__adj_free(getme_adj *adj)
 {
     free(adj->eptr);
     free(adj->eslot);
-    free(adj->fnb);
+    getme__facenb_free(&adj->fnb);
     free(adj->count);
     free(adj->irregular);
     free(adj->nsum);
@@ -318,7 +318,8 @@ static void counts_and_flags(getme_adj *adj, const getme_ws *ws,
         int t = getme__ws_type(ws, e), nv = getme__nv[t];
         const int32_t *c = getme__ws_nodes(ws, t, e);
         const getme_face_table *ft = &getme__faces[t];
-        const int32_t *f = getme__adj_faces(adj, ws, t, e);
+        int32_t f[6];
+        getme__adj_faces(adj, ws, t, e, f);
         int64_t cnt = 0, nb = 0, bad = 0;
         for (int i = 0; i < nv; i++)
             cnt += ws->star_ptr[c[i] + 1] - ws->star_ptr[c[i]];
@@ -362,7 +363,8 @@ static void check_element(getme_adj *adj, const getme_ws *ws,
     int t = getme__ws_type(ws, e), nv = getme__nv[t];
     const int32_t *c = getme__ws_nodes(ws, t, e);
     const getme_face_table *ft = &getme__faces[t];
-    const int32_t *f = getme__adj_faces(adj, ws, t, e);
+    int32_t f[6];
+    getme__adj_faces(adj, ws, t, e, f);
     /* counts_and_flags' test first, fused here (it read the same edge
        ids and faces in a pass of its own; its count was overwritten
        below): an element it would mark irregular is marked, count 0, as
@@ -491,11 +493,21 @@ getme_status getme__adj_build(getme_adj *adj, getme_ws *ws)
        are an edge or a face of it), so the formula can fail only where
        build_faces sees it; other types need the check. */
     int check = !simplices_only(ws);
-    int have_faces = ws->faces != NULL; /* the boundary search's table */
-    adj->fnb = have_faces ? ws->faces
-                          : malloc((size_t)(ftotal ? ftotal : 1) *
-                                   sizeof *adj->fnb);
-    ws->faces = NULL;
+    /* The boundary search's table, packed (facenb.h), or one built and
+       packed here first, in place, before the rest is allocated. */
+    getme_status st = GETME_ERR_NOMEM;
+    if (ws->faces.d) {
+        adj->fnb = ws->faces;
+        memset(&ws->faces, 0, sizeof ws->faces);
+    } else {
+        int32_t *table = malloc((size_t)(ftotal ? ftotal : 1) * sizeof *table);
+        if (!table || getme__ws_faces(ws, adj->foff, table) != GETME_OK) {
+            free(table);
+            return GETME_ERR_NOMEM;
+        }
+        if (getme__facenb_pack(&adj->fnb, ws, adj->foff, table) != GETME_OK)
+            return GETME_ERR_NOMEM; /* table freed */
+    }
     adj->count = malloc(ne * sizeof *adj->count);
     /* Zeroed, and only irregular elements written: on a mesh with none
        (tets) its pages are never touched, so they take no memory. */
@@ -518,16 +530,12 @@ getme_status getme__adj_build(getme_adj *adj, getme_ws *ws)
     if (check && check_scratch_bytes(ws) > sbytes)
         sbytes = check_scratch_bytes(ws);
     void *scratch = NULL;
-    getme_status st = GETME_ERR_NOMEM;
-    if (!adj->fnb || !adj->count || !adj->irregular || !adj->nsum)
+    if (!adj->count || !adj->irregular || !adj->nsum)
         goto fail;
     if (ws->dim == 3 &&
         (st = build_edges(adj, ws, &edeg, check, &re)) != GETME_OK)
         goto fail;
     st = GETME_ERR_NOMEM;
-    if (!have_faces &&
-        (st = getme__ws_faces(ws, adj->foff, adj->fnb)) != GETME_OK)
-        goto fail;
     if (!check) /* else fused into check_all's walk */
         counts_and_flags(adj, ws, edeg);
     if (ws->dim == 3) {

@@ -33,6 +33,7 @@
 
 #include "block_local.h"
 #include "exact.h"
+#include "facenb.h"
 #include "workspace.h"
 
 /* An element edge's slot that does not fit in a byte (a node with more
@@ -47,7 +48,8 @@ typedef struct getme_adj {
        byte per element edge instead of a 4-byte id saves 18 B per tet. */
     int32_t *eptr;      /* nn + 1                                          */
     uint8_t *eslot;     /* per element edge                                */
-    int32_t *fnb;       /* the element across each face (2-D: edge), -1    */
+    getme_facenb fnb;   /* the element across each face (2-D: edge), -1;
+                           2 bytes per face (facenb.h)                     */
     uint16_t *count;    /* ne: |N(E)| (exact for regular elements)         */
     uint8_t *irregular; /* ne: 1 = use the union walk for this element     */
     int32_t num_irregular;
@@ -88,13 +90,12 @@ static inline uint8_t *getme__adj_slots(const getme_adj *adj,
            (int64_t)(e - ws->tstart[t]) * getme__edges[t].num_edges;
 }
 
-/* The face neighbours of element e (type t): getme__faces[t].num_faces. */
-static inline const int32_t *getme__adj_faces(const getme_adj *adj,
-                                              const getme_ws *ws, int t,
-                                              int32_t e)
+/* The face neighbours of element e (type t) into f[]:
+   getme__faces[t].num_faces of them, at most 6. */
+static inline void getme__adj_faces(const getme_adj *adj, const getme_ws *ws,
+                                    int t, int32_t e, int32_t *f)
 {
-    return adj->fnb + adj->foff[t] +
-           (int64_t)(e - ws->tstart[t]) * getme__faces[t].num_faces;
+    getme__facenb_elem(&adj->fnb, ws, adj->foff, t, e, f);
 }
 
 /* Id of local edge j of element e (nodes c, type t), given its slot. */
@@ -180,7 +181,8 @@ static inline double getme__adj_nsum_sv(const getme_adj *adj,
 {
     const int32_t *c = getme__ws_nodes(ws, t, e);
     const getme_face_table *ft = &getme__faces[t];
-    const int32_t *f = getme__adj_faces(adj, ws, t, e);
+    int32_t f[6];
+    getme__adj_faces(adj, ws, t, e, f);
     int nv = getme__nv[t];
     /* In wrapping uint64 arithmetic: the sum over N(e) is a sum of
        non-negative terms (valid qualities, q <= 1 up to rounding), each

@@ -191,7 +191,7 @@ weights_3d(int t, const getme_run *run, int32_t e0, int32_t e1,
     const double qs = adj->qscale;
     for (int32_t c0 = e0; c0 < e1; c0 += WEIGHT_CHUNK) {
         int32_t c1 = c0 + WEIGHT_CHUNK < e1 ? c0 + WEIGHT_CHUNK : e1;
-        int32_t eid[WEIGHT_CHUNK][12];
+        int32_t eid[WEIGHT_CHUNK][12], fnb[WEIGHT_CHUNK][6];
         uint8_t kind[WEIGHT_CHUNK]; /* 0 none, 1 regular, 2 irregular */
         for (int32_t e = c0; e < c1; e++) {
             int k = !(ws->free_elem[e] && getme__owned(run, e)) ? 0
@@ -204,7 +204,8 @@ weights_3d(int t, const getme_run *run, int32_t e0, int32_t e1,
                                 getme__adj_slots(adj, ws, t, e), eid[e - c0]);
             for (int j = 0; j < ned; j++)
                 __builtin_prefetch(adj->esum + eid[e - c0][j], 0, 3);
-            const int32_t *f = getme__adj_faces(adj, ws, t, e);
+            int32_t *f = fnb[e - c0];
+            getme__adj_faces(adj, ws, t, e, f);
             for (int j = 0; j < nf; j++) /* no neighbour (-1): e itself */
                 __builtin_prefetch(q + (f[j] >= 0 ? f[j] : e), 0, 3);
         }
@@ -218,7 +219,7 @@ weights_3d(int t, const getme_run *run, int32_t e0, int32_t e1,
             if (kind[e - c0] != 1)
                 continue;
             const uint16_t *lc = getme__blocks_lnodes(scr, nv, e - e0);
-            const int32_t *f = getme__adj_faces(adj, ws, t, e);
+            const int32_t *f = fnb[e - c0];
             uint64_t sv = 0, se = 0;
             for (int i = 0; i < nv; i++)
                 sv += (uint64_t)ls[lc[i]];
@@ -746,7 +747,7 @@ static inline void some_chunks(int t, const struct some_ctx *s, int32_t j0,
     int o = 0;
     for (int32_t c0 = j0; c0 < j1; c0 += SOME_CHUNK) {
         int32_t n = c0 + SOME_CHUNK < j1 ? SOME_CHUNK : j1 - c0;
-        int32_t el[SOME_CHUNK], eid[SOME_CHUNK][12];
+        int32_t el[SOME_CHUNK], eid[SOME_CHUNK][12], fnb[SOME_CHUNK][6];
         /* bit 0 transformed, bit 1 untransformed (adds its I_T nodes),
            bit 2 irregular (the union walk's weight) */
         uint8_t kind[SOME_CHUNK];
@@ -767,7 +768,8 @@ static inline void some_chunks(int t, const struct some_ctx *s, int32_t j0,
                                 eid[i]);
             for (int j = 0; j < ned; j++)
                 __builtin_prefetch(adj->esum + eid[i][j], 0, 3);
-            const int32_t *f = getme__adj_faces(adj, ws, t, e);
+            int32_t *f = fnb[i];
+            getme__adj_faces(adj, ws, t, e, f);
             for (int j = 0; j < nf; j++) /* no neighbour (-1): e itself */
                 __builtin_prefetch(q + (f[j] >= 0 ? f[j] : e), 0, 3);
         }
@@ -779,7 +781,7 @@ static inline void some_chunks(int t, const struct some_ctx *s, int32_t j0,
                 continue;
             int32_t e = el[i];
             const int32_t *c = getme__ws_nodes(ws, t, e);
-            const int32_t *f = getme__adj_faces(adj, ws, t, e);
+            const int32_t *f = fnb[i];
             uint64_t sv = 0, se = 0;
             for (int v = 0; v < nv; v++) {
                 sv += (uint64_t)adj->nsum[c[v]];

@@ -10,6 +10,7 @@
  * workspace and the face table are then kept on the mesh (getme__ws_keep),
  * and getme_smooth() takes both over instead of building them again.
  */
+#include "facenb.h"
 #include "workspace.h"
 
 #include <omp.h>
@@ -69,14 +70,21 @@ getme_status getme_mesh_fix_boundary(getme_mesh *mesh, unsigned flags,
         return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
     int64_t foff[GETME_NUM_TYPES];
     int64_t total = getme__ws_face_offsets(&ws, foff);
-    if (!ws.faces) {
-        ws.faces = malloc((size_t)(total ? total : 1) * sizeof *ws.faces);
-        if (!ws.faces || getme__ws_faces(&ws, foff, ws.faces) != GETME_OK) {
+    /* Packed at once (facenb.h), in place: this reads it packed, and the
+       smoother takes it over.  A cached workspace has it already. */
+    if (!ws.faces.d) {
+        int32_t *table = malloc((size_t)(total ? total : 1) * sizeof *table);
+        getme_status st = GETME_ERR_NOMEM;
+        if (!table || (st = getme__ws_faces(&ws, foff, table)) != GETME_OK)
+            free(table);
+        else /* takes table, also on failure */
+            st = getme__facenb_pack(&ws.faces, &ws, foff, table);
+        if (st != GETME_OK) {
             getme__ws_free(&ws);
-            return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
+            return getme__fail(mesh, st, "out of memory");
         }
     }
-    const int32_t *fnb = ws.faces;
+    const getme_facenb *fnb = &ws.faces;
     int regions = (flags & GETME_FIX_INTERFACES) && !one_region(mesh);
     /* Which elements have a face to fix: a read-only scan of the whole
        face table, in parallel; the marking below (its writes to shared
@@ -91,7 +99,8 @@ getme_status getme_mesh_fix_boundary(getme_mesh *mesh, unsigned flags,
         int nf = getme__faces[t].num_faces;
 #pragma omp parallel for schedule(static) num_threads(ws.nt)
         for (int32_t e = ws.tstart[t]; e < ws.tstart[t + 1]; e++) {
-            const int32_t *f = fnb + foff[t] + (int64_t)(e - ws.tstart[t]) * nf;
+            int32_t f[6];
+            getme__facenb_elem(fnb, &ws, foff, t, e, f);
             int any = 0;
             for (int k = 0; k < nf; k++)
                 any |= face_fixed(mesh, &ws, e, f[k], flags, regions) != 0;
@@ -104,7 +113,8 @@ getme_status getme_mesh_fix_boundary(getme_mesh *mesh, unsigned flags,
             if (!touch[e])
                 continue;
             const int32_t *c = getme__ws_nodes(&ws, t, e);
-            const int32_t *f = fnb + foff[t] + (int64_t)(e - ws.tstart[t]) * ft->num_faces;
+            int32_t f[6];
+            getme__facenb_elem(fnb, &ws, foff, t, e, f);
             for (int k = 0; k < ft->num_faces; k++) {
                 int why = face_fixed(mesh, &ws, e, f[k], flags, regions);
                 for (int j = 0; why && j < ft->size[k]; j++)

@@ -4,6 +4,8 @@
  */
 #include "exact.h"
 #include "workspace.h"
+
+#include "facenb.h"
 #include "tally.h"
 
 #include <math.h>
@@ -36,7 +38,7 @@ void getme__ws_free(getme_ws *ws)
     free(ws->block_start);
     free(ws->colour_ptr);
     free(ws->colour_blocks);
-    free(ws->faces);
+    getme__facenb_free(&ws->faces);
     getme__packed_free(&ws->elem_packed);
     getme__packed_free(&ws->node_packed);
     getme__ho_free(ws->ho);

@@ -22,6 +22,15 @@
 
 #include <stdint.h>
 
+/* The face table, 2 bytes per face (facenb.h). */
+typedef struct getme_facenb {
+    int16_t *d;       /* per entry: 0 skin, GETME_FNB_ESCAPE, else nb - e */
+    uint16_t *ekey;   /* escapes: position in their chunk, ascending      */
+    int32_t *enb;     /* escapes: the neighbour                           */
+    int64_t *cptr;    /* chunks + 1: each chunk's first escape            */
+    int64_t n;        /* entries                                          */
+} getme_facenb;
+
 typedef struct getme_ws {
     int dim;
     int nt;              /* OpenMP threads to use                           */
@@ -64,9 +73,9 @@ typedef struct getme_ws {
        block (node_orig then points inside it, after elem_orig)            */
     getme_packed elem_packed, node_packed;
     int maps_packed;
-    int32_t *faces;       /* the face table (getme__ws_faces) the boundary
-                             search computed, for getme__adj_build to take
-                             over, or NULL                                  */
+    getme_facenb faces;   /* the face table (getme__ws_faces) the boundary
+                             search computed, packed, for getme__adj_build
+                             to take over; faces.d NULL if none             */
 } getme_ws;
 
 /* Walks over the stars (edges, faces) touch each star's elements at

@@ -126,6 +126,10 @@ typedef struct getme__model_in {
     int nodes_distinct;            /* 1: the caller refused, with its own
                                       message, every element that has a node
                                       twice; the builder does not look again */
+    int keep_copies;               /* 1: the caller takes out->xyz and
+                                      out->fixed after step 2; 0: step 2
+                                      frees them as soon as the mesh has
+                                      its own (a lower peak while reading) */
 } getme__model_in;
 
 typedef struct getme__frame {
@@ -137,8 +141,11 @@ typedef struct getme__frame {
 typedef struct getme__model_out {
     int32_t num_nodes;
     int32_t *loc;       /* caller's node -> mesh node, -1 if unused       */
-    double *xyz;        /* 3 per mesh node, in the mesh's frame           */
-    uint8_t *fixed;     /* fixed by classification / named groups         */
+    double *xyz;        /* 3 per mesh node, in the mesh's frame; freed
+                           (NULL) once step 2 has made the mesh, unless
+                           getme__model_in.keep_copies                     */
+    uint8_t *fixed;     /* fixed by classification / named groups; the
+                           same                                           */
     int32_t num_elements;
     int64_t *elem_ids;  /* per mesh element: its tag                      */
     getme_mesh *mesh;

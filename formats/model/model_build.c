@@ -263,6 +263,10 @@ static getme_status mark_fixed(const getme__model_in *in,
                                getme__model_out *out)
 {
     getme_status st = getme_mesh_set_fixed_mask(out->mesh, out->fixed);
+    if (!in->keep_copies) { /* the mesh's now */
+        free(out->fixed);
+        out->fixed = NULL;
+    }
     if (st == GETME_OK && in->fix_flags)
         st = getme_mesh_fix_boundary(out->mesh, in->fix_flags, NULL);
     return st == GETME_OK ? GETME_OK : mesh_error(out, st);
@@ -285,6 +289,12 @@ getme_status getme__model_finish(getme__model_in *in, getme__model_out *out)
         if (st != GETME_OK)
             snprintf(out->msg, sizeof out->msg,
                      "Could not create the mesh: %s", getme_status_string(st));
+    }
+    /* The mesh has its own copy: ours goes before the elements and the
+       boundary search (24 B per node less at the reading's peak). */
+    if (!in->keep_copies) {
+        free(out->xyz);
+        out->xyz = NULL;
     }
     if (st == GETME_OK)
         st = add_blocks(in, out);

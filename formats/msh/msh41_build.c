@@ -317,8 +317,10 @@ getme_formats_status msh41_build(msh41_reader *r, msh41_doc *m)
            mesh copies the coordinates. */
         free(r->xyz);
         free(r->tags);
+        free(out.loc);
         r->xyz = NULL;
         r->tags = NULL;
+        out.loc = NULL;
         gs = getme__model_finish(&in, &out);
         if (gs != GETME_OK)
             st = model_fail(r, gs, out.msg);

@@ -283,6 +283,7 @@ static getme_status build(getme_gmsh_model *m, gg_read *r,
         .phys = r->phys,
         .num_phys = r->num_phys,
         .z_plane_only = 0,
+        .keep_copies = 1, /* take_output keeps both */
         .fix_flags = (opt->fix_skin ? GETME_FIX_SKIN : 0u) |
                      (opt->fix_interfaces ? GETME_FIX_INTERFACES : 0u)};
     getme__model_out out;

@@ -690,7 +690,13 @@ static void same_setup(const getme_ws *a, const getme_adj *aa,
         /* the local connectivity follows from these and conn (it is
            rebuilt per block: getme__blocks_localise) */
     }
-    SAME(aa->fnb, ab->fnb, nf);
+    SAME(aa->fnb.d, ab->fnb.d, nf);
+    int64_t nch = (nf + GETME_FNB_CHUNK - 1) / GETME_FNB_CHUNK;
+    SAME(aa->fnb.cptr, ab->fnb.cptr, nch + 1);
+    if (aa->fnb.cptr[nch] == ab->fnb.cptr[nch]) {
+        SAME(aa->fnb.ekey, ab->fnb.ekey, aa->fnb.cptr[nch]);
+        SAME(aa->fnb.enb, ab->fnb.enb, aa->fnb.cptr[nch]);
+    }
     SAME(aa->count, ab->count, a->ne);
     SAME(aa->irregular, ab->irregular, a->ne);
     CHECK_EQ_INT(aa->num_irregular, ab->num_irregular);
@@ -786,9 +792,11 @@ static void check_faces_reference(const getme_ws *ws, const getme_adj *adj,
                 two++;
             }
             irregular += want == GETME_FACE_IRREGULAR;
-            int32_t got = adj->fnb[foff[t] + (int64_t)(e - ws->tstart[t]) *
-                                                 getme__faces[t].num_faces +
-                                   sd[k].face];
+            int32_t got = getme__facenb_at(
+                &adj->fnb,
+                foff[t] + (int64_t)(e - ws->tstart[t]) * getme__faces[t].num_faces +
+                    sd[k].face,
+                e);
             if (got != want && bad++ < 5)
                 fprintf(stderr, "element %d face %d: table %d, reference %d\n",
                         (int)e, (int)sd[k].face, (int)got, (int)want);
