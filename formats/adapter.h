@@ -31,11 +31,15 @@ struct getme_doc {
     char info[1024];     /* one line the CLI may log: zones, sets, fixed...  */
     char error[1024];    /* the last error, one line                         */
     char warning[1024];  /* input accepted with a caveat, one line           */
+    /* an adapter loaded as a module for this document (cgns/cgns_load.c):
+       its dlopen handle and its adapter, or NULL                          */
+    void *module;
+    const getme_format *module_format;
 };
 
 /* The built-in adapters (each in its own folder). */
 extern const getme_format getme__format_msh;  /* msh/msh_format.c   */
 extern const getme_format getme__format_inp;  /* inp/inp_format.c   */
-extern const getme_format getme__format_cgns; /* cgns/cgns_format.c */
+extern const getme_format getme__format_cgns; /* cgns/cgns_load.c   */
 
 #endif /* GETME_FORMATS_PRIVATE_ADAPTER_H */

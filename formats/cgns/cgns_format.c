@@ -1,12 +1,14 @@
 /*
- * cgns_format.c -- the CGNS adapter (getme__format_cgns): unstructured zones
- * of ADF and HDF5 CGNS files, read through libcgns (Debian libcgns-dev 3.4),
- * written back by overwriting only the coordinate arrays of a byte copy.
+ * cgns_format.c -- the CGNS adapter (the module libgetme_cgns.so, which
+ * cgns_load.c loads): unstructured zones of ADF and HDF5 CGNS files, read
+ * through libcgns (Debian libcgns-dev 3.4), written back by overwriting
+ * only the coordinate arrays of a byte copy.
  * See docs/cgns.md for what is read, what is fixed and what is refused.
  */
 #define _POSIX_C_SOURCE 200809L /* fstat's st_mtim */
 
 #include "cgns_internal.h"
+#include "cgns_magic.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -26,66 +28,6 @@ static void cgns_silent(int is_error, char *msg)
 void cgns_quiet(void)
 {
     cg_error_handler(cgns_silent);
-}
-
-/* ---- probe -------------------------------------------------------------- */
-
-enum { MAGIC_NONE = 0, MAGIC_ADF = 1, MAGIC_HDF5 = 2, MAGIC_HDF5_CGNS = 3 };
-
-/* Which container the file is, from its first bytes.  An ADF file starts
-   with "@(#)" (high bits set) + "ADF Database Version"; an HDF5 file with
-   its 8-byte signature; an HDF5 file written by libcgns names its
-   CGNSLibraryVersion node near the start. */
-static int magic(const char *path)
-{
-    static const unsigned char hdf5[8] = {0x89, 'H', 'D', 'F', '\r', '\n',
-                                          0x1a, '\n'};
-    enum { HEAD = 65536 };
-    unsigned char *buf = malloc(HEAD);
-    FILE *f = fopen(path, "rb");
-    size_t n = 0;
-    int kind = MAGIC_NONE;
-
-    if (f && buf)
-        n = fread(buf, 1, HEAD, f);
-    if (f)
-        fclose(f);
-    if (n >= 24 && memcmp(buf + 4, "ADF Database Version", 20) == 0)
-        kind = MAGIC_ADF;
-    else if (n >= 8 && memcmp(buf, hdf5, 8) == 0) {
-        static const char key[] = "CGNSLibraryVersion";
-        kind = MAGIC_HDF5;
-        for (size_t i = 0; i + sizeof key - 1 <= n; i++)
-            if (buf[i] == 'C' && memcmp(buf + i, key, sizeof key - 1) == 0) {
-                kind = MAGIC_HDF5_CGNS;
-                break;
-            }
-    }
-    free(buf);
-    return kind;
-}
-
-static int has_extension(const char *path, const char *ext)
-{
-    size_t n = strlen(path), m = strlen(ext);
-    if (n <= m || path[n - m - 1] != '.')
-        return 0;
-    for (size_t i = 0; i < m; i++) {
-        char c = path[n - m + i];
-        if (c >= 'A' && c <= 'Z')
-            c = (char)(c - 'A' + 'a');
-        if (c != ext[i])
-            return 0;
-    }
-    return 1;
-}
-
-static int cgns_probe(const char *path)
-{
-    if (has_extension(path, "cgns") || has_extension(path, "cgn"))
-        return 1;
-    int kind = magic(path);
-    return kind == MAGIC_ADF || kind == MAGIC_HDF5_CGNS;
 }
 
 /* ---- open / close ------------------------------------------------------- */
@@ -129,7 +71,7 @@ static getme_formats_status check_input(getme_doc *doc, cgns_impl *impl)
     impl->in_ino = (uint64_t)sb.st_ino;
     impl->in_mtime_ns = (int64_t)sb.st_mtim.tv_sec * 1000000000 +
                         sb.st_mtim.tv_nsec;
-    switch (magic(doc->path)) {
+    switch (cgns_magic(doc->path)) {
     case MAGIC_NONE:
         return getme_doc_fail(doc, GETME_FORMATS_ERR_PARSE,
                               "%s: not a CGNS file (%s)", doc->path,
@@ -185,10 +127,12 @@ static void cgns_close(getme_doc *doc)
     doc->impl = NULL;
 }
 
-const getme_format getme__format_cgns = {
+/* The module's adapter (cgns_load.c loads it; its probe and names are
+   cgns_load.c's). */
+__attribute__((visibility("default"))) const getme_format getme_cgns_module = {
     "cgns",
     "CGNS (ADF and HDF5; unstructured zones, via libcgns)",
-    cgns_probe,
+    NULL,
     cgns_open,
     cgns_write_doc,
     cgns_close,
