@@ -130,7 +130,10 @@ static uint64_t adj_hash(const getme_adj *adj, const getme_ws *ws)
         for (int t = 0; t < GETME_NUM_TYPES; t++)
             ns += (int64_t)(ws->tstart[t + 1] - ws->tstart[t]) *
                   getme__edges[t].num_edges;
-        h = fnv(h, adj->eptr, (nn + 1) * 4);
+        for (size_t v = 0; v <= nn; v++) { /* as int32, whatever the form */
+            int32_t x = getme__offs_at(&adj->eptr, (int64_t)v);
+            h = fnv(h, &x, 4);
+        }
         h = fnv(h, adj->eslot, (size_t)ns);
         h = fnv(h, &adj->num_edges, 4);
     }

@@ -24,7 +24,7 @@
 
 void getme__adj_free(getme_adj *adj)
 {
-    free(adj->eptr);
+    getme__offs_free(&adj->eptr);
     free(adj->eslot);
     getme__facenb_free(&adj->fnb);
     free(adj->count);
@@ -206,7 +206,7 @@ static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
     }
     int nt = ws->nt;
     size_t bufsize = (size_t)ws->max_star * 4 + 1;
-    adj->eptr = malloc(((size_t)ws->nn + 1) * sizeof *adj->eptr);
+    adj->eptr.plain = malloc(((size_t)ws->nn + 1) * sizeof *adj->eptr.plain);
     adj->eslot = malloc((size_t)(total ? total : 1));
     int64_t *first = calloc((size_t)nt + 1, sizeof *first);
     edge_walk *walks = calloc((size_t)nt, sizeof *walks);
@@ -215,12 +215,12 @@ static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
     int32_t *edeg = NULL;
     uint64_t *re = NULL;
     getme_status st = GETME_ERR_NOMEM;
-    if (!adj->eptr || !adj->eslot || !first || !walks || !bufs || !chks)
+    if (!adj->eptr.plain || !adj->eslot || !first || !walks || !bufs || !chks)
         goto done;
     corner_edges ce;
     corner_edge_table(&ce);
     int ok = 1, single = getme__ws_single_type(ws), nteam = 1;
-    adj->eptr[0] = 0;
+    adj->eptr.plain[0] = 0;
 #pragma omp parallel num_threads(nt) reduction(&& : ok)
     {
         int th = omp_get_thread_num(), n = omp_get_num_threads();
@@ -248,7 +248,7 @@ static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
                     : single == GETME_HEX
                         ? node_edges(GETME_HEX, adj, ws, &ce, u, w, checks)
                         : node_edges(-1, adj, ws, &ce, u, w, checks);
-            adj->eptr[u + 1] = m; /* a count until the prefix sum */
+            adj->eptr.plain[u + 1] = m; /* a count until the prefix sum */
             ok = walk_append(w, m, checks);
         }
         /* the range's own prefix sum (its edges before each node); the
@@ -256,8 +256,8 @@ static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
            took ~50 ms of the full hexes' set-up at any thread count) */
         int64_t sum = 0;
         for (int32_t u = u0; u < u1 && ok; u++) {
-            sum += adj->eptr[u + 1];
-            adj->eptr[u + 1] = (int32_t)sum; /* <= w->len */
+            sum += adj->eptr.plain[u + 1];
+            adj->eptr.plain[u + 1] = (int32_t)sum; /* <= w->len */
         }
         first[th + 1] = w->len;
     }
@@ -272,7 +272,7 @@ static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
     for (int k = 0; k < nteam; k++) {
         int32_t u1 = star_split(ws, k + 1, nteam), off = (int32_t)first[k];
         for (int32_t u = star_split(ws, k, nteam); u < u1; u++)
-            adj->eptr[u + 1] += off;
+            adj->eptr.plain[u + 1] += off;
     }
     adj->num_edges = (int32_t)first[nt];
     /* The first thread's arrays become the whole (no copy with one
@@ -562,6 +562,9 @@ getme_status getme__adj_build(getme_adj *adj, getme_ws *ws)
         nirr += adj->irregular[e];
     adj->num_irregular = nirr;
     free(scratch), free(edeg);
+    /* read node by node from here on: 2.25 bytes per node (offsets.h) */
+    if (adj->eptr.plain)
+        getme__offs_take(&adj->eptr, adj->eptr.plain, (int64_t)ws->nn + 1);
     return GETME_OK;
 fail:
     free(re), free(edeg), free(scratch);

@@ -34,6 +34,7 @@
 #include "block_local.h"
 #include "exact.h"
 #include "facenb.h"
+#include "offsets.h"
 #include "workspace.h"
 
 /* An element edge's slot that does not fit in a byte (a node with more
@@ -46,7 +47,7 @@ typedef struct getme_adj {
     /* 3-D types: edges are numbered node by node, each by its lower node:
        the id of an element edge (a, b), a < b, is eptr[a] + its slot.  A
        byte per element edge instead of a 4-byte id saves 18 B per tet. */
-    int32_t *eptr;      /* nn + 1                                          */
+    getme_offsets eptr; /* nn + 1; packed once built (offsets.h)            */
     uint8_t *eslot;     /* per element edge                                */
     getme_facenb fnb;   /* the element across each face (2-D: edge), -1;
                            2 bytes per face (facenb.h)                     */
@@ -103,7 +104,7 @@ static inline int32_t getme__adj_edge(const getme_adj *adj, const int32_t *c,
                                       int t, int j, uint8_t slot)
 {
     int32_t a = c[getme__edges[t].node[j][0]], b = c[getme__edges[t].node[j][1]];
-    return adj->eptr[a < b ? a : b] + slot;
+    return getme__offs_at(&adj->eptr, a < b ? a : b) + slot;
 }
 
 /* Edge ids of element e (type t; nodes c, slots slot) into id[]: the
@@ -118,7 +119,7 @@ getme__adj_edge_ids(const getme_adj *adj, const int32_t *c, int t,
 {
     int32_t ep[GETME_MAX_NV];
     for (int i = 0; i < getme__nv[t]; i++)
-        ep[i] = adj->eptr[c[i]];
+        ep[i] = getme__offs_at(&adj->eptr, c[i]);
     for (int j = 0; j < getme__edges[t].num_edges; j++) {
         int a = getme__edges[t].node[j][0], b = getme__edges[t].node[j][1];
         id[j] = slot[j] == GETME_NO_SLOT ? -1

@@ -87,4 +87,8 @@ void getme__stars_pack(getme_ws *ws)
     int32_t *shrunk = realloc(ws->star, (size_t)(keep ? keep : 1));
     if (shrunk)
         ws->star = shrunk;
+    /* the offsets in 2.25 bytes per node, if their groups fit */
+    getme__offs_take(&ws->star_offs, ws->star_ptr, (int64_t)ws->nn + 1);
+    ws->star_ptr = ws->star_offs.plain; /* NULL if packed */
+    ws->star_offs.plain = NULL;
 }

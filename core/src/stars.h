@@ -29,7 +29,9 @@
    count) and give the block's tail back (realloc), keeping room for
    getme__ws_unpack_map's two maps.  Does nothing if already packed or if
    an element index needs more than 4 bytes (ne >= 2^28): packing then
-   never grows a star.  No allocation: it cannot fail. */
+   never grows a star.  The byte offsets then go to ws->star_offs
+   (offsets.h; star_ptr NULL), which getme__ws_star_at reads.  It cannot
+   fail. */
 void getme__stars_pack(getme_ws *ws);
 
 typedef struct getme_star_it {
@@ -45,8 +47,8 @@ static inline getme_star_it getme__star_open(const getme_ws *ws, int32_t v)
     it.packed = ws->stars_packed;
     if (it.packed) {
         const uint8_t *b = (const uint8_t *)ws->star;
-        it.p = b + ws->star_ptr[v];
-        it.end = b + ws->star_ptr[v + 1];
+        it.p = b + getme__ws_star_at(ws, v);
+        it.end = b + getme__ws_star_at(ws, v + 1);
     } else {
         it.p = (const uint8_t *)(ws->star + ws->star_ptr[v]);
         it.end = (const uint8_t *)(ws->star + ws->star_ptr[v + 1]);
@@ -82,13 +84,13 @@ static inline int getme__star_next(getme_star_it *it, int32_t *e)
    packed): a bound for buffers, with no walk. */
 static inline int32_t getme__star_bound(const getme_ws *ws, int32_t v)
 {
-    return ws->star_ptr[v + 1] - ws->star_ptr[v];
+    return getme__ws_star_at(ws, v + 1) - getme__ws_star_at(ws, v);
 }
 
 /* The number of elements in node v's star. */
 static inline int32_t getme__star_size(const getme_ws *ws, int32_t v)
 {
-    int32_t k0 = ws->star_ptr[v], k1 = ws->star_ptr[v + 1];
+    int32_t k0 = getme__ws_star_at(ws, v), k1 = getme__ws_star_at(ws, v + 1);
     if (!ws->stars_packed)
         return k1 - k0;
     const uint8_t *b = (const uint8_t *)ws->star;

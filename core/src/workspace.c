@@ -34,6 +34,7 @@ void getme__ws_free(getme_ws *ws)
     free(ws->fixed);
     free(ws->free_elem);
     free(ws->star_ptr);
+    getme__offs_free(&ws->star_offs);
     free(ws->star);
     free(ws->block_start);
     free(ws->colour_ptr);

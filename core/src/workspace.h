@@ -22,6 +22,8 @@
 
 #include <stdint.h>
 
+#include "offsets.h"
+
 /* The face table, 2 bytes per face (facenb.h). */
 typedef struct getme_facenb {
     int16_t *d;       /* per entry: 0 skin, GETME_FNB_ESCAPE, else nb - e */
@@ -54,6 +56,9 @@ typedef struct getme_ws {
                             the loop on packed (stars.h: star_ptr then
                             holds byte offsets)                             */
     int stars_packed;
+    getme_offsets star_offs; /* once packed: star_ptr in 2.25 B per node
+                                (offsets.h), star_ptr then NULL; read
+                                both through getme__ws_star_at         */
     int32_t max_star;    /* largest star                                     */
     /* colour-blocks */
     int32_t num_blocks;
@@ -133,11 +138,19 @@ uint32_t getme__morton(const double *x, const double lo[3],
    lent coordinates are returned (getme__ws_return_x). */
 void getme__ws_store(getme_ws *ws, getme_mesh *mesh);
 
+/* star_ptr[v], plain or packed (getme__stars_pack). */
+static inline int32_t getme__ws_star_at(const getme_ws *ws, int64_t v)
+{
+    if (ws->star_ptr)
+        return ws->star_ptr[v];
+    return ws->star_offs.base[v / GETME_OFFS_GROUP] + ws->star_offs.off[v];
+}
+
 /* Node i is one the smoother moves: free and in an element (star_ptr's
    difference is 0 exactly for an empty star, plain or packed). */
 static inline int getme__ws_moves(const getme_ws *ws, int32_t i)
 {
-    return !ws->fixed[i] && ws->star_ptr[i + 1] > ws->star_ptr[i];
+    return !ws->fixed[i] && getme__ws_star_at(ws, i + 1) > getme__ws_star_at(ws, i);
 }
 
 static inline int getme__ws_type(const getme_ws *ws, int32_t e)

@@ -72,6 +72,7 @@ static void make_fake(fake *f, int32_t nn, int scale_bits, int nt)
 static void free_fake(fake *f)
 {
     free(f->ptr0), free(f->star0), free(f->ws.star_ptr), free(f->ws.star);
+    getme__offs_free(&f->ws.star_offs);
 }
 
 /* Every star of ws reads back as the plain one; sizes and bounds. */
@@ -109,12 +110,15 @@ static void pack_three(int scale, int all_wide)
             f[i].leb = 4 * (int64_t)f[i].ptr0[f[i].ws.nn];
         getme__stars_pack(&f[i].ws);
         CHECK(f[i].ws.stars_packed);
-        CHECK(f[i].ws.star_ptr[f[i].ws.nn] == f[i].leb);
+        CHECK(getme__ws_star_at(&f[i].ws, f[i].ws.nn) == f[i].leb);
+        CHECK(!f[i].ws.star_ptr); /* the offsets packed too */
         check_reads(&f[i].ws, f[0].ptr0, f[0].star0);
     }
     for (int i = 1; i < 3; i++) { /* the same bytes for any thread count */
-        CHECK(!memcmp(f[0].ws.star_ptr, f[i].ws.star_ptr,
-                      ((size_t)f[0].ws.nn + 1) * sizeof *f[0].ws.star_ptr));
+        int64_t diff = 0;
+        for (int32_t v = 0; v <= f[0].ws.nn; v++)
+            diff += getme__ws_star_at(&f[0].ws, v) != getme__ws_star_at(&f[i].ws, v);
+        CHECK(diff == 0);
         CHECK(!memcmp(f[0].ws.star, f[i].ws.star, (size_t)f[0].leb));
     }
     getme__stars_pack(&f[0].ws); /* packing twice changes nothing */
@@ -153,7 +157,7 @@ static void real_workspace(int kind, int nt)
     getme_ws ws;
     CHECK(getme__ws_build(&ws, mesh, 1, nt) == GETME_OK);
     int32_t nn = ws.nn, ne = ws.ne;
-    int64_t total = ws.star_ptr[nn];
+    int64_t total = getme__ws_star_at(&ws, nn);
     int32_t *ptr0 = malloc(((size_t)nn + 1) * sizeof *ptr0);
     int32_t *star0 = malloc((size_t)total * sizeof *star0);
     int32_t *eo = malloc((size_t)ne * sizeof *eo);
@@ -165,7 +169,7 @@ static void real_workspace(int kind, int nt)
     getme__ws_pack_map(&ws);
     getme__stars_pack(&ws);
     CHECK(ws.stars_packed);
-    CHECK(ws.star_ptr[nn] < 3 * total);
+    CHECK(getme__ws_star_at(&ws, nn) < 3 * total);
     check_reads(&ws, ptr0, star0);
     getme__ws_unpack_map(&ws);
     CHECK(!memcmp(ws.elem_orig, eo, (size_t)ne * sizeof *eo));
@@ -176,8 +180,41 @@ static void real_workspace(int kind, int nt)
     free_gen(&g);
 }
 
+/* offsets.h on its own: random nondecreasing tables of every length
+   around the group size read back entry by entry, packed; a table with
+   a group spanning 65536 stays plain and reads back too. */
+static void check_offsets(void)
+{
+    for (int64_t n = 1; n < 70; n += 3) {
+        for (int wide = 0; wide <= 1; wide++) {
+            int32_t *t = malloc((size_t)n * sizeof *t), *want = malloc((size_t)n * sizeof *t);
+            int64_t x = next32() % 1000;
+            for (int64_t v = 0; v < n; v++) {
+                x += wide && v == n / 2 ? 65536 : next32() % 5000;
+                t[v] = want[v] = (int32_t)x;
+            }
+            getme_offsets o;
+            getme__offs_take(&o, t, n);
+            /* packed exactly when no group spans 65536 or more */
+            int64_t span = 0;
+            for (int64_t v = 0; v < n; v++) {
+                int64_t d = (int64_t)want[v] - want[v / GETME_OFFS_GROUP * GETME_OFFS_GROUP];
+                span = d > span ? d : span;
+            }
+            CHECK((o.plain == NULL) == (span <= UINT16_MAX));
+            int64_t bad = 0;
+            for (int64_t v = 0; v < n; v++)
+                bad += getme__offs_at(&o, v) != want[v];
+            CHECK(bad == 0);
+            getme__offs_free(&o);
+            free(want);
+        }
+    }
+}
+
 int main(void)
 {
+    check_offsets();
     random_stars();
     too_wide();
     for (int kind = 0; kind <= 4; kind++)
