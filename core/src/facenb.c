@@ -11,7 +11,6 @@
 void getme__facenb_free(getme_facenb *fb)
 {
     free(fb->d);
-    free(fb->ekey);
     free(fb->enb);
     free(fb->cptr);
     memset(fb, 0, sizeof *fb);
@@ -26,20 +25,21 @@ static int32_t entry_elem(const getme_ws *ws, const int64_t *foff, int64_t k)
     return ws->tstart[t] + (int32_t)((k - foff[t]) / getme__faces[t].num_faces);
 }
 
-/* Entry k's int16 code, given its element e and neighbour nb. */
-static int16_t code_of(int32_t e, int32_t nb)
+/* Whether element e's neighbour nb is an escape (else its int16 code is
+   0 for the skin or the difference). */
+static int escapes(int32_t e, int32_t nb)
 {
     if (nb == -1)
         return 0;
     int64_t d = (int64_t)nb - e;
-    if (nb < 0 || d == 0 || d <= GETME_FNB_ESCAPE || d > INT16_MAX)
-        return GETME_FNB_ESCAPE;
-    return (int16_t)d;
+    return nb < 0 || d == 0 || d < GETME_FNB_ESCAPE + GETME_FNB_CHUNK ||
+           d > INT16_MAX;
 }
 
 /* Chunk c's escapes: counted (fill 0, nothing written), or (fill 1) its
-   codes written into fb->d and its escapes into fb->ekey and fb->enb from
-   fb->cptr[c]; returns the count.  Entries are followed element by
+   codes written into fb->d and its escapes into fb->enb from fb->cptr[c];
+   returns the count (at most GETME_FNB_CHUNK, so an escape's index in its
+   chunk is a code).  Entries are followed element by
    element, so no division per entry.  fb->d is table's own bytes (packing
    in place): entry k's code goes to bytes [2k, 2k + 2), inside entries
    already read; both are accessed as bytes (memcpy), which may alias. */
@@ -58,16 +58,16 @@ static int32_t pack_chunk(getme_facenb *fb, const getme_ws *ws,
     for (int64_t k = k0; k < k1; k++) {
         int32_t nb;
         memcpy(&nb, table + 4 * k, sizeof nb);
-        int16_t code = code_of(e, nb);
-        if (fill)
+        int esc = escapes(e, nb);
+        if (fill) {
+            int16_t code = esc        ? (int16_t)(GETME_FNB_ESCAPE + m)
+                         : nb == -1   ? 0
+                                      : (int16_t)(nb - e);
             memcpy((unsigned char *)fb->d + 2 * k, &code, sizeof code);
-        if (code == GETME_FNB_ESCAPE) {
-            if (fill) {
-                fb->ekey[at + m] = (uint16_t)(k - k0);
+            if (esc)
                 fb->enb[at + m] = nb;
-            }
-            m++;
         }
+        m += esc;
         if (++j == nf && k + 1 < k1) { /* the next element, maybe a type on */
             j = 0;
             e++;
@@ -104,9 +104,8 @@ getme_status getme__facenb_pack(getme_facenb *fb, const getme_ws *ws,
     for (int64_t c = 0; c < nc; c++)
         fb->cptr[c + 1] += fb->cptr[c];
     int64_t ne = fb->cptr[nc];
-    fb->ekey = malloc((size_t)(ne ? ne : 1) * sizeof *fb->ekey);
     fb->enb = malloc((size_t)(ne ? ne : 1) * sizeof *fb->enb);
-    if (!fb->ekey || !fb->enb)
+    if (!fb->enb)
         goto fail;
     fb->d = (int16_t *)(void *)table;
     table = NULL;
@@ -122,18 +121,4 @@ fail:
     free(table);
     getme__facenb_free(fb);
     return GETME_ERR_NOMEM;
-}
-int32_t getme__facenb_escape(const getme_facenb *fb, int64_t k)
-{
-    int64_t c = k / GETME_FNB_CHUNK;
-    uint16_t key = (uint16_t)(k - c * GETME_FNB_CHUNK);
-    int64_t lo = fb->cptr[c], hi = fb->cptr[c + 1]; /* key in [lo, hi) */
-    while (hi - lo > 1) {
-        int64_t mid = lo + (hi - lo) / 2;
-        if (fb->ekey[mid] <= key)
-            lo = mid;
-        else
-            hi = mid;
-    }
-    return fb->enb[lo];
 }

@@ -9,20 +9,26 @@
  * hexes' and 96.5 % of the tets' face neighbours are within 32767 of
  * their element (docs/bench.md, session 15).  So each entry holds
  * d = nb - e as an int16: 0 means no neighbour (-1, the skin: an element
- * is never its own neighbour), INT16_MIN an escape, any other value the
- * difference.  Escapes (far neighbours, GETME_FACE_IRREGULAR, and an
- * element across from itself, which faces.c never gives but which must
- * not read as skin) are kept apart, 6 bytes each: per chunk of
- * GETME_FNB_CHUNK entries, their positions in the chunk ascending with
- * their neighbours, found by binary search (a few steps in one or two
- * cache lines).
+ * is never its own neighbour), a value in [INT16_MIN, INT16_MIN +
+ * GETME_FNB_CHUNK) an escape, any other value the difference.  Escapes
+ * (far neighbours, GETME_FACE_IRREGULAR, and an element across from
+ * itself, which faces.c never gives but which must not read as skin) are
+ * kept apart, 4 bytes each, chunk by chunk of GETME_FNB_CHUNK entries:
+ * an escape's code is its index among its chunk's escapes (a chunk has at
+ * most GETME_FNB_CHUNK), so reading it is two loads.  (A first version
+ * kept each escape's position in its chunk and found it by binary search:
+ * the search's dependent, unpredictable steps cost stage 1 ~5-10 % on the
+ * medium meshes, docs/bench.md, session 16.)  Differences in [-32767,
+ * -31744] become escapes too: a few more of them (0.02 % of the faces of
+ * the full benchmark meshes).
  */
 #ifndef GETME_FACENB_H
 #define GETME_FACENB_H
 
 #include "workspace.h"
 
-/* Entries per chunk of the escape index: a position in it fits uint16. */
+/* Entries per chunk of the escape index.  Escape codes are
+   [GETME_FNB_ESCAPE, GETME_FNB_ESCAPE + GETME_FNB_CHUNK). */
 #define GETME_FNB_CHUNK 1024
 #define GETME_FNB_ESCAPE INT16_MIN
 
@@ -35,20 +41,17 @@ getme_status getme__facenb_pack(getme_facenb *fb, const getme_ws *ws,
                                 const int64_t *foff, int32_t *table);
 void getme__facenb_free(getme_facenb *fb);
 
-/* The neighbour of escaped entry k. */
-int32_t getme__facenb_escape(const getme_facenb *fb, int64_t k);
-
 /* The neighbour across entry k of element e: an element, -1 or
    GETME_FACE_IRREGULAR. */
 static inline int32_t getme__facenb_at(const getme_facenb *fb, int64_t k,
                                        int32_t e)
 {
-    int16_t d = fb->d[k];
+    int32_t d = fb->d[k];
     if (d == 0)
         return -1;
-    if (d != GETME_FNB_ESCAPE)
+    if (d >= GETME_FNB_ESCAPE + GETME_FNB_CHUNK)
         return e + d;
-    return getme__facenb_escape(fb, k);
+    return fb->enb[fb->cptr[k / GETME_FNB_CHUNK] + (d - GETME_FNB_ESCAPE)];
 }
 
 /* The neighbours across all faces of element e (type t) into f[]

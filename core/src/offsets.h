@@ -31,7 +31,7 @@ static inline int32_t getme__offs_at(const getme_offsets *o, int64_t v)
 {
     if (o->plain)
         return o->plain[v];
-    return o->base[v / GETME_OFFS_GROUP] + o->off[v];
+    return o->base[(uint64_t)v / GETME_OFFS_GROUP] + o->off[v];
 }
 
 /* Take table (n entries, nondecreasing, malloc'd) into o: packed in place

@@ -26,8 +26,7 @@
 
 /* The face table, 2 bytes per face (facenb.h). */
 typedef struct getme_facenb {
-    int16_t *d;       /* per entry: 0 skin, GETME_FNB_ESCAPE, else nb - e */
-    uint16_t *ekey;   /* escapes: position in their chunk, ascending      */
+    int16_t *d;       /* per entry: 0 skin, an escape's code, else nb - e */
     int32_t *enb;     /* escapes: the neighbour                           */
     int64_t *cptr;    /* chunks + 1: each chunk's first escape            */
     int64_t n;        /* entries                                          */

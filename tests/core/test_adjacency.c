@@ -694,7 +694,6 @@ static void same_setup(const getme_ws *a, const getme_adj *aa,
     int64_t nch = (nf + GETME_FNB_CHUNK - 1) / GETME_FNB_CHUNK;
     SAME(aa->fnb.cptr, ab->fnb.cptr, nch + 1);
     if (aa->fnb.cptr[nch] == ab->fnb.cptr[nch]) {
-        SAME(aa->fnb.ekey, ab->fnb.ekey, aa->fnb.cptr[nch]);
         SAME(aa->fnb.enb, ab->fnb.enb, aa->fnb.cptr[nch]);
     }
     SAME(aa->count, ab->count, a->ne);
