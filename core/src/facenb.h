@@ -17,10 +17,9 @@
  * an escape's code is its index among its chunk's escapes (a chunk has at
  * most GETME_FNB_CHUNK), so reading it is two loads.  (A first version
  * kept each escape's position in its chunk and found it by binary search:
- * the search's dependent, unpredictable steps cost stage 1 ~5-10 % on the
+ * the search's dependent, unpredictable steps cost stage 1 ~6-8 % on the
  * medium meshes, docs/bench.md, session 16.)  Differences in [-32767,
- * -31744] become escapes too: a few more of them (0.02 % of the faces of
- * the full benchmark meshes).
+ * -31745] become escapes too (the lowest direct code is -31744).
  */
 #ifndef GETME_FACENB_H
 #define GETME_FACENB_H

@@ -140,9 +140,7 @@ void getme__ws_store(getme_ws *ws, getme_mesh *mesh);
 /* star_ptr[v], plain or packed (getme__stars_pack). */
 static inline int32_t getme__ws_star_at(const getme_ws *ws, int64_t v)
 {
-    if (ws->star_ptr)
-        return ws->star_ptr[v];
-    return ws->star_offs.base[v / GETME_OFFS_GROUP] + ws->star_offs.off[v];
+    return ws->star_ptr ? ws->star_ptr[v] : getme__offs_at(&ws->star_offs, v);
 }
 
 /* Node i is one the smoother moves: free and in an element (star_ptr's
