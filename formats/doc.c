@@ -4,6 +4,7 @@
  */
 #define _XOPEN_SOURCE 700
 #include "adapter.h"
+#include "getme_alloc.h"
 
 #include <errno.h>
 #include <stdarg.h>
@@ -261,7 +262,7 @@ getme_formats_status getme_doc_open(getme_doc **out, const char *path,
         getme_doc_options_init(&defaults);
         opts = &defaults;
     }
-    getme_doc *doc = calloc(1, sizeof *doc);
+    getme_doc *doc = getme__calloc(1, sizeof *doc);
     *out = doc;
     if (!doc)
         return GETME_FORMATS_ERR_INTERNAL;

@@ -85,10 +85,11 @@ static int walk_append(edge_walk *w, int m, int checks)
 {
     if (w->len + m > w->cap) {
         int64_t cap = w->cap * 2 > w->len + m ? w->cap * 2 : w->len + m + 1024;
-        int32_t *d = realloc(w->edeg, (size_t)cap * sizeof *d);
+        int32_t *d = getme__realloc(w->edeg, (size_t)cap * sizeof *d);
         if (d)
             w->edeg = d;
-        uint64_t *r = checks ? realloc(w->re, (size_t)cap * sizeof *r) : NULL;
+        uint64_t *r =
+            checks ? getme__realloc(w->re, (size_t)cap * sizeof *r) : NULL;
         if (r)
             w->re = r;
         if (!d || (checks && !r))
@@ -206,12 +207,13 @@ static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
     }
     int nt = ws->nt;
     size_t bufsize = (size_t)ws->max_star * 4 + 1;
-    adj->eptr.plain = malloc(((size_t)ws->nn + 1) * sizeof *adj->eptr.plain);
-    adj->eslot = malloc((size_t)(total ? total : 1));
-    int64_t *first = calloc((size_t)nt + 1, sizeof *first);
-    edge_walk *walks = calloc((size_t)nt, sizeof *walks);
-    int32_t *bufs = malloc((size_t)nt * bufsize * 2 * sizeof *bufs);
-    uint64_t *chks = malloc((size_t)nt * bufsize * sizeof *chks);
+    adj->eptr.plain =
+        getme__malloc(((size_t)ws->nn + 1) * sizeof *adj->eptr.plain);
+    adj->eslot = getme__malloc((size_t)(total ? total : 1));
+    int64_t *first = getme__calloc((size_t)nt + 1, sizeof *first);
+    edge_walk *walks = getme__calloc((size_t)nt, sizeof *walks);
+    int32_t *bufs = getme__malloc((size_t)nt * bufsize * 2 * sizeof *bufs);
+    uint64_t *chks = getme__malloc((size_t)nt * bufsize * sizeof *chks);
     int32_t *edeg = NULL;
     uint64_t *re = NULL;
     getme_status st = GETME_ERR_NOMEM;
@@ -238,8 +240,8 @@ static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
            from small sizes, the arrays left freed blocks in the heap that
            stayed resident. */
         w->cap = (ws->star_ptr[u1] - ws->star_ptr[u0]) / 2 + 1024;
-        w->edeg = malloc((size_t)w->cap * sizeof *w->edeg);
-        w->re = checks ? malloc((size_t)w->cap * sizeof *w->re) : NULL;
+        w->edeg = getme__malloc((size_t)w->cap * sizeof *w->edeg);
+        w->re = checks ? getme__malloc((size_t)w->cap * sizeof *w->re) : NULL;
         if (!w->edeg || (checks && !w->re))
             ok = 0, w->cap = 0;
         for (int32_t u = u0; u < u1 && ok; u++) {
@@ -280,11 +282,11 @@ static getme_status build_edges(getme_adj *adj, const getme_ws *ws,
        the counts get 8 bytes per edge: their buffer becomes the S_e
        array once they are read (getme__adj_build). */
     size_t nedge = (size_t)(first[nt] ? first[nt] : 1);
-    edeg = realloc(walks[0].edeg,
-                   nedge * (checks ? sizeof *edeg : sizeof(int64_t)));
+    edeg = getme__realloc(walks[0].edeg,
+                          nedge * (checks ? sizeof *edeg : sizeof(int64_t)));
     if (edeg)
         walks[0].edeg = NULL;
-    re = checks ? realloc(walks[0].re, nedge * sizeof *re) : NULL;
+    re = checks ? getme__realloc(walks[0].re, nedge * sizeof *re) : NULL;
     if (re)
         walks[0].re = NULL;
     if (!edeg || (checks && !re))
@@ -448,7 +450,7 @@ static getme_status check_all(getme_adj *adj, const getme_ws *ws,
                               const int32_t *edeg, void *scratch)
 {
     int nt = ws->nt;
-    union_scratch *sc = calloc((size_t)nt, sizeof *sc);
+    union_scratch *sc = getme__calloc((size_t)nt, sizeof *sc);
     int ok = sc != NULL;
     size_t ne = (size_t)(ws->ne ? ws->ne : 1);
     uint32_t *stamps = scratch;
@@ -500,7 +502,8 @@ getme_status getme__adj_build(getme_adj *adj, getme_ws *ws)
         adj->fnb = ws->faces;
         memset(&ws->faces, 0, sizeof ws->faces);
     } else {
-        int32_t *table = malloc((size_t)(ftotal ? ftotal : 1) * sizeof *table);
+        int32_t *table =
+            getme__malloc((size_t)(ftotal ? ftotal : 1) * sizeof *table);
         if (!table || getme__ws_faces(ws, adj->foff, table) != GETME_OK) {
             free(table);
             return GETME_ERR_NOMEM;
@@ -508,11 +511,11 @@ getme_status getme__adj_build(getme_adj *adj, getme_ws *ws)
         if (getme__facenb_pack(&adj->fnb, ws, adj->foff, table) != GETME_OK)
             return GETME_ERR_NOMEM; /* table freed */
     }
-    adj->count = malloc(ne * sizeof *adj->count);
+    adj->count = getme__malloc(ne * sizeof *adj->count);
     /* Zeroed, and only irregular elements written: on a mesh with none
        (tets) its pages are never touched, so they take no memory. */
-    adj->irregular = calloc(ne, 1);
-    adj->nsum = malloc(nn * sizeof *adj->nsum);
+    adj->irregular = getme__calloc(ne, 1);
+    adj->nsum = getme__malloc(nn * sizeof *adj->nsum);
     /* The fixed-point scale of the sums (adjacency.h). */
     adj->qscale = 0x1p61 / getme__pow2_ceil((double)ws->max_star + 1.0);
     adj->qinv = 1.0 / adj->qscale;
@@ -547,7 +550,7 @@ getme_status getme__adj_build(getme_adj *adj, getme_ws *ws)
         else
             edeg = NULL;
     }
-    if (!(scratch = malloc(sbytes)))
+    if (!(scratch = getme__malloc(sbytes)))
         goto fail;
     if ((st = getme__blocks_build(&adj->blk, ws, scratch)) != GETME_OK)
         goto fail;

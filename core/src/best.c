@@ -19,10 +19,10 @@ getme_status getme__best_init(getme_best *b, const getme_run *run, int on)
         return GETME_OK;
     const getme_ws *ws = run->ws;
     if (run->comm) {
-        b->whole = malloc(coord_bytes(ws));
+        b->whole = getme__malloc(coord_bytes(ws));
         return b->whole ? GETME_OK : GETME_ERR_NOMEM;
     }
-    b->seen = calloc(((size_t)ws->nn + 63) / 64 + 1, sizeof *b->seen);
+    b->seen = getme__calloc(((size_t)ws->nn + 63) / 64 + 1, sizeof *b->seen);
     return b->seen ? GETME_OK : GETME_ERR_NOMEM;
 }
 
@@ -43,7 +43,7 @@ void getme__best_take(getme_best *b, const getme_ws *ws)
    ones put back.  0, or -1 if out of memory (the log stays). */
 static int to_whole(getme_best *b, const getme_ws *ws)
 {
-    b->whole = malloc(coord_bytes(ws));
+    b->whole = getme__malloc(coord_bytes(ws));
     if (!b->whole)
         return -1;
     memcpy(b->whole, ws->x, (size_t)ws->nn * 3 * sizeof *b->whole);
@@ -63,11 +63,11 @@ static int reserve(getme_best *b, int64_t more)
         return 0;
     int64_t cap = b->n + more > 2 * b->cap ? b->n + more : 2 * b->cap;
     cap = cap < 1024 ? 1024 : cap;
-    int32_t *node = realloc(b->node, (size_t)cap * sizeof *node);
+    int32_t *node = getme__realloc(b->node, (size_t)cap * sizeof *node);
     if (!node)
         return -1;
     b->node = node;
-    double *x = realloc(b->x, (size_t)cap * 3 * sizeof *x);
+    double *x = getme__realloc(b->x, (size_t)cap * 3 * sizeof *x);
     if (!x)
         return -1;
     b->x = x;
@@ -138,7 +138,7 @@ getme_status getme__best_restore(getme_best *b, getme_run *run)
                3 * sizeof *b->x);
     rescore(b, run);
 #ifdef GETME_CHECK_SUMS
-    double *q = malloc((size_t)(ws->ne ? ws->ne : 1) * sizeof *q);
+    double *q = getme__malloc((size_t)(ws->ne ? ws->ne : 1) * sizeof *q);
     if (!q)
         return GETME_ERR_NOMEM;
     getme__ws_qualities(ws, q);

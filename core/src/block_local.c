@@ -83,8 +83,8 @@ static getme_status alloc_scratch(getme_blocks *blk, int nt)
                  me * (sizeof(int64_t) + sizeof(int32_t) +
                        GETME_MAX_NV * sizeof(uint16_t));
     per = (per + 63) & ~(size_t)63;
-    blk->scratch = calloc((size_t)nt, sizeof *blk->scratch);
-    char *p = aligned_alloc(64, per * (size_t)nt);
+    blk->scratch = getme__calloc((size_t)nt, sizeof *blk->scratch);
+    char *p = getme__aligned_alloc(64, per * (size_t)nt);
     if (!blk->scratch || !p) {
         free(p);
         return GETME_ERR_NOMEM;
@@ -159,13 +159,15 @@ static getme_status build_order(getme_blocks *blk, const getme_ws *ws,
     int32_t nb = ws->num_blocks;
     size_t nbs = (size_t)(nb ? nb : 1);
     blk->num_parts = np;
-    blk->order = malloc(nbs * sizeof *blk->order);
-    blk->part_ptr = calloc((size_t)GETME_ORDER_LEVELS * np + 1,
-                           sizeof *blk->part_ptr);
-    blk->col_ptr = calloc((size_t)ws->num_colours + 1, sizeof *blk->col_ptr);
-    int32_t *cur = malloc(nbs * sizeof *cur), *bpart = malloc(nbs * sizeof *bpart);
-    getme_ranked *keys = malloc(nbs * sizeof *keys);
-    uint8_t *left = malloc(nbs);
+    blk->order = getme__malloc(nbs * sizeof *blk->order);
+    blk->part_ptr = getme__calloc((size_t)GETME_ORDER_LEVELS * np + 1,
+                                  sizeof *blk->part_ptr);
+    blk->col_ptr =
+        getme__calloc((size_t)ws->num_colours + 1, sizeof *blk->col_ptr);
+    int32_t *cur = getme__malloc(nbs * sizeof *cur);
+    int32_t *bpart = getme__malloc(nbs * sizeof *bpart);
+    getme_ranked *keys = getme__malloc(nbs * sizeof *keys);
+    uint8_t *left = getme__malloc(nbs);
     getme_status st = GETME_ERR_NOMEM;
     if (!blk->order || !blk->part_ptr || !blk->col_ptr || !cur || !bpart ||
         !keys || !left)
@@ -270,13 +272,13 @@ getme_status getme__blocks_build(getme_blocks *blk, const getme_ws *ws,
     blk->group.n = -1;
     int nt = ws->nt;
     size_t nn = (size_t)(ws->nn ? ws->nn : 1);
-    blk->nptr = malloc(((size_t)ws->num_blocks + 1) * sizeof *blk->nptr);
-    blk->local = malloc(nn * sizeof *blk->local);
+    blk->nptr = getme__malloc(((size_t)ws->num_blocks + 1) * sizeof *blk->nptr);
+    blk->local = getme__malloc(nn * sizeof *blk->local);
     /* The marks in the caller's scratch if it lends
        one (getme__adj_build: the same pages serve the inclusion-exclusion
        check next, and a fresh page costs ~3 ms per MiB to fault in on the
        VMs measured), else our own. */
-    void *own = scratch ? NULL : malloc(getme__blocks_scratch_bytes(ws));
+    void *own = scratch ? NULL : getme__malloc(getme__blocks_scratch_bytes(ws));
     void *mem = scratch ? scratch : own;
     int32_t *mark = mem;
     getme_status st = GETME_ERR_NOMEM;
@@ -309,8 +311,9 @@ getme_status getme__blocks_build(getme_blocks *blk, const getme_ws *ws,
         st = GETME_ERR_NOMEM;
         goto done;
     }
-    blk->nodes = malloc((size_t)(blk->nptr[ws->num_blocks] ? blk->nptr[ws->num_blocks] : 1) *
-                        sizeof *blk->nodes);
+    blk->nodes =
+        getme__malloc((size_t)(blk->nptr[ws->num_blocks] ? blk->nptr[ws->num_blocks] : 1) *
+                      sizeof *blk->nodes);
     if (!blk->nodes)
         goto done;
     if (alloc_scratch(blk, nt) != GETME_OK)
@@ -335,13 +338,13 @@ getme_status getme__blocks_group(getme_blocks *blk, const getme_ws *ws,
     struct getme_block_group *g = &blk->group;
     size_t nb = (size_t)ws->num_blocks;
     if (!g->ptr)
-        g->ptr = malloc((nb + 1) * sizeof *g->ptr);
+        g->ptr = getme__malloc((nb + 1) * sizeof *g->ptr);
     if (!g->cnt)
-        g->cnt = malloc((size_t)ws->nt * (nb ? nb : 1) * sizeof *g->cnt);
+        g->cnt = getme__malloc((size_t)ws->nt * (nb ? nb : 1) * sizeof *g->cnt);
     if (n > g->cap) {
         free(g->pos);
         g->cap = 2 * (int64_t)n + 64;
-        g->pos = malloc((size_t)g->cap * sizeof *g->pos);
+        g->pos = getme__malloc((size_t)g->cap * sizeof *g->pos);
     }
     g->n = -1;
     if (!g->ptr || !g->cnt || !g->pos) {

@@ -91,7 +91,7 @@ getme_status getme_mesh_distort(getme_mesh *mesh, uint64_t seed, double amount,
         getme__ws_free(&ws);
         return st;
     }
-    double *q = malloc((size_t)(ws.ne ? ws.ne : 1) * sizeof *q);
+    double *q = getme__malloc((size_t)(ws.ne ? ws.ne : 1) * sizeof *q);
     if (!q) {
         getme__ws_free(&ws);
         return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");

@@ -88,7 +88,7 @@ getme_status getme__facenb_pack(getme_facenb *fb, const getme_ws *ws,
              getme__faces[t].num_faces;
     int64_t nc = (n + GETME_FNB_CHUNK - 1) / GETME_FNB_CHUNK;
     fb->n = n;
-    fb->cptr = malloc((size_t)(nc + 1) * sizeof *fb->cptr);
+    fb->cptr = getme__malloc((size_t)(nc + 1) * sizeof *fb->cptr);
     if (!fb->cptr)
         goto fail;
     /* The escapes counted chunk by chunk in parallel (reading only), then
@@ -104,7 +104,7 @@ getme_status getme__facenb_pack(getme_facenb *fb, const getme_ws *ws,
     for (int64_t c = 0; c < nc; c++)
         fb->cptr[c + 1] += fb->cptr[c];
     int64_t ne = fb->cptr[nc];
-    fb->enb = malloc((size_t)(ne ? ne : 1) * sizeof *fb->enb);
+    fb->enb = getme__malloc((size_t)(ne ? ne : 1) * sizeof *fb->enb);
     if (!fb->enb)
         goto fail;
     fb->d = (int16_t *)(void *)table;
@@ -113,7 +113,7 @@ getme_status getme__facenb_pack(getme_facenb *fb, const getme_ws *ws,
         pack_chunk(fb, ws, foff, (const unsigned char *)fb->d, c, 1);
     /* the int32 table's second half back (a shrinking realloc does not
        fail in practice; if it does, the block is kept whole) */
-    int16_t *d = realloc(fb->d, (size_t)(n ? n : 1) * sizeof *fb->d);
+    int16_t *d = getme__realloc(fb->d, (size_t)(n ? n : 1) * sizeof *fb->d);
     if (d)
         fb->d = d;
     return GETME_OK;

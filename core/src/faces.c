@@ -248,12 +248,13 @@ getme_status getme__ws_faces(const getme_ws *ws, const int64_t *foff,
 {
     static const int max_faces_at_corner = 4; /* pyramid apex */
     size_t bufsize = (size_t)ws->max_star * max_faces_at_corner + 1;
-    face_side *sides = malloc((size_t)ws->nt * bufsize * sizeof *sides);
-    face_group *groups = malloc((size_t)ws->nt * bufsize * sizeof *groups);
+    face_side *sides = getme__malloc((size_t)ws->nt * bufsize * sizeof *sides);
+    face_group *groups =
+        getme__malloc((size_t)ws->nt * bufsize * sizeof *groups);
     size_t hsize = 16;
     while (hsize < 2 * bufsize)
         hsize *= 2;
-    int32_t *hashes = malloc((size_t)ws->nt * hsize * sizeof *hashes);
+    int32_t *hashes = getme__malloc((size_t)ws->nt * hsize * sizeof *hashes);
     if (!sides || !groups || !hashes) {
         free(sides), free(groups), free(hashes);
         return GETME_ERR_NOMEM;

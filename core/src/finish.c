@@ -88,7 +88,7 @@ static void memo_free(climb_memo *m)
 
 static int memo_alloc(climb_memo *m, uint32_t cap)
 {
-    m->slot = malloc((size_t)cap * sizeof *m->slot);
+    m->slot = getme__malloc((size_t)cap * sizeof *m->slot);
     if (!m->slot)
         return -1;
     for (uint32_t i = 0; i < cap; i++)
@@ -169,7 +169,7 @@ static void memo_failed(climb_memo *m, int32_t node, fail_record f)
     if (!*idx) {
         if (m->num_rec == m->cap_rec) {
             uint32_t cap = m->cap_rec ? 2 * m->cap_rec : 1024;
-            fail_record *r = realloc(m->rec, cap * sizeof *r);
+            fail_record *r = getme__realloc(m->rec, cap * sizeof *r);
             if (!r)
                 return;
             m->rec = r, m->cap_rec = cap;
@@ -316,7 +316,7 @@ static getme_status pool_build(getme_run *run, pool *pl, double fraction,
 static int32_t pool_values(pool *pl, const double *q)
 {
     if (pl->n > pl->cap_v) {
-        double *v = realloc(pl->v, (size_t)pl->n * 2 * sizeof *v);
+        double *v = getme__realloc(pl->v, (size_t)pl->n * 2 * sizeof *v);
         if (!v)
             return -1;
         pl->v = v, pl->cap_v = 2 * (int64_t)pl->n;
@@ -355,7 +355,7 @@ static double pool_bound(getme_run *run, pool *pl, double fraction,
 static getme_ranked *pool_list(const getme_run *run, const pool *pl,
                                double bound, int32_t *count)
 {
-    getme_ranked *r = malloc((size_t)(pl->n ? pl->n : 1) * sizeof *r);
+    getme_ranked *r = getme__malloc((size_t)(pl->n ? pl->n : 1) * sizeof *r);
     if (!r)
         return NULL;
     int32_t n = 0;
@@ -464,7 +464,7 @@ static getme_status fill(getme_run *run, getme_patch *p, const int32_t *mv,
        to evaluate the elements again */
     getme__patch_eval_known(p, run->q);
 #ifdef GETME_CHECK_SUMS
-    double *q = malloc((size_t)(p->n ? p->n : 1) * sizeof *q);
+    double *q = getme__malloc((size_t)(p->n ? p->n : 1) * sizeof *q);
     if (!q)
         return GETME_ERR_NOMEM;
     memcpy(q, p->q, (size_t)p->n * sizeof *q);
@@ -615,7 +615,7 @@ static double sub_bound(const getme_run *run, double fraction,
         *incomplete = 1;
         return 0.0;
     }
-    double *v = malloc((size_t)ws->num_free_elem * sizeof *v);
+    double *v = getme__malloc((size_t)ws->num_free_elem * sizeof *v);
     if (!v)
         return -1.0;
     int32_t m = 0;
@@ -706,7 +706,7 @@ static getme_ranked *pass_list(const getme_run *run, double bound,
 #pragma omp parallel for schedule(static) num_threads(ws->nt) reduction(+ : n)
     for (int32_t e = 0; e < ws->ne; e++)
         n += ws->free_elem[e] && run->q[e] <= bound;
-    getme_ranked *r = malloc((size_t)(n ? n : 1) * sizeof *r);
+    getme_ranked *r = getme__malloc((size_t)(n ? n : 1) * sizeof *r);
     if (!r)
         return NULL;
     n = 0;
@@ -1125,7 +1125,7 @@ static getme_status sweep_levelled(sweep_ctx *c, int undo, double *budget)
 static getme_status workers_init(sweep_ctx *c, int nw)
 {
     const getme_run *run = c->run;
-    c->w = calloc((size_t)nw, sizeof *c->w);
+    c->w = getme__calloc((size_t)nw, sizeof *c->w);
     if (!c->w)
         return GETME_ERR_NOMEM;
     c->nw = nw;
@@ -1163,7 +1163,7 @@ static getme_status pass_sweeps(sweep_ctx *c, double *budget)
     if (levelled) {
         if (c->n > c->cap_rec) {
             free(c->rec);
-            c->rec = malloc((size_t)c->n * sizeof *c->rec);
+            c->rec = getme__malloc((size_t)c->n * sizeof *c->rec);
             c->cap_rec = c->rec ? c->n : 0;
             if (!c->rec)
                 return GETME_ERR_NOMEM;

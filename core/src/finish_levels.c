@@ -30,8 +30,8 @@ static uint32_t probe(const getme_levels *lv, int32_t e)
    (then lv is as it was). */
 static int marks_grow(getme_levels *lv, uint32_t cap)
 {
-    int32_t *key = malloc((size_t)cap * sizeof *key);
-    int32_t *mark = malloc((size_t)cap * sizeof *mark);
+    int32_t *key = getme__malloc((size_t)cap * sizeof *key);
+    int32_t *mark = getme__malloc((size_t)cap * sizeof *mark);
     if (!key || !mark) {
         free(key), free(mark);
         return -1;
@@ -55,7 +55,7 @@ static int marks_grow(getme_levels *lv, uint32_t cap)
 static int reserve(getme_levels *lv, int64_t refs)
 {
     if (refs > lv->cap_s) {
-        uint32_t *s = realloc(lv->slot, (size_t)refs * sizeof *s);
+        uint32_t *s = getme__realloc(lv->slot, (size_t)refs * sizeof *s);
         if (!s)
             return -1;
         lv->slot = s, lv->cap_s = refs;
@@ -108,17 +108,18 @@ getme_status getme__levels_build(getme_levels *lv, const getme_ws *ws,
 {
     int32_t nc = n ? (n - 1) / chunk + 1 : 0;
     if (nc + 1 > lv->cap_c) {
-        int32_t *f = realloc(lv->cfirst, (size_t)(nc + 1) * sizeof *f);
+        int32_t *f = getme__realloc(lv->cfirst, (size_t)(nc + 1) * sizeof *f);
         if (!f)
             return GETME_ERR_NOMEM;
         lv->cfirst = f, lv->cap_c = nc + 1;
     }
     lv->chunk = chunk, lv->num_chunks = nc;
     if (n > lv->cap) {
-        int32_t *a = realloc(lv->level, (size_t)n * sizeof *a);
+        int32_t *a = getme__realloc(lv->level, (size_t)n * sizeof *a);
         if (a)
             lv->level = a;
-        int32_t *b = a ? realloc(lv->order, (size_t)n * sizeof *b) : NULL;
+        int32_t *b =
+            a ? getme__realloc(lv->order, (size_t)n * sizeof *b) : NULL;
         if (!b)
             return GETME_ERR_NOMEM;
         lv->order = b, lv->cap = n;
@@ -151,7 +152,7 @@ getme_status getme__levels_build(getme_levels *lv, const getme_ws *ws,
     }
     lv->cfirst[nc] = num;
     if (num + 1 > lv->cap_ptr) {
-        int32_t *p = realloc(lv->ptr, (size_t)(num + 1) * sizeof *p);
+        int32_t *p = getme__realloc(lv->ptr, (size_t)(num + 1) * sizeof *p);
         if (!p)
             return GETME_ERR_NOMEM;
         lv->ptr = p, lv->cap_ptr = num + 1;

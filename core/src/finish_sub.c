@@ -158,8 +158,8 @@ getme_status getme_smooth_finish_sub(getme_mesh *sub,
     memset(&fs, 0, sizeof fs);
     fs.rest = rest;
     fs.cap_log = params->finish_max_passes > 0 ? params->finish_max_passes : 0;
-    fs.log = malloc((size_t)(fs.cap_log + 1) * sizeof *fs.log);
-    uint8_t *inside = malloc((size_t)(ws.nn ? ws.nn : 1));
+    fs.log = getme__malloc((size_t)(fs.cap_log + 1) * sizeof *fs.log);
+    uint8_t *inside = getme__malloc((size_t)(ws.nn ? ws.nn : 1));
     fs.complete = inside;
     run.ws = &ws;
     run.params = lp;

@@ -540,7 +540,7 @@ static getme_status pool_reserve(getme_run *run, int64_t need)
     if (cap > run->ws->nn)
         cap = run->ws->nn > need ? run->ws->nn : need;
     size_t bytes = (size_t)cap * 4 * sizeof *run->facc;
-    getme_fx *p = aligned_alloc(64, bytes);
+    getme_fx *p = getme__aligned_alloc(64, bytes);
     if (!p)
         return GETME_ERR_NOMEM;
     memset(p, 0, bytes);
@@ -606,8 +606,10 @@ static getme_status assign_slots(getme_run *run)
     const getme_blocks *blk = &run->adj->blk;
     const getme_ws *ws = run->ws;
     size_t nn = (size_t)(ws->nn ? ws->nn : 1);
-    int32_t *avail = malloc(nn * sizeof *avail); /* free at the phase start */
-    int32_t *back = malloc(nn * sizeof *back);   /* given back in the phase */
+    int32_t *avail =
+        getme__malloc(nn * sizeof *avail); /* free at the phase start */
+    int32_t *back =
+        getme__malloc(nn * sizeof *back);   /* given back in the phase */
     uint8_t *seen = run->in_t;                   /* zero before and after */
     if (!avail || !back) {
         free(avail), free(back);
@@ -889,7 +891,7 @@ static int32_t ring_sweep(getme_run *run)
     uint8_t *eflag = run->eflag;
     int32_t *out = run->elems, n = ws->ne;
     int32_t nc = (n + RING_CHUNK - 1) / RING_CHUNK;
-    int32_t *cnt = malloc(((size_t)nc + 1) * sizeof *cnt);
+    int32_t *cnt = getme__malloc(((size_t)nc + 1) * sizeof *cnt);
     if (!cnt) {
         int32_t m = 0;
         for (int32_t e = 0; e < n; e++)
@@ -1023,7 +1025,7 @@ static int tlist_reserve(getme_run *run, int64_t n)
     if (n <= run->cap_t)
         return 0;
     int64_t cap = n > 2 * run->cap_t ? n : 2 * run->cap_t;
-    int32_t *p = realloc(run->tlist, (size_t)cap * sizeof *p);
+    int32_t *p = getme__realloc(run->tlist, (size_t)cap * sizeof *p);
     if (!p)
         return -1;
     run->tlist = p;
@@ -1134,7 +1136,7 @@ static getme_status update_after(getme_run *run, double qt)
         getme__adj_sums_all(adj, ws, run->q);
     getme_ufx *tsum = NULL;
     if (run->qold && adj->blk.group.n == run->num_elems)
-        tsum = aligned_alloc(64, (size_t)ws->nt * 4 * sizeof *tsum);
+        tsum = getme__aligned_alloc(64, (size_t)ws->nt * 4 * sizeof *tsum);
     if (tsum) { /* in the blocks' race-free order, as scatter_some */
         for (int p = 0; p < ws->nt; p++)
             tsum[4 * p] = 0;
@@ -1318,7 +1320,7 @@ static void qold_reserve(getme_run *run)
         return;
     free(run->qold);
     run->cap_qold = 2 * (int64_t)run->num_elems + 64;
-    run->qold = malloc((size_t)run->cap_qold * sizeof *run->qold);
+    run->qold = getme__malloc((size_t)run->cap_qold * sizeof *run->qold);
     if (!run->qold)
         run->cap_qold = 0;
 }
@@ -1332,7 +1334,7 @@ static int sums_current(getme_run *run)
     getme_adj *adj = run->adj;
     size_t nb = (size_t)run->ws->nn * sizeof *adj->nsum;
     size_t eb = (size_t)adj->num_edges * sizeof *adj->esum;
-    int64_t *n = malloc(nb ? nb : 1), *e = malloc(eb ? eb : 1);
+    int64_t *n = getme__malloc(nb ? nb : 1), *e = getme__malloc(eb ? eb : 1);
     int same = n && e;
     if (same) {
         memcpy(n, adj->nsum, nb);
@@ -1357,7 +1359,7 @@ static int sums_current(getme_run *run)
 static getme_status undo_check(getme_run *run, double q_lo)
 {
     size_t xb = (size_t)run->ws->nn * 3 * sizeof(double);
-    double *x0 = malloc(xb ? xb : 1), bound = run->xbound;
+    double *x0 = getme__malloc(xb ? xb : 1), bound = run->xbound;
     if (!x0)
         return GETME_ERR_STATE;
     memcpy(x0, run->ws->x, xb);
@@ -1547,8 +1549,8 @@ double getme__threshold(getme_run *run, double fraction, int32_t min_count)
     int64_t k = getme__quantile_pos(n, fraction, min_count);
     /* the histogram (dist/test_fail_alloc.c fails this malloc by its
        size), and one per thread */
-    int64_t *hist = malloc(65536 * sizeof *hist);
-    int64_t *part = malloc((size_t)ws->nt * 65536 * sizeof *part);
+    int64_t *hist = getme__malloc(65536 * sizeof *hist);
+    int64_t *part = getme__malloc((size_t)ws->nt * 65536 * sizeof *part);
     if (getme__dist_any(run, !hist || !part)) { /* all stop, not only this one */
         free(hist);
         free(part);
@@ -1578,7 +1580,7 @@ double getme__threshold(getme_run *run, double fraction, int32_t min_count)
         memcpy(&qt, &prefix, sizeof qt);
         return qt;
     }
-    double *cand = malloc((size_t)in_bin * sizeof *cand);
+    double *cand = getme__malloc((size_t)in_bin * sizeof *cand);
     if (!cand)
         return -1.0;
     int32_t m = 0;
@@ -1597,11 +1599,11 @@ static getme_status alloc_stamps(getme_run *run)
     size_t ne = (size_t)(ws->ne ? ws->ne : 1);
     if (run->adj->num_irregular == 0)
         return GETME_OK;
-    run->stamps = calloc((size_t)ws->nt, sizeof *run->stamps);
+    run->stamps = getme__calloc((size_t)ws->nt, sizeof *run->stamps);
     if (!run->stamps)
         return GETME_ERR_NOMEM;
     for (int t = 0; t < ws->nt; t++)
-        if (!(run->stamps[t].mark = calloc(ne, sizeof(uint32_t))))
+        if (!(run->stamps[t].mark = getme__calloc(ne, sizeof(uint32_t))))
             return GETME_ERR_NOMEM;
     return GETME_OK;
 }
@@ -1613,7 +1615,7 @@ static getme_status alloc_adaptive(getme_run *run)
 {
     const getme_ws *ws = run->ws;
     size_t ne = (size_t)(ws->ne ? ws->ne : 1);
-    run->tflag = calloc(ne, 1);
+    run->tflag = getme__calloc(ne, 1);
     size_t nn = (size_t)(ws->nn ? ws->nn : 1);
     /* A pool of sums with a slot map (getme_run.facc, assign_slots), on
        one process (a distributed run sums every node's entry over the
@@ -1627,15 +1629,15 @@ static getme_status alloc_adaptive(getme_run *run)
     pool = pool && ws->nt != 3;
 #endif
     if (pool) { /* the pool itself after mark_last (assign_slots) */
-        run->slot = malloc(nn * sizeof *run->slot);
-        run->xold = malloc(nn * 3 * sizeof *run->xold);
+        run->slot = getme__malloc(nn * sizeof *run->slot);
+        run->xold = getme__malloc(nn * 3 * sizeof *run->xold);
         if (!run->tflag || !run->slot || !run->xold)
             return GETME_ERR_NOMEM;
         return alloc_stamps(run);
     }
     /* 64-byte aligned: a node's four sums are one cache line. */
     size_t fbytes = nn * 4 * sizeof *run->facc;
-    run->facc = aligned_alloc(64, fbytes);
+    run->facc = getme__aligned_alloc(64, fbytes);
     run->pool_cap = (int64_t)nn;
     /* Zeroed by every thread in its own share of the nodes, not by one
        memset: the array is fresh pages (the CLI maps every block of 1 MiB

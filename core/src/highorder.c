@@ -67,19 +67,20 @@ getme_status getme_mesh_add_elements_ho(getme_mesh *mesh, getme_ho_type type,
                                "out of range or repeated",
                                (int)(mesh->num_elements + e),
                                ho_names[type], (int)e);
-    if (!mesh->ho && !(mesh->ho = calloc(1, sizeof *mesh->ho)))
+    if (!mesh->ho && !(mesh->ho = getme__calloc(1, sizeof *mesh->ho)))
         return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
     getme_ho_mesh *ho = mesh->ho;
     if (ho->num_blocks == ho->cap_blocks) {
         int cap = ho->cap_blocks ? 2 * ho->cap_blocks : 4;
-        getme_ho_block *nb = realloc(ho->blocks, (size_t)cap * sizeof *nb);
+        getme_ho_block *nb =
+            getme__realloc(ho->blocks, (size_t)cap * sizeof *nb);
         if (!nb)
             return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
         ho->blocks = nb;
         ho->cap_blocks = cap;
     }
-    int32_t *full = malloc((size_t)count * nv * sizeof *full);
-    int32_t *corners = malloc((size_t)count * nl * sizeof *corners);
+    int32_t *full = getme__malloc((size_t)count * nv * sizeof *full);
+    int32_t *corners = getme__malloc((size_t)count * nl * sizeof *corners);
     if (!full || !corners) {
         free(full);
         free(corners);

@@ -71,9 +71,9 @@ getme_status getme__ho_repair(getme_ws *ws, int32_t *num_found,
     *num_nodes = 0;
     if (!ho)
         return GETME_OK;
-    uint8_t *mark = calloc((size_t)ho->nh + 1, 1);
-    uint8_t *moved = calloc((size_t)ho->nh + 1, 1);
-    uint8_t *bad = calloc((size_t)ws->ne + 1, 1);
+    uint8_t *mark = getme__calloc((size_t)ho->nh + 1, 1);
+    uint8_t *moved = getme__calloc((size_t)ho->nh + 1, 1);
+    uint8_t *bad = getme__calloc((size_t)ws->ne + 1, 1);
     if (!mark || !moved || !bad) {
         free(mark), free(moved), free(bad);
         return GETME_ERR_NOMEM;

@@ -218,18 +218,19 @@ getme_status getme__ho_attach(getme_ws *ws, getme_mesh *mesh)
     if (!mesh->ho || mesh->ho->num_elements == 0)
         return GETME_OK;
     const getme_ho_mesh *hm = mesh->ho;
-    getme_ho_ws *ho = calloc(1, sizeof *ho);
+    getme_ho_ws *ho = getme__calloc(1, sizeof *ho);
     size_t nn = (size_t)ws->nn + 1, ne = (size_t)ws->ne + 1;
-    int32_t *inv_node = malloc(nn * sizeof *inv_node);
-    int32_t *inv_elem = malloc(ne * sizeof *inv_elem);
-    int32_t *hid = malloc(nn * sizeof *hid); /* internal node -> h, or -1 */
+    int32_t *inv_node = getme__malloc(nn * sizeof *inv_node);
+    int32_t *inv_elem = getme__malloc(ne * sizeof *inv_elem);
+    int32_t *hid =
+        getme__malloc(nn * sizeof *hid); /* internal node -> h, or -1 */
     getme_status st = GETME_ERR_NOMEM;
     if (!ho || !inv_node || !inv_elem || !hid)
         goto fail;
-    ho->info = calloc(GETME_NUM_HO_TYPES, sizeof *ho->info);
-    ho->etype = malloc(ne);
-    ho->eptr = calloc(ne, sizeof *ho->eptr);
-    ho->x0 = malloc(3 * nn * sizeof *ho->x0);
+    ho->info = getme__calloc(GETME_NUM_HO_TYPES, sizeof *ho->info);
+    ho->etype = getme__malloc(ne);
+    ho->eptr = getme__calloc(ne, sizeof *ho->eptr);
+    ho->x0 = getme__malloc(3 * nn * sizeof *ho->x0);
     if (!ho->info || !ho->etype || !ho->eptr || !ho->x0)
         goto fail;
     memcpy(ho->x0, ws->x, (size_t)ws->nn * 3 * sizeof *ho->x0);
@@ -260,7 +261,7 @@ getme_status getme__ho_attach(getme_ws *ws, getme_mesh *mesh)
     for (int32_t e = 0; e < ws->ne; e++)
         ho->eptr[e + 1] += ho->eptr[e];
     int64_t slots = ho->eptr[ws->ne];
-    ho->eho = malloc((size_t)(slots + 1) * sizeof *ho->eho);
+    ho->eho = getme__malloc((size_t)(slots + 1) * sizeof *ho->eho);
     if (!ho->eho)
         goto fail;
     /* Number the dependent nodes in internal element order (deterministic
@@ -279,9 +280,9 @@ getme_status getme__ho_attach(getme_ws *ws, getme_mesh *mesh)
             if (hid[inv_node[conn[k]]] < 0)
                 hid[inv_node[conn[k]]] = nh++;
     }
-    ho->node = malloc(((size_t)nh + 1) * sizeof *ho->node);
-    ho->nc = calloc((size_t)nh + 1, 1);
-    ho->cn = malloc(((size_t)nh + 1) * 8 * sizeof *ho->cn);
+    ho->node = getme__malloc(((size_t)nh + 1) * sizeof *ho->node);
+    ho->nc = getme__calloc((size_t)nh + 1, 1);
+    ho->cn = getme__malloc(((size_t)nh + 1) * 8 * sizeof *ho->cn);
     if (!ho->node || !ho->nc || !ho->cn)
         goto fail;
     for (int32_t e = 0; e < ws->ne; e++) {
@@ -327,9 +328,9 @@ getme_status getme__ho_attach(getme_ws *ws, getme_mesh *mesh)
         }
     }
     ho->nh = nh;
-    ho->pinned = malloc((size_t)nh + 1);
-    ho->straight = malloc((size_t)nh + 1);
-    ho->ref = malloc(((size_t)nh + 1) * 3 * sizeof *ho->ref);
+    ho->pinned = getme__malloc((size_t)nh + 1);
+    ho->straight = getme__malloc((size_t)nh + 1);
+    ho->ref = getme__malloc(((size_t)nh + 1) * 3 * sizeof *ho->ref);
     if (!ho->pinned || !ho->straight || !ho->ref)
         goto fail;
     for (int32_t h = 0; h < nh; h++) {

@@ -17,6 +17,8 @@
 #include <stdint.h>
 #include <stdlib.h>
 
+#include "getme_alloc.h"
+
 #define GETME_MAX_NV 8 /* nodes of the largest element type (hex) */
 
 /* ---- element tables (quality.c) ---------------------------------------- */

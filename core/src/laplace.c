@@ -115,9 +115,11 @@ getme_status getme__laplace(getme_run *run)
     /* A node has at most 4 edge neighbours per incident element (pyramid
        apex), hence 4 * max_star entries per thread. */
     int32_t per_thread = 4 * (ws->max_star > 0 ? ws->max_star : 1);
-    int32_t *scratch = malloc((size_t)ws->nt * per_thread * sizeof *scratch);
+    int32_t *scratch =
+        getme__malloc((size_t)ws->nt * per_thread * sizeof *scratch);
     run->phat_step = 6 * sizeof(double); /* p-hat, old coordinates */
-    run->phat = malloc((size_t)(ws->nn ? ws->nn : 1) * (size_t)run->phat_step);
+    run->phat =
+        getme__malloc((size_t)(ws->nn ? ws->nn : 1) * (size_t)run->phat_step);
     if (!scratch || !run->phat) {
         free(scratch);
         free(run->phat);

@@ -682,8 +682,8 @@ static void reduce(const getme_mesh *mesh, const double *v, int per_type,
 
 static double *values_buffer(getme_mesh *mesh)
 {
-    return malloc((size_t)(mesh->num_elements ? mesh->num_elements : 1) *
-                  sizeof(double));
+    return getme__malloc((size_t)(mesh->num_elements ? mesh->num_elements : 1) *
+                         sizeof(double));
 }
 
 getme_status getme_mesh_measure_stats(getme_mesh *mesh, int type,
@@ -1205,9 +1205,10 @@ getme_status getme_mesh_measure_all_qualities(getme_mesh *mesh,
     for (int k = 0; k < GETME_NUM_TYPES * GETME_NUM_MEASURES; k++)
         init_stats(&stats[k], k % GETME_NUM_MEASURES);
     int nt = omp_get_max_threads();
-    double *v = malloc((size_t)MEASURE_TILE * GETME_NUM_MEASURES * sizeof *v);
+    double *v =
+        getme__malloc((size_t)MEASURE_TILE * GETME_NUM_MEASURES * sizeof *v);
     getme_measure_stats *part =
-        malloc((size_t)nt * GETME_NUM_MEASURES * sizeof *part);
+        getme__malloc((size_t)nt * GETME_NUM_MEASURES * sizeof *part);
     if (!v || !part) {
         free(v);
         free(part);

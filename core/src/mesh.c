@@ -55,14 +55,14 @@ getme_status getme_mesh_create(getme_mesh **out, int dim, int32_t num_nodes,
     if ((dim != 2 && dim != 3) || num_nodes < 0 ||
         (num_nodes > 0 && !coords) || num_nodes > INT32_MAX / 3)
         return GETME_ERR_ARGUMENT;
-    getme_mesh *m = calloc(1, sizeof *m);
+    getme_mesh *m = getme__calloc(1, sizeof *m);
     if (!m)
         return GETME_ERR_NOMEM;
     m->dim = dim;
     m->num_nodes = num_nodes;
     size_t n = (size_t)num_nodes;
-    m->coords = malloc((n ? n : 1) * 3 * sizeof(double));
-    m->fixed = calloc(n ? n : 1, 1);
+    m->coords = getme__malloc((n ? n : 1) * 3 * sizeof(double));
+    m->fixed = getme__calloc(n ? n : 1, 1);
     if (!m->coords || !m->fixed) {
         getme_mesh_free(m);
         return GETME_ERR_NOMEM;
@@ -146,7 +146,8 @@ getme_status getme_mesh_add_elements(getme_mesh *mesh, getme_elem_type type,
                            getme_type_name(type), (int)bad);
     if (mesh->num_blocks == mesh->cap_blocks) {
         int cap = mesh->cap_blocks ? 2 * mesh->cap_blocks : 4;
-        getme_block *nb = realloc(mesh->blocks, (size_t)cap * sizeof *nb);
+        getme_block *nb =
+            getme__realloc(mesh->blocks, (size_t)cap * sizeof *nb);
         if (!nb)
             return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
         mesh->blocks = nb;
@@ -158,7 +159,7 @@ getme_status getme_mesh_add_elements(getme_mesh *mesh, getme_elem_type type,
     b->type = type;
     b->first = mesh->num_elements;
     b->count = count;
-    b->conn = malloc((size_t)count * nv * sizeof(int32_t));
+    b->conn = getme__malloc((size_t)count * nv * sizeof(int32_t));
     int32_t same = 1; /* one region for the whole block: no array */
     for (int32_t e = 1; region && same && e < count; e++)
         same = region[e] == region[0];
@@ -167,7 +168,7 @@ getme_status getme_mesh_add_elements(getme_mesh *mesh, getme_elem_type type,
         region = NULL;
     }
     if (region)
-        b->region = malloc((size_t)count * sizeof(int32_t));
+        b->region = getme__malloc((size_t)count * sizeof(int32_t));
     if (!b->conn || (region && !b->region)) {
         free(b->conn);
         free(b->region);

@@ -3,6 +3,7 @@
  * (offsets.h says why and how).
  */
 #include "offsets.h"
+#include "getme_alloc.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -27,7 +28,7 @@ void getme__offs_take(getme_offsets *o, int32_t *table, int64_t n)
         if ((int64_t)table[last] - table[g * GETME_OFFS_GROUP] > UINT16_MAX)
             return;
     }
-    int32_t *base = malloc((size_t)(ng ? ng : 1) * sizeof *base);
+    int32_t *base = getme__malloc((size_t)(ng ? ng : 1) * sizeof *base);
     if (!base)
         return;
     /* In place: entry v's uint16 goes to bytes [2v, 2v + 2), inside
@@ -41,7 +42,7 @@ void getme__offs_take(getme_offsets *o, int32_t *table, int64_t n)
         uint16_t d = (uint16_t)(x - base[v / GETME_OFFS_GROUP]);
         memcpy(bytes + 2 * v, &d, sizeof d);
     }
-    uint16_t *off = realloc(table, (size_t)(n ? n : 1) * sizeof *off);
+    uint16_t *off = getme__realloc(table, (size_t)(n ? n : 1) * sizeof *off);
     o->off = off ? off : (uint16_t *)(void *)table;
     o->base = base;
     o->plain = NULL;

@@ -3,6 +3,7 @@
  * starts at a 64-bit word, so runs never share a word.
  */
 #include "pack.h"
+#include "getme_alloc.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -32,9 +33,9 @@ int getme__pack(getme_packed *p, const int32_t *v, int64_t n)
     if (runs == 0)
         return 0;
     p->n = n;
-    p->base = malloc((size_t)runs * sizeof *p->base);
-    p->bits = malloc((size_t)runs * sizeof *p->bits);
-    p->start = malloc((size_t)runs * sizeof *p->start);
+    p->base = getme__malloc((size_t)runs * sizeof *p->base);
+    p->bits = getme__malloc((size_t)runs * sizeof *p->bits);
+    p->start = getme__malloc((size_t)runs * sizeof *p->start);
     if (!p->base || !p->bits || !p->start) {
         getme__packed_free(p);
         return 0;
@@ -60,7 +61,7 @@ int getme__pack(getme_packed *p, const int32_t *v, int64_t n)
     int64_t words = bit / 64 + 1;
     p->words = words;
     if (bytes_of(runs, words) >= n * (int64_t)sizeof *v ||
-        !(p->data = calloc((size_t)words, sizeof *p->data))) {
+        !(p->data = getme__calloc((size_t)words, sizeof *p->data))) {
         getme__packed_free(p);
         return 0;
     }

@@ -32,7 +32,7 @@ void getme__patch_free(getme_patch *p)
    gradients, D_MAX values per element.  RESIZE keeps a field unchanged
    when realloc fails. */
 #define RESIZE(field, n)                                                   \
-    ((tmp = realloc(p->field, (n) * sizeof *p->field)) ? (p->field = tmp, 0) \
+    ((tmp = getme__realloc(p->field, (n) * sizeof *p->field)) ? (p->field = tmp, 0) \
                                                        : -1)
 
 static getme_status grow(getme_patch *p, int32_t cap)

@@ -221,7 +221,7 @@ static int32_t list_invalid(const getme_run *run, int32_t **bad, int64_t *cap,
 {
     int32_t m = 0;
     if (n > *cap) {
-        int32_t *p = realloc(*bad, (size_t)n * 2 * sizeof *p);
+        int32_t *p = getme__realloc(*bad, (size_t)n * 2 * sizeof *p);
         if (!p)
             return -1;
         *bad = p;
@@ -329,7 +329,7 @@ static void steps_local(getme_run *run, const double *R, int nR,
     int32_t *bad = NULL, *next = NULL;
     int32_t nbad = invalid ? list_invalid(run, &bad, &cap, invalid) : 0;
     int64_t cap_next = cap;
-    if (nbad > 0 && !(next = malloc((size_t)cap * sizeof *next)))
+    if (nbad > 0 && !(next = getme__malloc((size_t)cap * sizeof *next)))
         nbad = -1;
     while (nbad != 0) {
         /* Out of memory for the lists: the whole list is the candidate

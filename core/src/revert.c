@@ -33,7 +33,7 @@ getme_status getme__input_keep(getme_input *in, const getme_ws *ws,
     memset(in, 0, sizeof *in);
     if (!on)
         return GETME_OK;
-    in->x = malloc((size_t)ws->nn * 3 * sizeof *in->x);
+    in->x = getme__malloc((size_t)ws->nn * 3 * sizeof *in->x);
     if (!in->x)
         return GETME_ERR_NOMEM;
     /* Copied by every thread in its own share: the copy is fresh pages
@@ -117,7 +117,7 @@ getme_status getme__input_revert(const getme_input *in, getme_ws *ws,
         if (ws->free_elem[e] && q[e] < in->q_min_star &&
             getme__push_i32(&bad.v, &bad.n, &bad.cap, e))
             goto out;
-    if (bad.n && !(done = calloc(((size_t)ws->nn + 63) / 64, sizeof *done)))
+    if (bad.n && !(done = getme__calloc(((size_t)ws->nn + 63) / 64, sizeof *done)))
         goto out;
     while (bad.n) {
         nodes.n = 0;

@@ -15,14 +15,14 @@ getme_status getme__run_alloc(getme_run *run)
 {
     const getme_ws *ws = run->ws;
     size_t nn = (size_t)(ws->nn ? ws->nn : 1), ne = (size_t)(ws->ne ? ws->ne : 1);
-    run->q = malloc(ne * sizeof *run->q);
-    run->in_t = calloc(nn, 1);
-    run->flag = calloc(nn, 1);
-    run->ridx = calloc(nn, 1);
-    run->eflag = calloc(ne, 1);
-    run->nodes = malloc(nn * sizeof *run->nodes);
-    run->elems = malloc(ne * sizeof *run->elems);
-    run->list = malloc(nn * sizeof *run->list);
+    run->q = getme__malloc(ne * sizeof *run->q);
+    run->in_t = getme__calloc(nn, 1);
+    run->flag = getme__calloc(nn, 1);
+    run->ridx = getme__calloc(nn, 1);
+    run->eflag = getme__calloc(ne, 1);
+    run->nodes = getme__malloc(nn * sizeof *run->nodes);
+    run->elems = getme__malloc(ne * sizeof *run->elems);
+    run->list = getme__malloc(nn * sizeof *run->list);
     if (!run->q || !run->in_t || !run->flag ||
         !run->ridx || !run->eflag || !run->nodes || !run->elems || !run->list)
         return GETME_ERR_NOMEM;
@@ -50,7 +50,7 @@ void getme__run_free(getme_run *run)
 static int32_t compact(const uint8_t *flag, int32_t n, int32_t *out, int nt)
 {
     int32_t nc = (n + COLLECT_CHUNK - 1) / COLLECT_CHUNK;
-    int32_t *cnt = malloc(((size_t)nc + 1) * sizeof *cnt);
+    int32_t *cnt = getme__malloc(((size_t)nc + 1) * sizeof *cnt);
     if (!cnt) { /* serial fallback gives the same list */
         int32_t m = 0;
         for (int32_t i = 0; i < n; i++)

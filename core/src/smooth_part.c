@@ -67,8 +67,8 @@ getme_status getme_smooth_part(getme_mesh *mesh, const getme_params *params,
     run.t0 = t0;
     run.comm = comm;
     if (st == GETME_OK) {
-        run.owned = malloc((size_t)(ws.ne ? ws.ne : 1));
-        run.counted = malloc((size_t)(ws.nn ? ws.nn : 1));
+        run.owned = getme__malloc((size_t)(ws.ne ? ws.ne : 1));
+        run.counted = getme__malloc((size_t)(ws.nn ? ws.nn : 1));
         if ((st = getme__run_alloc(&run)) != GETME_OK || !run.owned ||
             !run.counted)
             st = getme__fail(mesh, GETME_ERR_NOMEM, "out of memory for %d "

@@ -84,7 +84,7 @@ void getme__stars_pack(getme_ws *ws)
        if they are packed (getme__ws_pack_map made sure they fit). */
     int64_t keep = ws->maps_packed == 1 ? 4 * ((int64_t)ws->ne + ws->nn) : 0;
     keep = keep > ptr[ws->nn] ? keep : ptr[ws->nn];
-    int32_t *shrunk = realloc(ws->star, (size_t)(keep ? keep : 1));
+    int32_t *shrunk = getme__realloc(ws->star, (size_t)(keep ? keep : 1));
     if (shrunk)
         ws->star = shrunk;
     /* the offsets in 2.25 bytes per node, if their groups fit */

@@ -136,7 +136,7 @@ getme_status getme_mesh_quality_stats_from(getme_mesh *mesh, const double *q,
         type >= GETME_NUM_TYPES)
         return GETME_ERR_ARGUMENT;
     int nt = omp_get_max_threads();
-    partial all, *part = malloc((size_t)nt * sizeof *part);
+    partial all, *part = getme__malloc((size_t)nt * sizeof *part);
     if (!part)
         return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
     partial_init(&all);
@@ -163,8 +163,9 @@ getme_status getme_mesh_quality_stats(getme_mesh *mesh, int type,
         return GETME_ERR_ARGUMENT;
     /* the qualities first, then the statistics: measured faster than one
        sweep doing both (1M tets, one thread: 36 against 45 ms) */
-    double *q = malloc((size_t)(mesh->num_elements ? mesh->num_elements : 1) *
-                       sizeof *q);
+    double *q =
+        getme__malloc((size_t)(mesh->num_elements ? mesh->num_elements : 1) *
+                      sizeof *q);
     if (!q)
         return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
     getme_mesh_element_qualities(mesh, q);

@@ -73,7 +73,8 @@ getme_status getme_mesh_fix_boundary(getme_mesh *mesh, unsigned flags,
     /* Packed at once (facenb.h), in place: this reads it packed, and the
        smoother takes it over.  A cached workspace has it already. */
     if (!ws.faces.d) {
-        int32_t *table = malloc((size_t)(total ? total : 1) * sizeof *table);
+        int32_t *table =
+            getme__malloc((size_t)(total ? total : 1) * sizeof *table);
         getme_status st = GETME_ERR_NOMEM;
         if (!table || (st = getme__ws_faces(&ws, foff, table)) != GETME_OK)
             free(table);
@@ -90,7 +91,7 @@ getme_status getme_mesh_fix_boundary(getme_mesh *mesh, unsigned flags,
        face table, in parallel; the marking below (its writes to shared
        nodes serial) then visits only those, the few on the skin and the
        interfaces. */
-    uint8_t *touch = malloc((size_t)(ws.ne ? ws.ne : 1));
+    uint8_t *touch = getme__malloc((size_t)(ws.ne ? ws.ne : 1));
     if (!touch) {
         getme__ws_free(&ws);
         return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");

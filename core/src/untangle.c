@@ -497,7 +497,7 @@ static getme_status colour_nodes(ut_state *u)
         n++;
     }
     free(u->colour_ptr);
-    u->colour_ptr = calloc((size_t)nc + 2, sizeof *u->colour_ptr);
+    u->colour_ptr = getme__calloc((size_t)nc + 2, sizeof *u->colour_ptr);
     if (!u->colour_ptr)
         return GETME_ERR_NOMEM;
     for (int32_t i = 0; i < ws->nn; i++)
@@ -677,15 +677,15 @@ getme_status getme__untangle(getme_ws *ws, double *q,
     u.q = q;
     size_t nn = (size_t)(ws->nn ? ws->nn : 1), ne = (size_t)(ws->ne ? ws->ne : 1);
     u.max_colours = 8 * ws->max_star + 2;
-    u.nflag = calloc(nn, 1);
-    u.eflag = calloc(ne, 1);
-    u.nodes = malloc(nn * sizeof *u.nodes);
-    u.colour = malloc(nn * sizeof *u.colour);
-    u.elems = malloc(ne * sizeof *u.elems);
-    u.stamp = calloc((size_t)u.max_colours, sizeof *u.stamp);
+    u.nflag = getme__calloc(nn, 1);
+    u.eflag = getme__calloc(ne, 1);
+    u.nodes = getme__malloc(nn * sizeof *u.nodes);
+    u.colour = getme__malloc(nn * sizeof *u.colour);
+    u.elems = getme__malloc(ne * sizeof *u.elems);
+    u.stamp = getme__calloc((size_t)u.max_colours, sizeof *u.stamp);
     u.scratch_per_thread = (int64_t)CORNERS_PER_ELEMENT * ws->max_star;
-    u.scratch = malloc((size_t)(ws->nt * u.scratch_per_thread) *
-                       sizeof *u.scratch);
+    u.scratch = getme__malloc((size_t)(ws->nt * u.scratch_per_thread) *
+                              sizeof *u.scratch);
     getme_status st = GETME_ERR_NOMEM;
     if (!u.nflag || !u.eflag || !u.nodes || !u.colour || !u.elems || !u.stamp ||
         !u.scratch)
@@ -786,7 +786,7 @@ getme_status getme_mesh_untangle(getme_mesh *mesh, const getme_params *params,
                                    sizeof *result, &t0, 0);
     if (st != GETME_OK)
         return st;
-    double *q = malloc((size_t)ws.ne * sizeof *q);
+    double *q = getme__malloc((size_t)ws.ne * sizeof *q);
     if (!q) {
         getme__ws_free(&ws);
         return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");

@@ -49,7 +49,7 @@ void getme__ws_free(getme_ws *ws)
 void getme__ws_keep(getme_ws *ws, getme_mesh *mesh)
 {
     getme__mesh_drop_ws(mesh);
-    mesh->ws_cache = malloc(sizeof *mesh->ws_cache);
+    mesh->ws_cache = getme__malloc(sizeof *mesh->ws_cache);
     if (mesh->ws_cache)
         *mesh->ws_cache = *ws;
     else
@@ -101,9 +101,9 @@ uint32_t getme__morton(const double *x, const double lo[3],
 static int radix_sort(uint32_t *key, int32_t *idx, int32_t n, int nt)
 {
     enum { BITS = 11, DIGITS = 1 << BITS };
-    uint32_t *k2 = malloc((size_t)(n ? n : 1) * sizeof *k2);
-    int32_t *i2 = malloc((size_t)(n ? n : 1) * sizeof *i2);
-    int64_t *cnt = malloc((size_t)nt * DIGITS * sizeof *cnt);
+    uint32_t *k2 = getme__malloc((size_t)(n ? n : 1) * sizeof *k2);
+    int32_t *i2 = getme__malloc((size_t)(n ? n : 1) * sizeof *i2);
+    int64_t *cnt = getme__malloc((size_t)nt * DIGITS * sizeof *cnt);
     if (!k2 || !i2 || !cnt) {
         free(k2), free(i2), free(cnt);
         return -1;
@@ -195,9 +195,10 @@ static getme_status order_elements(getme_ws *ws, const getme_mesh *mesh,
     double scale[3];
     for (int d = 0; d < 3; d++)
         scale[d] = hi[d] > lo[d] ? 1023.0 / (hi[d] - lo[d]) : 0.0;
-    uint32_t *key = malloc((size_t)ws->ne * sizeof *key);
-    uint32_t *nkey = malloc((size_t)(mesh->num_nodes ? mesh->num_nodes : 1) *
-                            sizeof *nkey);
+    uint32_t *key = getme__malloc((size_t)ws->ne * sizeof *key);
+    uint32_t *nkey =
+        getme__malloc((size_t)(mesh->num_nodes ? mesh->num_nodes : 1) *
+                      sizeof *nkey);
     if (!key || !nkey) {
         free(key), free(nkey);
         return GETME_ERR_NOMEM;
@@ -250,9 +251,10 @@ static getme_status first_touch_parallel(const getme_ws *ws, int32_t *c,
 {
     int nt = ws->nt;
     size_t words = ((size_t)ws->nn + 63) / 64;
-    uint64_t *seen = calloc((size_t)nt * (words ? words : 1), sizeof *seen);
-    int32_t **list = calloc((size_t)nt, sizeof *list);
-    int64_t *len = calloc((size_t)nt, sizeof *len);
+    uint64_t *seen =
+        getme__calloc((size_t)nt * (words ? words : 1), sizeof *seen);
+    int32_t **list = getme__calloc((size_t)nt, sizeof *list);
+    int64_t *len = getme__calloc((size_t)nt, sizeof *len);
     int failed = !seen || !list || !len;
     /* A range lists each node at most once, plus one slot that the
        branch-free append may write past the last; the team may be
@@ -260,7 +262,7 @@ static getme_status first_touch_parallel(const getme_ws *ws, int32_t *c,
     int64_t cap = (total < ws->nn ? total : ws->nn) + 1;
     if (!failed)
         for (int t = 0; t < nt; t++) {
-            list[t] = malloc((size_t)cap * sizeof **list);
+            list[t] = getme__malloc((size_t)cap * sizeof **list);
             failed |= !list[t];
         }
     if (failed) {
@@ -318,8 +320,9 @@ static getme_status number_nodes(getme_ws *ws, const getme_mesh *mesh,
         ws->coff[t] = total;
         total += (int64_t)(ws->tstart[t + 1] - ws->tstart[t]) * getme__nv[t];
     }
-    ws->conn = malloc((size_t)(total ? total : 1) * sizeof *ws->conn);
-    int32_t *newid = malloc((size_t)(ws->nn ? ws->nn : 1) * sizeof *newid);
+    ws->conn = getme__malloc((size_t)(total ? total : 1) * sizeof *ws->conn);
+    int32_t *newid =
+        getme__malloc((size_t)(ws->nn ? ws->nn : 1) * sizeof *newid);
     if (!ws->conn || !newid) {
         free(newid);
         return GETME_ERR_NOMEM;
@@ -390,14 +393,14 @@ static getme_status number_nodes(getme_ws *ws, const getme_mesh *mesh,
 
 static getme_status build_stars(getme_ws *ws)
 {
-    ws->star_ptr = calloc((size_t)ws->nn + 1, sizeof *ws->star_ptr);
+    ws->star_ptr = getme__calloc((size_t)ws->nn + 1, sizeof *ws->star_ptr);
     int64_t total = ws->coff[GETME_NUM_TYPES - 1] +
                     (int64_t)(ws->tstart[GETME_NUM_TYPES] -
                               ws->tstart[GETME_NUM_TYPES - 1]) *
                         getme__nv[GETME_NUM_TYPES - 1];
     if (total > INT32_MAX)
         return GETME_ERR_NOMEM; /* star_ptr is 32-bit (workspace.h) */
-    ws->star = malloc((size_t)(total ? total : 1) * sizeof *ws->star);
+    ws->star = getme__malloc((size_t)(total ? total : 1) * sizeof *ws->star);
     if (!ws->star_ptr || !ws->star)
         return GETME_ERR_NOMEM;
     /* Each thread owns a range of nodes and walks all the connectivity,
@@ -426,7 +429,7 @@ static getme_status build_stars(getme_ws *ws)
             ws->max_star = c;
         ws->star_ptr[i + 1] += ws->star_ptr[i];
     }
-    int32_t *pos = malloc((size_t)(ws->nn ? ws->nn : 1) * sizeof *pos);
+    int32_t *pos = getme__malloc((size_t)(ws->nn ? ws->nn : 1) * sizeof *pos);
     if (!pos)
         return GETME_ERR_NOMEM;
     memcpy(pos, ws->star_ptr, (size_t)ws->nn * sizeof *pos);
@@ -459,11 +462,11 @@ static getme_status colour_blocks(getme_ws *ws)
         nb += (n + BLOCK_SIZE - 1) / BLOCK_SIZE;
     }
     ws->num_blocks = nb;
-    ws->block_start = malloc(((size_t)nb + 1) * sizeof *ws->block_start);
-    int32_t *colour = malloc((size_t)(nb ? nb : 1) * sizeof *colour);
-    uint64_t *mask = calloc((size_t)(ws->nn ? ws->nn : 1), sizeof *mask);
-    ws->colour_ptr = calloc(MAX_COLOURS + 2, sizeof *ws->colour_ptr);
-    ws->colour_blocks = malloc((size_t)(nb ? nb : 1) * sizeof(int32_t));
+    ws->block_start = getme__malloc(((size_t)nb + 1) * sizeof *ws->block_start);
+    int32_t *colour = getme__malloc((size_t)(nb ? nb : 1) * sizeof *colour);
+    uint64_t *mask = getme__calloc((size_t)(ws->nn ? ws->nn : 1), sizeof *mask);
+    ws->colour_ptr = getme__calloc(MAX_COLOURS + 2, sizeof *ws->colour_ptr);
+    ws->colour_blocks = getme__malloc((size_t)(nb ? nb : 1) * sizeof(int32_t));
     if (!ws->block_start || !colour || !mask || !ws->colour_ptr ||
         !ws->colour_blocks) {
         free(colour), free(mask);
@@ -570,8 +573,8 @@ getme_status getme__ws_build(getme_ws *ws, getme_mesh *mesh, int renumber,
     ws->nn = mesh->num_nodes;
     ws->ne = mesh->num_elements;
     size_t nn = (size_t)(ws->nn ? ws->nn : 1), ne = (size_t)(ws->ne ? ws->ne : 1);
-    ws->elem_orig = malloc(ne * sizeof *ws->elem_orig);
-    ws->node_orig = malloc(nn * sizeof *ws->node_orig);
+    ws->elem_orig = getme__malloc(ne * sizeof *ws->elem_orig);
+    ws->node_orig = getme__malloc(nn * sizeof *ws->node_orig);
     getme_status st = GETME_ERR_NOMEM;
     if (!ws->elem_orig || !ws->node_orig)
         goto fail;
@@ -580,9 +583,9 @@ getme_status getme__ws_build(getme_ws *ws, getme_mesh *mesh, int renumber,
     if ((st = number_nodes(ws, mesh, renumber)) != GETME_OK)
         goto fail;
     st = GETME_ERR_NOMEM;
-    ws->x = malloc(nn * 3 * sizeof *ws->x);
-    ws->fixed = malloc(nn);
-    ws->free_elem = malloc(ne);
+    ws->x = getme__malloc(nn * 3 * sizeof *ws->x);
+    ws->fixed = getme__malloc(nn);
+    ws->free_elem = getme__malloc(ne);
     if (!ws->x || !ws->fixed || !ws->free_elem)
         goto fail;
     double ysign = mesh->mirror == 1 ? -1.0 : 1.0;
@@ -662,7 +665,7 @@ static void permute_rows_in_place(void *rows, size_t size, int32_t *dest,
 static void *permute_rows(void *rows, size_t size, int32_t *dest, int32_t n,
                           int nt)
 {
-    unsigned char *out = malloc((size_t)(n ? n : 1) * size);
+    unsigned char *out = getme__malloc((size_t)(n ? n : 1) * size);
     if (!out) {
         permute_rows_in_place(rows, size, dest, n);
         return rows;

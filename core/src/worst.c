@@ -100,7 +100,8 @@ static int marked(const getme_block *bl, const uint8_t *mark, hits *part,
             return -1;
         add += part[k].n;
     }
-    int32_t *grown = realloc(*list, ((size_t)*m + add + 1) * sizeof *grown);
+    int32_t *grown =
+        getme__realloc(*list, ((size_t)*m + add + 1) * sizeof *grown);
     if (!grown)
         return -1;
     *list = grown;
@@ -120,9 +121,9 @@ static getme_status candidates(const getme_mesh *mesh,
                                int32_t **cand, int32_t *num)
 {
     int nt = omp_get_max_threads();
-    uint8_t *mark = calloc((size_t)mesh->num_nodes, 1);
-    hits *part = calloc((size_t)nt, sizeof *part);
-    int32_t *list = malloc(sizeof *list), m = 0;
+    uint8_t *mark = getme__calloc((size_t)mesh->num_nodes, 1);
+    hits *part = getme__calloc((size_t)nt, sizeof *part);
+    int32_t *list = getme__malloc(sizeof *list), m = 0;
     for (int32_t i = 0; mark && i < n; i++) {
         int t;
         const int32_t *c = nodes_of(mesh, w[i].element, &t);
@@ -195,8 +196,8 @@ static getme_status worst_sweep(const getme_mesh *mesh, const double *q,
                                 getme_worst_element *out, int32_t *n)
 {
     int nt = omp_get_max_threads();
-    getme_worst_element *part = malloc((size_t)nt * max * sizeof *part);
-    int32_t *cnt = malloc((size_t)nt * sizeof *cnt);
+    getme_worst_element *part = getme__malloc((size_t)nt * max * sizeof *part);
+    int32_t *cnt = getme__malloc((size_t)nt * sizeof *cnt);
     if (!part || !cnt) {
         free(part);
         free(cnt);
@@ -241,7 +242,7 @@ getme_status getme_mesh_worst_elements(getme_mesh *mesh, int32_t max_count,
     *count = 0;
     if (max_count == 0 || mesh->num_elements == 0)
         return GETME_OK;
-    double *q = malloc((size_t)mesh->num_elements * sizeof *q);
+    double *q = getme__malloc((size_t)mesh->num_elements * sizeof *q);
     if (!q)
         return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
     getme_mesh_element_qualities(mesh, q);

@@ -7,6 +7,7 @@
  * numbers are resolved through the zone's sections.
  */
 #include "cgns_internal.h"
+#include "getme_alloc.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -109,7 +110,7 @@ static getme_formats_status read_bc(bc_ctx *c, cgns_impl *impl, int fn, int bc,
                               c->doc->path, c->path, cg_PointSetTypeName(ptset));
     if (npnts <= 0)
         return GETME_FORMATS_OK;
-    cgsize_t *pnts = malloc((size_t)npnts * sizeof *pnts);
+    cgsize_t *pnts = getme__malloc((size_t)npnts * sizeof *pnts);
     if (!pnts)
         return getme_doc_fail(c->doc, GETME_FORMATS_ERR_INTERNAL, "%s: out of memory",
                               c->doc->path);

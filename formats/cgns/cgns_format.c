@@ -8,6 +8,7 @@
 #define _POSIX_C_SOURCE 200809L /* fstat's st_mtim */
 
 #include "cgns_internal.h"
+#include "getme_alloc.h"
 #include "cgns_magic.h"
 
 #include <errno.h>
@@ -89,7 +90,7 @@ static getme_formats_status check_input(getme_doc *doc, cgns_impl *impl)
 
 static getme_formats_status cgns_open(getme_doc *doc, const getme_doc_options *opts)
 {
-    cgns_impl *impl = calloc(1, sizeof *impl);
+    cgns_impl *impl = getme__calloc(1, sizeof *impl);
     getme_formats_status st;
     int fn;
 

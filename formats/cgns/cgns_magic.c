@@ -4,6 +4,7 @@
  * (cgns_format.c) both ask, so both are built with it.
  */
 #include "cgns_magic.h"
+#include "getme_alloc.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -18,7 +19,7 @@ int cgns_magic(const char *path)
     static const unsigned char hdf5[8] = {0x89, 'H', 'D', 'F', '\r', '\n',
                                           0x1a, '\n'};
     enum { HEAD = 65536 };
-    unsigned char *buf = malloc(HEAD);
+    unsigned char *buf = getme__malloc(HEAD);
     FILE *f = fopen(path, "rb");
     size_t n = 0;
     int kind = MAGIC_NONE;

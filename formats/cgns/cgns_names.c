@@ -5,6 +5,7 @@
  * names.  CGNS names are case-sensitive, so is the matching here.
  */
 #include "cgns_internal.h"
+#include "getme_alloc.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -19,7 +20,7 @@ getme_formats_status cgns_add_set(getme_doc *doc, cgns_impl *impl,
             return GETME_FORMATS_OK;
     if (impl->num_sets == impl->cap_sets) {
         int cap = impl->cap_sets ? 2 * impl->cap_sets : 32;
-        cgns_set_name *s = realloc(impl->sets, (size_t)cap * sizeof *s);
+        cgns_set_name *s = getme__realloc(impl->sets, (size_t)cap * sizeof *s);
         if (!s)
             return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL,
                                   "%s: out of memory", doc->path);

@@ -4,6 +4,7 @@
  * BCs zone by zone, then mark the fixed nodes and check the input is valid.
  */
 #include "cgns_internal.h"
+#include "getme_alloc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -102,8 +103,8 @@ static getme_formats_status scan_zone(getme_doc *doc, cgns_impl *impl, int fn,
     cgns_zone *zone;
     getme_formats_status st;
 
-    cgns_zone *zones = realloc(impl->zones,
-                               (size_t)(impl->num_zones + 1) * sizeof *zones);
+    cgns_zone *zones = getme__realloc(impl->zones,
+                                      (size_t)(impl->num_zones + 1) * sizeof *zones);
     if (!zones)
         return oom(doc);
     impl->zones = zones;
@@ -323,7 +324,7 @@ static getme_formats_status read_coords(getme_doc *doc, cgns_impl *impl, int fn,
     for (int z = 0; z < impl->num_zones; z++)
         if (impl->zones[z].num_nodes > max_n)
             max_n = impl->zones[z].num_nodes;
-    double *buf = malloc((size_t)max_n * sizeof *buf);
+    double *buf = getme__malloc((size_t)max_n * sizeof *buf);
     if (!buf)
         return oom(doc);
     for (int z = 0; z < impl->num_zones && st == GETME_FORMATS_OK; z++) {
@@ -394,7 +395,7 @@ static void describe_element(const getme_doc *doc, const cgns_impl *impl,
 static getme_formats_status check_valid(getme_doc *doc, const cgns_impl *impl)
 {
     int32_t ne = getme_mesh_num_elements(doc->mesh), bad = 0;
-    double *q = malloc((size_t)ne * sizeof *q);
+    double *q = getme__malloc((size_t)ne * sizeof *q);
     char list[600] = "", one[2 * CGNS_PATH_LEN];
 
     if (!q)
@@ -463,12 +464,13 @@ static getme_formats_status build_mesh(getme_doc *doc, cgns_impl *impl, int fn,
                                   const getme_doc_options *opts,
                                   int32_t total)
 {
-    uint8_t *fixed = calloc((size_t)total, 1);
+    uint8_t *fixed = getme__calloc((size_t)total, 1);
     unsigned flags = 0;
     getme_formats_status st;
 
-    doc->elem_ids = malloc((size_t)(impl->max_elems > 0 ? impl->max_elems : 1) *
-                           sizeof *doc->elem_ids);
+    doc->elem_ids =
+        getme__malloc((size_t)(impl->max_elems > 0 ? impl->max_elems : 1) *
+                      sizeof *doc->elem_ids);
     if (!fixed || !doc->elem_ids) {
         free(fixed);
         return oom(doc);
@@ -509,7 +511,7 @@ getme_formats_status cgns_read(getme_doc *doc, cgns_impl *impl, int fn,
         st = cgns_check_names(doc, impl, opts);
     if (st != GETME_FORMATS_OK)
         return st;
-    double *coords = calloc((size_t)total * 3, sizeof *coords);
+    double *coords = getme__calloc((size_t)total * 3, sizeof *coords);
     if (!coords)
         return oom(doc);
     st = read_coords(doc, impl, fn, coords, (int32_t)total);

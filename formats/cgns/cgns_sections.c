@@ -9,6 +9,7 @@
  * volume types on a file converted by the CGNS project's aflr3_to_cgns).
  */
 #include "cgns_internal.h"
+#include "getme_alloc.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -219,13 +220,13 @@ static getme_formats_status read_section(const zone_ctx *c, int fn, int S,
         return getme_doc_fail(c->doc, GETME_FORMATS_ERR_PARSE,
                               "%s: %s/%s: no ElementConnectivity (%s)",
                               c->doc->path, c->path, sec->name, cgns_error());
-    sec->data = malloc((size_t)size * sizeof *sec->data);
+    sec->data = getme__malloc((size_t)size * sizeof *sec->data);
     if (!sec->data)
         return oom(c);
     cgsize_t n = sec->end - sec->start + 1;
     int rc;
     if (is_poly(sec->type)) {
-        sec->offset = malloc((size_t)(n + 1) * sizeof *sec->offset);
+        sec->offset = getme__malloc((size_t)(n + 1) * sizeof *sec->offset);
         if (!sec->offset)
             return oom(c);
         rc = cg_poly_elements_read(fn, zone->base, zone->zone, S, sec->data,
@@ -295,7 +296,7 @@ static int region_id(const zone_ctx *c, const cgns_fams *fams)
             return r;
     if (impl->num_regions == impl->cap_regions) {
         int cap = impl->cap_regions ? 2 * impl->cap_regions : 16;
-        cgns_region *r = realloc(impl->regions, (size_t)cap * sizeof *r);
+        cgns_region *r = getme__realloc(impl->regions, (size_t)cap * sizeof *r);
         if (!r)
             return -1;
         impl->regions = r;
@@ -313,14 +314,15 @@ static getme_formats_status keep_conn(const zone_ctx *c, int type, int32_t count
     cgns_zone *zone = &c->impl->zones[c->z];
     int nv = getme_type_num_nodes((getme_elem_type)type);
     int32_t used = zone->conn_offset ? zone->conn_offset[have] : 0;
-    int32_t *off = realloc(zone->conn_offset,
-                           (size_t)(have + count + 1) * sizeof *off);
+    int32_t *off = getme__realloc(zone->conn_offset,
+                                  (size_t)(have + count + 1) * sizeof *off);
     if (!off)
         return oom(c);
     zone->conn_offset = off;
-    int32_t *cn = realloc(zone->conn,
-                          ((size_t)used + (size_t)count * (size_t)nv) * sizeof *cn);
-    uint8_t *ty = cn ? realloc(zone->conn_type, (size_t)(have + count)) : NULL;
+    int32_t *cn = getme__realloc(zone->conn,
+                                 ((size_t)used + (size_t)count * (size_t)nv) * sizeof *cn);
+    uint8_t *ty =
+        cn ? getme__realloc(zone->conn_type, (size_t)(have + count)) : NULL;
     if (cn)
         zone->conn = cn;
     if (!ty)
@@ -346,7 +348,7 @@ static getme_formats_status add_block(const zone_ctx *c, const cgns_section *sec
     int32_t off = impl->zones[c->z].node_offset;
     int32_t first = getme_mesh_num_elements(c->doc->mesh);
     int region = region_id(c, &sec->fams);
-    int32_t *regions = malloc((size_t)count * sizeof *regions);
+    int32_t *regions = getme__malloc((size_t)count * sizeof *regions);
     getme_formats_status st = GETME_FORMATS_OK;
 
     if (!regions || region < 0) {
@@ -400,7 +402,7 @@ static getme_formats_status add_block(const zone_ctx *c, const cgns_section *sec
         return st;
     if (impl->num_blocks == impl->cap_blocks) {
         int cap = impl->cap_blocks ? 2 * impl->cap_blocks : 16;
-        cgns_block *b = realloc(impl->blocks, (size_t)cap * sizeof *b);
+        cgns_block *b = getme__realloc(impl->blocks, (size_t)cap * sizeof *b);
         if (!b)
             return oom(c);
         impl->blocks = b;
@@ -421,8 +423,8 @@ static getme_formats_status add_type(const zone_ctx *c, const cgns_section *sec,
     int nv = kind_nodes(type);
     const int8_t *order =
         type >= CGNS_HO ? cgns_ho_order(type - CGNS_HO) : NULL;
-    int32_t *conn = malloc((size_t)count * (size_t)nv * sizeof *conn);
-    cgsize_t *numbers = malloc((size_t)count * sizeof *numbers);
+    int32_t *conn = getme__malloc((size_t)count * (size_t)nv * sizeof *conn);
+    cgsize_t *numbers = getme__malloc((size_t)count * sizeof *numbers);
     cgsize_t n = sec->end - sec->start + 1;
     int32_t k = 0;
     getme_formats_status st;
@@ -507,7 +509,7 @@ getme_formats_status cgns_read_sections(getme_doc *doc, cgns_impl *impl, int fn,
     if (cg_nsections(fn, zone->base, zone->zone, &ns) != CG_OK)
         return getme_doc_fail(doc, GETME_FORMATS_ERR_PARSE, "%s: %s: %s", doc->path,
                               c.path, cgns_error());
-    cgns_section *secs = calloc(ns > 0 ? (size_t)ns : 1, sizeof *secs);
+    cgns_section *secs = getme__calloc(ns > 0 ? (size_t)ns : 1, sizeof *secs);
     if (!secs)
         return oom(&c);
     zone->first_elem = getme_mesh_num_elements(doc->mesh);

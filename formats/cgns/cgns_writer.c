@@ -26,6 +26,7 @@
 #define _POSIX_C_SOURCE 200809L /* open flags, fsync, st_mtim */
 
 #include "cgns_internal.h"
+#include "getme_alloc.h"
 
 #include <cgns_io.h>
 #include <errno.h>
@@ -202,7 +203,7 @@ static getme_formats_status copy_input(getme_doc *doc, const cgns_impl *impl,
     /* mkstemp made it 0600: give the copy the input's permissions */
     if (out >= 0)
         (void)fchmod(out, sb.st_mode & 07777);
-    buf = malloc(COPY_CHUNK);
+    buf = getme__malloc(COPY_CHUNK);
     if (out < 0 || !buf) {
         st = out < 0 ? getme_doc_fail(doc, GETME_FORMATS_ERR_WRITE, "%s: %s", tmp,
                                       strerror(errno))
@@ -298,7 +299,7 @@ static getme_formats_status write_coords(getme_doc *doc, const cgns_impl *impl,
     int cg;
     double root;
     getme_formats_status st = GETME_FORMATS_OK;
-    void *buf = malloc(max_zone_nodes(impl) * sizeof(double));
+    void *buf = getme__malloc(max_zone_nodes(impl) * sizeof(double));
 
     if (!buf)
         return oom(doc);
@@ -323,7 +324,8 @@ static getme_formats_status verify(getme_doc *doc, const cgns_impl *impl,
                               const char *tmp, const double *xyz)
 {
     size_t n = max_zone_nodes(impl);
-    void *want = malloc(n * sizeof(double)), *got = malloc(n * sizeof(double));
+    void *want = getme__malloc(n * sizeof(double));
+    void *got = getme__malloc(n * sizeof(double));
     getme_formats_status st = GETME_FORMATS_OK;
     int fn;
 
@@ -396,7 +398,7 @@ getme_formats_status cgns_write(getme_doc *doc, const char *out_path)
                               "%s: cannot create a temporary file next to "
                               "it: %s", out_path,
                               errno ? strerror(errno) : "path too long");
-    double *xyz = malloc(3 * (size_t)n * sizeof *xyz);
+    double *xyz = getme__malloc(3 * (size_t)n * sizeof *xyz);
     if (!xyz || getme_mesh_get_coords(doc->mesh, xyz) != GETME_OK) {
         free(xyz);
         return oom(doc);

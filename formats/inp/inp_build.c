@@ -13,6 +13,7 @@
  * solid deck, springs, rigid and surface elements...) are always fixed.
  */
 #include "inp_internal.h"
+#include "getme_alloc.h"
 #include "model.h"
 
 #include <stdarg.h>
@@ -80,7 +81,7 @@ static getme_formats_status build_maps(builder *b)
 {
     inp_deck *d = b->d;
     size_t nr = d->nnblocks > d->neblocks ? d->nnblocks : d->neblocks;
-    inp_run *runs = malloc((nr ? nr : 1) * sizeof *runs);
+    inp_run *runs = getme__malloc((nr ? nr : 1) * sizeof *runs);
     if (!runs)
         return getme_doc_fail(b->doc, GETME_FORMATS_ERR_INTERNAL, "out of memory");
     for (size_t i = 0; i < d->nnblocks; i++)
@@ -353,8 +354,8 @@ static getme_formats_status for_each_member(builder *b, int32_t set, member_fn f
 {
     inp_deck *d = b->d;
     if (!b->stamp[depth]) {
-        b->stamp[depth] = calloc(d->nsets, sizeof *b->stamp[depth]);
-        b->stack[depth] = malloc(d->nsets * sizeof *b->stack[depth]);
+        b->stamp[depth] = getme__calloc(d->nsets, sizeof *b->stamp[depth]);
+        b->stack[depth] = getme__malloc(d->nsets * sizeof *b->stack[depth]);
         if (!b->stamp[depth] || !b->stack[depth])
             return getme_doc_fail(b->doc, GETME_FORMATS_ERR_INTERNAL,
                                   "out of memory");
@@ -558,7 +559,7 @@ static getme_formats_status fix_nodes(builder *b, const getme_doc_options *opts,
                                  getme_mesh *mesh, int32_t *nfixed)
 {
     inp_deck *d = b->d;
-    b->fixed = calloc((size_t)d->nnodes, 1);
+    b->fixed = getme__calloc((size_t)d->nnodes, 1);
     if (!b->fixed)
         return getme_doc_fail(b->doc, GETME_FORMATS_ERR_INTERNAL, "out of memory");
     fix_other_elements(b);
@@ -623,7 +624,7 @@ static getme_status inp_add_block(getme_mesh *mesh, const inp_deck *d,
     if (ho < 0 && !reverse)
         return getme_mesh_add_elements(mesh, (getme_elem_type)eb->gtype,
                                        eb->count, conn, region);
-    int32_t *g = malloc(((size_t)eb->count * nv + 1) * sizeof *g);
+    int32_t *g = getme__malloc(((size_t)eb->count * nv + 1) * sizeof *g);
     if (!g)
         return GETME_ERR_NOMEM;
     const int8_t *order = ho >= 0 ? inp_ho_order((getme_ho_type)ho) : NULL;
@@ -643,7 +644,7 @@ static getme_status inp_add_block(getme_mesh *mesh, const inp_deck *d,
 static getme_formats_status add_blocks(builder *b, getme_mesh *mesh)
 {
     inp_deck *d = b->d;
-    int32_t *region = malloc(((size_t)b->nsmooth + 1) * sizeof *region);
+    int32_t *region = getme__malloc(((size_t)b->nsmooth + 1) * sizeof *region);
     if (!region)
         return getme_doc_fail(b->doc, GETME_FORMATS_ERR_INTERNAL, "out of memory");
     getme_formats_status st = regions(b, region);
@@ -699,7 +700,8 @@ static getme_formats_status add_blocks(builder *b, getme_mesh *mesh)
 static getme_formats_status make_ids(builder *b)
 {
     inp_deck *d = b->d;
-    b->doc->elem_ids = malloc(((size_t)b->nsmooth + 1) * sizeof(int64_t));
+    b->doc->elem_ids =
+        getme__malloc(((size_t)b->nsmooth + 1) * sizeof(int64_t));
     if (!b->doc->elem_ids)
         return getme_doc_fail(b->doc, GETME_FORMATS_ERR_INTERNAL, "out of memory");
     for (size_t k = 0; k < d->neblocks; k++) {
@@ -739,7 +741,7 @@ static void info(builder *b, getme_mesh *mesh, int32_t nfixed)
 static getme_formats_status keep_for_writer(builder *b)
 {
     inp_deck *d = b->d;
-    inp_doc *st = calloc(1, sizeof *st);
+    inp_doc *st = getme__calloc(1, sizeof *st);
     if (!st)
         return getme_doc_fail(b->doc, GETME_FORMATS_ERR_INTERNAL, "out of memory");
     st->files = d->files;
@@ -767,7 +769,8 @@ static getme_formats_status build_mesh(builder *b, const getme_doc_options *opts
         return st;
     if (b->smooth == INP_KIND_PLANAR && (st = check_plane(b)))
         return st;
-    b->sfirst = malloc((d->neblocks ? d->neblocks : 1) * sizeof *b->sfirst);
+    b->sfirst =
+        getme__malloc((d->neblocks ? d->neblocks : 1) * sizeof *b->sfirst);
     if (!b->sfirst)
         return getme_doc_fail(b->doc, GETME_FORMATS_ERR_INTERNAL, "out of memory");
     for (size_t k = 0; k < d->neblocks; k++) {

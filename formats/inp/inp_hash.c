@@ -4,6 +4,7 @@
  * case-insensitive string table (Abaqus labels are case-insensitive).
  */
 #include "inp_internal.h"
+#include "getme_alloc.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -25,8 +26,8 @@ static uint64_t mix64(uint64_t x)
 static int hash_grow(inp_hash *h)
 {
     size_t ncap = h->cap ? h->cap * 2 : 64;
-    int64_t *keys = malloc(ncap * sizeof *keys);
-    int32_t *vals = malloc(ncap * sizeof *vals);
+    int64_t *keys = getme__malloc(ncap * sizeof *keys);
+    int32_t *vals = getme__malloc(ncap * sizeof *vals);
     if (!keys || !vals) {
         free(keys);
         free(vals);
@@ -121,7 +122,7 @@ static size_t str_slot(const inp_strtab *t, const char *s, int *found)
 static int str_rehash(inp_strtab *t)
 {
     size_t n = t->nslots ? t->nslots * 2 : 64;
-    int32_t *slots = calloc(n, sizeof *slots);
+    int32_t *slots = getme__calloc(n, sizeof *slots);
     if (!slots)
         return -1;
     free(t->slots);

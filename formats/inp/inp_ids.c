@@ -5,6 +5,7 @@
  * 4 bytes per id; where they are sparse, one shared open-addressing hash.
  */
 #include "inp_internal.h"
+#include "getme_alloc.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -40,10 +41,10 @@ int inp_ids_build(inp_ids *m, size_t nscopes, const int32_t *id,
 {
     memset(m, 0, sizeof *m);
     m->nscopes = nscopes;
-    m->min = calloc(nscopes ? nscopes : 1, sizeof *m->min);
-    m->range = calloc(nscopes ? nscopes : 1, sizeof *m->range);
-    m->table = calloc(nscopes ? nscopes : 1, sizeof *m->table);
-    int64_t *count = calloc(nscopes ? nscopes : 1, sizeof *count);
+    m->min = getme__calloc(nscopes ? nscopes : 1, sizeof *m->min);
+    m->range = getme__calloc(nscopes ? nscopes : 1, sizeof *m->range);
+    m->table = getme__calloc(nscopes ? nscopes : 1, sizeof *m->table);
+    int64_t *count = getme__calloc(nscopes ? nscopes : 1, sizeof *count);
     if (!m->min || !m->range || !m->table || !count) {
         free(count);
         return -1;
@@ -55,7 +56,7 @@ int inp_ids_build(inp_ids *m, size_t nscopes, const int32_t *id,
         m->range[s] = span > 0 && span <= 4 * count[s] + 1024 ? span : 0;
         if (!m->range[s])
             continue;
-        m->table[s] = malloc((size_t)span * sizeof **m->table);
+        m->table[s] = getme__malloc((size_t)span * sizeof **m->table);
         if (!m->table[s]) {
             free(count);
             return -1;

@@ -4,6 +4,7 @@
  * size is read with constant memory for its text.
  */
 #include "inp_internal.h"
+#include "getme_alloc.h"
 #include "numformat.h"
 #include "numparse.h"
 
@@ -21,7 +22,7 @@ int inp_lines_open(inp_lines *r, const char *path)
     if (!r->fp)
         return -1;
     r->cap = 4 * CHUNK;
-    r->buf = malloc(r->cap + 1);
+    r->buf = getme__malloc(r->cap + 1);
     if (!r->buf) {
         fclose(r->fp);
         r->fp = NULL;
@@ -51,7 +52,7 @@ static int refill(inp_lines *r)
     if (r->end == r->cap) {
         if (r->cap > INP_MAX_LINE)
             return -2;
-        char *b = realloc(r->buf, 2 * r->cap + 1);
+        char *b = getme__realloc(r->buf, 2 * r->cap + 1);
         if (!b)
             return -1;
         r->buf = b;
@@ -244,7 +245,7 @@ const char *inp_lines_window(inp_lines *r, size_t want, size_t *avail)
             r->beg = 0;
         }
         if (want > r->cap) {
-            char *b = realloc(r->buf, want + 1);
+            char *b = getme__realloc(r->buf, want + 1);
             if (b) {
                 r->buf = b;
                 r->cap = want;

@@ -10,6 +10,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "inp_internal.h"
+#include "getme_alloc.h"
 
 #include <errno.h>
 #include <stdarg.h>
@@ -899,7 +900,7 @@ static getme_formats_status add_file(reader *rd, const char *path, int parent,
                         "*INCLUDE cycle: '%s' is already being read", path);
     rd->dev[rd->depth] = sb.st_dev;
     rd->ino[rd->depth] = sb.st_ino;
-    char *copy = malloc(strlen(path) + 1);
+    char *copy = getme__malloc(strlen(path) + 1);
     if (!copy || INP_RESERVE(d->files, d->cap_files, d->nfiles + 1)) {
         free(copy);
         return nomem(rd);
@@ -964,7 +965,7 @@ static getme_formats_status read_file(reader *rd, const char *path, int parent)
 getme_formats_status inp_read(inp_deck *d, const char *path, getme_doc *doc,
                               int threads)
 {
-    reader *rd = calloc(1, sizeof *rd);
+    reader *rd = getme__calloc(1, sizeof *rd);
     if (!rd)
         return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL, "out of memory");
     rd->d = d;

@@ -3,6 +3,7 @@
  * case-insensitive names.
  */
 #include "inp_internal.h"
+#include "getme_alloc.h"
 
 #include <stdint.h>
 #include <stdlib.h>
@@ -21,7 +22,7 @@ int inp_reserve(void **p, size_t *cap, size_t need, size_t sz)
         return -1;
     /* Doubling keeps the number of reallocations logarithmic in the mesh
        size: no allocation per node, element or line. */
-    void *q = realloc(*p, n * sz);
+    void *q = getme__realloc(*p, n * sz);
     if (!q)
         return -1;
     *p = q;

@@ -19,6 +19,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "inp_internal.h"
+#include "getme_alloc.h"
 
 #include <errno.h>
 #include <math.h>
@@ -361,8 +362,8 @@ getme_formats_status inp_write(getme_doc *doc, const inp_doc *st,
     w.xyz = getme_mesh_coords(doc->mesh);
     w.dim = getme_mesh_dim(doc->mesh);
     w.keep_tol = keep_tolerance(w.xyz, st->nnodes);
-    w.out = malloc(st->nfiles * sizeof *w.out);
-    w.tmp = malloc(st->nfiles * sizeof *w.tmp);
+    w.out = getme__malloc(st->nfiles * sizeof *w.out);
+    w.tmp = getme__malloc(st->nfiles * sizeof *w.tmp);
     getme_formats_status s = w.out && w.tmp
                             ? write_all(&w, out_path)
                             : getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL,

@@ -5,6 +5,7 @@
  * path, and smoothing gives bit-identical results.
  */
 #include "model.h"
+#include "getme_alloc.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -83,9 +84,10 @@ getme_status getme__model_number(getme__model_in *in, getme__model_out *out)
     for (size_t i = 0; i < in->num_nodes; i++)
         n += (in->flags[i] & GETME__NODE_USED) != 0;
     out->num_nodes = n;
-    out->loc = malloc((in->num_nodes ? in->num_nodes : 1) * sizeof *out->loc);
-    out->xyz = malloc((n ? (size_t)n : 1) * 3 * sizeof *out->xyz);
-    out->fixed = malloc(n ? (size_t)n : 1);
+    out->loc =
+        getme__malloc((in->num_nodes ? in->num_nodes : 1) * sizeof *out->loc);
+    out->xyz = getme__malloc((n ? (size_t)n : 1) * 3 * sizeof *out->xyz);
+    out->fixed = getme__malloc(n ? (size_t)n : 1);
     if (!out->loc || !out->xyz || !out->fixed)
         return oom(out);
     /* Gmsh's node order: the ranges in turn, each in the caller's order. */
@@ -186,8 +188,8 @@ static getme_status add_run(getme__model_in *in, getme__model_out *out,
         len += block_len(&in->blocks[i]);
     }
     int32_t *conn = b1 - b0 == 1 ? b->conn
-                                 : malloc((len ? len : 1) * sizeof *conn);
-    int32_t *region = malloc((count ? count : 1) * sizeof *region);
+                                 : getme__malloc((len ? len : 1) * sizeof *conn);
+    int32_t *region = getme__malloc((count ? count : 1) * sizeof *region);
     getme_status st = conn && region ? GETME_OK : oom(out);
     for (size_t i = b0, at = 0; st == GETME_OK && i < b1; i++) {
         const getme__model_block *bi = &in->blocks[i];
@@ -234,10 +236,11 @@ static getme_status add_run(getme__model_in *in, getme__model_out *out,
 
 static getme_status add_blocks(getme__model_in *in, getme__model_out *out)
 {
-    int32_t *region = malloc((in->num_entities ? in->num_entities : 1) *
-                             sizeof *region);
-    out->elem_ids = malloc((out->num_elements ? (size_t)out->num_elements : 1) *
-                           sizeof *out->elem_ids);
+    int32_t *region = getme__malloc((in->num_entities ? in->num_entities : 1) *
+                                    sizeof *region);
+    out->elem_ids =
+        getme__malloc((out->num_elements ? (size_t)out->num_elements : 1) *
+                      sizeof *out->elem_ids);
     getme_status st = region && out->elem_ids ? GETME_OK : oom(out);
     if (st == GETME_OK)
         entity_regions(in, region);

@@ -12,6 +12,7 @@
  * whole smoothing run.
  */
 #include "model.h"
+#include "getme_alloc.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -30,9 +31,9 @@ static int cmp_tag_index(const void *a, const void *b)
 static getme_status build_sorted(getme__nodemap *map, const uint64_t *tags,
                                  size_t n, uint64_t *repeated)
 {
-    tag_index *ti = malloc((n ? n : 1) * sizeof *ti);
-    map->sorted_tag = malloc((n ? n : 1) * sizeof *map->sorted_tag);
-    map->sorted_idx = malloc((n ? n : 1) * sizeof *map->sorted_idx);
+    tag_index *ti = getme__malloc((n ? n : 1) * sizeof *ti);
+    map->sorted_tag = getme__malloc((n ? n : 1) * sizeof *map->sorted_tag);
+    map->sorted_idx = getme__malloc((n ? n : 1) * sizeof *map->sorted_idx);
     if (!ti || !map->sorted_tag || !map->sorted_idx) {
         free(ti);
         return GETME_ERR_NOMEM;
@@ -78,7 +79,7 @@ getme_status getme__nodemap_build(getme__nodemap *map, const uint64_t *tags,
             map->max_tag = tags[i];
     if (map->max_tag > 2 * (uint64_t)n + 1024)
         return build_sorted(map, tags, n, repeated);
-    map->dense = malloc((size_t)(map->max_tag + 1) * sizeof *map->dense);
+    map->dense = getme__malloc((size_t)(map->max_tag + 1) * sizeof *map->dense);
     if (!map->dense)
         return GETME_ERR_NOMEM;
     memset(map->dense, 0xff, (size_t)(map->max_tag + 1) * sizeof *map->dense);

@@ -9,6 +9,7 @@
  * frame, which the native writer does not undo) are declined.
  */
 #include "msh41_internal.h"
+#include "getme_alloc.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -68,8 +69,8 @@ static int cmp_key(const void *a, const void *b)
 static getme_formats_status sort_blocks(msh41_reader *r)
 {
     size_t n = r->neb;
-    block_key *key = malloc((n ? n : 1) * sizeof *key);
-    msh41_eblock *sorted = malloc((n ? n : 1) * sizeof *sorted);
+    block_key *key = getme__malloc((n ? n : 1) * sizeof *key);
+    msh41_eblock *sorted = getme__malloc((n ? n : 1) * sizeof *sorted);
     if (!key || !sorted) {
         free(key);
         free(sorted);
@@ -128,7 +129,7 @@ static int cmp_pair(const void *a, const void *b)
 /* '"a" (3:1), "b" (2:5)' as the Gmsh path lists the groups. */
 static void describe_groups(const msh41_reader *r, char *buf, size_t size)
 {
-    int *pairs = malloc((r->nphys ? r->nphys : 1) * 2 * sizeof *pairs);
+    int *pairs = getme__malloc((r->nphys ? r->nphys : 1) * 2 * sizeof *pairs);
     size_t n = 0, used = 0;
     for (size_t i = 0; pairs && i < r->nents; i++)
         for (size_t k = 0; k < r->ents[i].phys_count; k++) {
@@ -213,9 +214,9 @@ static getme_formats_status make_input(msh41_reader *r, getme__model_in *in,
                                   size_t **nphys)
 {
     qsort(r->nb, r->nnb, sizeof *r->nb, cmp_nblock);
-    *ranges = malloc((r->nnb ? r->nnb : 1) * sizeof **ranges);
-    *phys = malloc((r->neb ? r->neb : 1) * sizeof **phys);
-    *nphys = malloc((r->neb ? r->neb : 1) * sizeof **nphys);
+    *ranges = getme__malloc((r->nnb ? r->nnb : 1) * sizeof **ranges);
+    *phys = getme__malloc((r->neb ? r->neb : 1) * sizeof **phys);
+    *nphys = getme__malloc((r->neb ? r->neb : 1) * sizeof **nphys);
     if (!*ranges || !*phys || !*nphys)
         return oom(r);
     for (size_t b = 0; b < r->nnb; b++) {
@@ -266,9 +267,10 @@ static getme_formats_status part_ids(msh41_reader *r,
     size_t ne = 0;
     for (size_t b = 0; b < r->neb; b++)
         ne += (size_t)r->eb[b].count;
-    doc->node_ids = malloc((out->num_nodes ? (size_t)out->num_nodes : 1) *
-                           sizeof *doc->node_ids);
-    doc->elem_region = malloc((ne ? ne : 1) * sizeof *doc->elem_region);
+    doc->node_ids =
+        getme__malloc((out->num_nodes ? (size_t)out->num_nodes : 1) *
+                      sizeof *doc->node_ids);
+    doc->elem_region = getme__malloc((ne ? ne : 1) * sizeof *doc->elem_region);
     if (!doc->node_ids || !doc->elem_region)
         return oom(r);
     for (size_t i = 0; i < r->nnodes; i++)

@@ -9,6 +9,7 @@
  * is refilled or the echo is switched.
  */
 #include "msh41_internal.h"
+#include "getme_alloc.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -26,7 +27,7 @@ int msh41_in_open(msh41_input *in, const char *path)
     memset(in, 0, sizeof *in);
     in->line = 1;
     in->f = fopen(path, "rb");
-    in->buf = malloc(IN_CHUNK);
+    in->buf = getme__malloc(IN_CHUNK);
     if (in->f && in->buf)
         return 0;
     msh41_in_close(in);

@@ -14,6 +14,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "msh41_internal.h"
+#include "getme_alloc.h"
 #include "numparse.h"
 
 #include <errno.h>
@@ -283,7 +284,7 @@ static getme_formats_status read_name(msh41_reader *r, msh41_pname *p)
         q2 == q1)
         return line_fail(r, GETME_FORMATS_ERR_PARSE,
                          "bad physical name line (want: dim tag \"name\")");
-    p->name = malloc((size_t)(q2 - q1));
+    p->name = getme__malloc((size_t)(q2 - q1));
     if (!p->name)
         return oom(r);
     memcpy(p->name, q1 + 1, (size_t)(q2 - q1 - 1));
@@ -304,7 +305,7 @@ static getme_formats_status read_physical_names(msh41_reader *r)
         sscanf(line, "%llu", &n) != 1 || n > (uint64_t)r->file_size / 6)
         st = line_fail(r, GETME_FORMATS_ERR_PARSE, "bad number of names");
     if (st == GETME_FORMATS_OK && r->names == NULL && n > 0) {
-        r->names = calloc((size_t)n, sizeof *r->names);
+        r->names = getme__calloc((size_t)n, sizeof *r->names);
         if (!r->names)
             st = oom(r);
     } else if (st == GETME_FORMATS_OK && n > 0) {
@@ -326,7 +327,7 @@ static getme_formats_status add_phys(msh41_reader *r, int tag, size_t *cap)
 {
     if (r->nphys == *cap) {
         size_t ncap = *cap ? 2 * *cap : 64;
-        int *np = realloc(r->phys, ncap * sizeof *np);
+        int *np = getme__realloc(r->phys, ncap * sizeof *np);
         if (!np)
             return oom(r);
         r->phys = np;
@@ -405,7 +406,7 @@ static getme_formats_status read_entities(msh41_reader *r)
         total += st == GETME_FORMATS_OK ? count[d] : 0;
     }
     if (st == GETME_FORMATS_OK && total > 0) {
-        r->ents = calloc((size_t)total, sizeof *r->ents);
+        r->ents = getme__calloc((size_t)total, sizeof *r->ents);
         if (!r->ents)
             st = oom(r);
     }
@@ -513,7 +514,7 @@ static getme_formats_status read_partitioned_entities(msh41_reader *r)
         total += st == GETME_FORMATS_OK ? count[d] : 0;
     }
     if (st == GETME_FORMATS_OK && total > 0 &&
-        !(r->ents = calloc((size_t)total, sizeof *r->ents)))
+        !(r->ents = getme__calloc((size_t)total, sizeof *r->ents)))
         st = oom(r);
     for (int d = 0; d < 4 && st == GETME_FORMATS_OK; d++)
         for (uint64_t i = 0; i < count[d] && st == GETME_FORMATS_OK; i++) {
@@ -560,7 +561,7 @@ static getme_formats_status prepare_groups(msh41_reader *r)
     r->groups_ready = 1;
     /* --fix words first, then --free words (only looked up: no physical
        group is fixed by default, but an unknown name is an error) */
-    r->fix_found = calloc((size_t)(nfix + nfree), sizeof *r->fix_found);
+    r->fix_found = getme__calloc((size_t)(nfix + nfree), sizeof *r->fix_found);
     if (!r->fix_found)
         return oom(r);
     for (int w = 0; w < nfix + nfree; w++) {
@@ -600,10 +601,10 @@ static getme_formats_status alloc_nodes(msh41_reader *r, uint64_t nblocks,
                           "%llu nodes: more than 2^31-1 are not supported",
                           (unsigned long long)n);
     size_t k = n ? (size_t)n : 1;
-    r->tags = malloc(k * sizeof *r->tags);
-    r->xyz = malloc(3 * k * sizeof *r->xyz);
-    r->flag = calloc(k, 1);
-    r->nb = malloc((nblocks ? (size_t)nblocks : 1) * sizeof *r->nb);
+    r->tags = getme__malloc(k * sizeof *r->tags);
+    r->xyz = getme__malloc(3 * k * sizeof *r->xyz);
+    r->flag = getme__calloc(k, 1);
+    r->nb = getme__malloc((nblocks ? (size_t)nblocks : 1) * sizeof *r->nb);
     if (!r->tags || !r->xyz || !r->flag || !r->nb)
         return oom(r);
     return GETME_FORMATS_OK;
@@ -792,7 +793,7 @@ static getme_formats_status new_eblock(msh41_reader *r, int dim, int tag,
     r->top_dim = dim;
     if (r->neb == r->cap_eb) {
         size_t cap = r->cap_eb ? 2 * r->cap_eb : 16;
-        msh41_eblock *nb = realloc(r->eb, cap * sizeof *nb);
+        msh41_eblock *nb = getme__realloc(r->eb, cap * sizeof *nb);
         if (!nb)
             return oom(r);
         r->eb = nb;
@@ -811,8 +812,8 @@ static getme_formats_status new_eblock(msh41_reader *r, int dim, int tag,
     int linear = order == 1 && ((dim == 3 && type >= 4 && type <= 7) ||
                                 (dim == 2 && (type == 2 || type == 3)));
     if (linear || getme__msh_type_ho(type, dim) >= 0) {
-        b->conn = malloc((size_t)count * (size_t)nv * sizeof *b->conn);
-        b->ids = malloc((size_t)count * sizeof *b->ids);
+        b->conn = getme__malloc((size_t)count * (size_t)nv * sizeof *b->conn);
+        b->ids = getme__malloc((size_t)count * sizeof *b->ids);
         if (!b->conn || !b->ids)
             return oom(r);
     }
@@ -934,7 +935,7 @@ static getme_formats_status read_binary_elements(msh41_reader *r, msh41_eblock *
 {
     size_t rec = (size_t)nv + 1;
     size_t chunk = count < BIG_CHUNK ? (size_t)(count ? count : 1) : BIG_CHUNK;
-    uint64_t *buf = malloc(chunk * rec * sizeof *buf);
+    uint64_t *buf = getme__malloc(chunk * rec * sizeof *buf);
     if (!buf)
         return oom(r);
     /* --fix flags nodes while storing: one thread, no shared writes */
@@ -1102,8 +1103,9 @@ static getme_formats_status read_nodes22(msh41_reader *r)
         st = alloc_nodes(r, 0, n);
     r->nnodes = st == GETME_FORMATS_OK ? (size_t)n : 0;
     if (st == GETME_FORMATS_OK) {
-        r->ndim = malloc(r->nnodes ? r->nnodes : 1);
-        r->netag = malloc((r->nnodes ? r->nnodes : 1) * sizeof *r->netag);
+        r->ndim = getme__malloc(r->nnodes ? r->nnodes : 1);
+        r->netag =
+            getme__malloc((r->nnodes ? r->nnodes : 1) * sizeof *r->netag);
         if (!r->ndim || !r->netag)
             st = oom(r);
         else
@@ -1176,10 +1178,10 @@ static getme_formats_status block22(msh41_reader *r, int dim, int etag, int type
     }
     if (b->conn && (size_t)b->count == r->cap_cur) {
         size_t cap = r->cap_cur ? 2 * r->cap_cur : 64;
-        int32_t *c = realloc(b->conn, cap * (size_t)nv * sizeof *c);
+        int32_t *c = getme__realloc(b->conn, cap * (size_t)nv * sizeof *c);
         if (c)
             b->conn = c;
-        int64_t *ids = realloc(b->ids, cap * sizeof *ids);
+        int64_t *ids = getme__realloc(b->ids, cap * sizeof *ids);
         if (ids)
             b->ids = ids;
         if (!c || !ids)
@@ -1211,7 +1213,7 @@ static getme_formats_status element22(msh41_reader *r, int type, int ntags,
         r->ent22[r->nent22 - 1][2] != phys) {
         if (r->nent22 == r->cap_ent22) {
             size_t cap = r->cap_ent22 ? 2 * r->cap_ent22 : 64;
-            int(*e)[3] = realloc(r->ent22, cap * sizeof *e);
+            int(*e)[3] = getme__realloc(r->ent22, cap * sizeof *e);
             if (!e)
                 return oom(r);
             r->ent22 = e;
@@ -1311,7 +1313,7 @@ static getme_formats_status read_elements22(msh41_reader *r)
         return st;
     int nw = r->opts ? r->opts->num_fix + r->opts->num_free : 0;
     if (nw && !r->fix_found &&
-        !(r->fix_found = calloc((size_t)nw, sizeof *r->fix_found)))
+        !(r->fix_found = getme__calloc((size_t)nw, sizeof *r->fix_found)))
         return oom(r);
     st = read_count22(r, &n, "number of elements", 8);
     if (r->binary)
@@ -1338,8 +1340,8 @@ static int cmp_triple(const void *a, const void *b)
 static getme_formats_status entities22(msh41_reader *r)
 {
     qsort(r->ent22, r->nent22, sizeof *r->ent22, cmp_triple);
-    r->ents = malloc((r->nent22 ? r->nent22 : 1) * sizeof *r->ents);
-    r->phys = malloc((r->nent22 ? r->nent22 : 1) * sizeof *r->phys);
+    r->ents = getme__malloc((r->nent22 ? r->nent22 : 1) * sizeof *r->ents);
+    r->phys = getme__malloc((r->nent22 ? r->nent22 : 1) * sizeof *r->phys);
     if (!r->ents || !r->phys)
         return oom(r);
     for (size_t i = 0; i < r->nent22; i++) {
@@ -1381,12 +1383,12 @@ static int cmp_node22(const void *a, const void *b)
 static getme_formats_status nodes22(msh41_reader *r)
 {
     size_t n = r->nnodes;
-    size_t *order = malloc((n ? n : 1) * sizeof *order);
-    int32_t *pos = malloc((n ? n : 1) * sizeof *pos);
-    uint64_t *tags = malloc((n ? n : 1) * sizeof *tags);
-    double *xyz = malloc((n ? n : 1) * 3 * sizeof *xyz);
-    uint8_t *flag = malloc(n ? n : 1);
-    msh41_nblock *nb = malloc((n ? n : 1) * sizeof *nb);
+    size_t *order = getme__malloc((n ? n : 1) * sizeof *order);
+    int32_t *pos = getme__malloc((n ? n : 1) * sizeof *pos);
+    uint64_t *tags = getme__malloc((n ? n : 1) * sizeof *tags);
+    double *xyz = getme__malloc((n ? n : 1) * 3 * sizeof *xyz);
+    uint8_t *flag = getme__malloc(n ? n : 1);
+    msh41_nblock *nb = getme__malloc((n ? n : 1) * sizeof *nb);
     getme_formats_status st =
         order && pos && tags && xyz && flag && nb ? GETME_FORMATS_OK : oom(r);
     if (st == GETME_FORMATS_OK) {
@@ -1536,7 +1538,7 @@ getme_formats_status msh41_open(getme_doc *doc, const getme_doc_options *opts,
     r.opts = opts;
     *out = NULL;
     *eligible = 1;
-    msh41_doc *m = calloc(1, sizeof *m);
+    msh41_doc *m = getme__calloc(1, sizeof *m);
     if (!m)
         return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL, "Out of memory");
     if (msh41_in_open(&r.in, doc->path)) {

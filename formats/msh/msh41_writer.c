@@ -18,6 +18,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "msh41_internal.h"
+#include "getme_alloc.h"
 #include "numformat.h"
 #include "numparse.h"
 
@@ -75,7 +76,7 @@ static int bin_u64(writer *w, uint64_t *v)
 /* Coordinates of count nodes with these tags, chunk by chunk. */
 static int bin_coords(writer *w, const uint64_t *tags, size_t count)
 {
-    unsigned char *buf = malloc(NODE_CHUNK * 24);
+    unsigned char *buf = getme__malloc(NODE_CHUNK * 24);
     if (!buf)
         return -2;
     msh41_in_echo(&w->in, NULL);
@@ -113,7 +114,7 @@ static int bin_block(writer *w)
     if (msh41_in_read(&w->in, head, 12) || bin_u64(w, &count) ||
         count > (uint64_t)w->m->size / 32)
         return -1;
-    uint64_t *tags = malloc((count ? (size_t)count : 1) * sizeof *tags);
+    uint64_t *tags = getme__malloc((count ? (size_t)count : 1) * sizeof *tags);
     int rc = tags ? 0 : -2;
     for (size_t i = 0; rc == 0 && i < count; i++)
         rc = bin_u64(w, &tags[i]);
@@ -203,7 +204,7 @@ static int ascii_block(writer *w)
     uint64_t count = head[3];
     if (count > (uint64_t)w->m->size / 8)
         return -1;
-    uint64_t *tags = malloc((count ? (size_t)count : 1) * sizeof *tags);
+    uint64_t *tags = getme__malloc((count ? (size_t)count : 1) * sizeof *tags);
     int rc = tags ? 0 : -2;
     for (size_t i = 0; rc == 0 && i < count; i++)
         rc = ascii_u64(w, &tags[i]);

@@ -16,6 +16,7 @@
  * decline an error; anything else, or unset, means "native if it can".
  */
 #include "msh41_internal.h"
+#include "getme_alloc.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -91,7 +92,7 @@ static getme_formats_status open_native(getme_doc *doc, msh_impl *impl,
 
 static getme_formats_status msh_open(getme_doc *doc, const getme_doc_options *opts)
 {
-    msh_impl *impl = calloc(1, sizeof *impl);
+    msh_impl *impl = getme__calloc(1, sizeof *impl);
     if (!impl)
         return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL, "Out of memory");
     doc->impl = impl;

@@ -1,0 +1,110 @@
+/*
+ * test_alloc.c -- the allocation functions of core/alloc/getme_alloc.h:
+ * each gives a block that works as the C library's does (zeroed by calloc,
+ * kept by realloc), and a block of GETME_HUGE_MIN bytes or more lies in
+ * memory advised for huge pages (the "hg" flag in /proc/self/smaps, which
+ * madvise(MADV_HUGEPAGE) sets), while a smaller one and a plain malloc of
+ * the same size do not (so the check itself can fail).  Built with
+ * -DGETME_HUGE_PAGES=OFF, no block is advised.  Skipped (exit 77) where
+ * the kernel has no transparent huge pages.
+ */
+#include "check.h"
+#include "getme_alloc.h"
+
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Does the mapping that holds address p carry VmFlags flag (two letters)?
+   -1 if /proc/self/smaps has no mapping for it. */
+static int vma_has_flag(const void *p, const char *flag)
+{
+    FILE *f = fopen("/proc/self/smaps", "r");
+    if (!f)
+        return -1;
+    char line[512];
+    int inside = 0, found = -1;
+    uintptr_t a = (uintptr_t)p;
+    while (fgets(line, sizeof line, f)) {
+        unsigned long lo, hi;
+        char dash;
+        if (sscanf(line, "%lx%c%lx ", &lo, &dash, &hi) == 3 && dash == '-') {
+            inside = a >= lo && a < hi;
+            continue;
+        }
+        if (inside && strncmp(line, "VmFlags:", 8) == 0) {
+            found = 0;
+            for (const char *s = line + 8; *s; s++)
+                if (s[0] == flag[0] && s[1] == flag[1] &&
+                    (s[-1] == ' ') && (s[2] == ' ' || s[2] == '\n'))
+                    found = 1;
+            break;
+        }
+    }
+    fclose(f);
+    return found;
+}
+
+static int advised(const void *p, size_t n)
+{
+    return vma_has_flag((const char *)p + n / 2, "hg") == 1;
+}
+
+int main(void)
+{
+    FILE *thp = fopen("/sys/kernel/mm/transparent_hugepage/enabled", "r");
+    if (!thp) {
+        printf("skipped: no transparent huge pages in this kernel\n");
+        return 77;
+    }
+    fclose(thp);
+#ifdef GETME_NO_HUGE_PAGES
+    const int want = 0;
+#else
+    const int want = 1;
+#endif
+    const size_t big = 2 * GETME_HUGE_MIN, small = GETME_HUGE_MIN / 4;
+
+    /* small first, while nothing around it has been advised */
+    unsigned char *s = getme__malloc(small);
+    CHECK(s != NULL);
+    memset(s, 0x5a, small);
+    CHECK(!advised(s, small));
+
+    unsigned char *plain = malloc(big);
+    CHECK(plain != NULL);
+    CHECK(vma_has_flag(plain + big / 2, "hg") == 0); /* the check sees it */
+
+    unsigned char *m = getme__malloc(big);
+    CHECK(m != NULL);
+    CHECK(advised(m, big) == want);
+    memset(m, 0xa5, big);
+    CHECK(m[0] == 0xa5 && m[big - 1] == 0xa5);
+
+    size_t k = big / sizeof(double);
+    double *c = getme__calloc(k, sizeof *c);
+    CHECK(c != NULL);
+    CHECK(advised(c, big) == want);
+    int zero = 1;
+    for (size_t i = 0; i < k; i += 509)
+        zero &= c[i] == 0.0;
+    CHECK(zero && c[k - 1] == 0.0);
+
+    void *al = getme__aligned_alloc(64, big);
+    CHECK(al != NULL && (uintptr_t)al % 64 == 0);
+    CHECK(advised(al, big) == want);
+
+    /* grown from the small block: its bytes kept, the new block advised */
+    unsigned char *r = getme__realloc(s, big);
+    CHECK(r != NULL);
+    CHECK(r[0] == 0x5a && r[small - 1] == 0x5a);
+    CHECK(advised(r, big) == want);
+
+    free(plain);
+    free(m);
+    free(c);
+    free(al);
+    free(r);
+    return check_summary("alloc");
+}
