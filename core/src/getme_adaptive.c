@@ -606,10 +606,9 @@ static getme_status assign_slots(getme_run *run)
     const getme_blocks *blk = &run->adj->blk;
     const getme_ws *ws = run->ws;
     size_t nn = (size_t)(ws->nn ? ws->nn : 1);
-    int32_t *avail =
-        getme__malloc(nn * sizeof *avail); /* free at the phase start */
-    int32_t *back =
-        getme__malloc(nn * sizeof *back);   /* given back in the phase */
+    /* avail: free at the phase start; back: given back in the phase */
+    int32_t *avail = getme__malloc(nn * sizeof *avail);
+    int32_t *back = getme__malloc(nn * sizeof *back);
     uint8_t *seen = run->in_t;                   /* zero before and after */
     if (!avail || !back) {
         free(avail), free(back);

@@ -222,8 +222,8 @@ getme_status getme__ho_attach(getme_ws *ws, getme_mesh *mesh)
     size_t nn = (size_t)ws->nn + 1, ne = (size_t)ws->ne + 1;
     int32_t *inv_node = getme__malloc(nn * sizeof *inv_node);
     int32_t *inv_elem = getme__malloc(ne * sizeof *inv_elem);
-    int32_t *hid =
-        getme__malloc(nn * sizeof *hid); /* internal node -> h, or -1 */
+    /* hid: internal node -> h, or -1 */
+    int32_t *hid = getme__malloc(nn * sizeof *hid);
     getme_status st = GETME_ERR_NOMEM;
     if (!ho || !inv_node || !inv_elem || !hid)
         goto fail;
