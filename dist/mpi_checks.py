@@ -5,8 +5,11 @@ PYTHONPATH).
 
 usage: test_mpi*.py GETME_MPI GETME MPIEXEC SOURCE_DIR [--sanitized]
 """
+import atexit
 import os
+import shutil
 import sys
+import tempfile
 
 from checks import Checks
 
@@ -17,6 +20,13 @@ SANITIZED = "--sanitized" in sys.argv[5:]
 # ranks than cores.
 ENV = dict(os.environ, OMP_WAIT_POLICY="passive", OMPI_ALLOW_RUN_AS_ROOT="1",
            OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_rmaps_base_oversubscribe="1")
+# Each test's mpiexec keeps its session directory under a tree of its own:
+# in the shared /tmp/ompi.HOST.UID, one test's mpiexec removing the tree
+# as it ends could fail another's start ("orte_session_dir failed",
+# seen once with ctest -j2 in a clean-clone .ci/run).
+SESSION_DIR = tempfile.mkdtemp(prefix="getme-ompi-")
+atexit.register(shutil.rmtree, SESSION_DIR, ignore_errors=True)
+ENV["OMPI_MCA_orte_tmpdir_base"] = SESSION_DIR
 if SANITIZED:
     # Open MPI's own start-up allocations are never freed.
     ENV["ASAN_OPTIONS"] = "detect_leaks=0"
