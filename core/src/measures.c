@@ -11,6 +11,7 @@
  * each measure's statistics in element order.
  */
 #include "internal.h"
+#include "angle.h"
 
 /* Compiled with -fno-trapping-math (core/CMakeLists.txt says why): the
    measures' lane loops, where a division or square root is evaluated on
@@ -222,12 +223,13 @@ KERNEL double end_uv(v3 a, v3 b, v3 p, v3 q, v3 *u, v3 *v)
     return div_or(v3_dot(*u, *v), den, 1.0);
 }
 
-/* atan2(|u x v|, u . v): the angle between u and v in [0, pi] */
+/* atan2(|u x v|, u . v): the angle between u and v in [0, pi] (angle.h:
+   the lanes' kernel, so both give the same bits) */
 static double angle_between(const double u[3], const double v[3])
 {
     double w[3];
     vcross(u, v, w);
-    return atan2(vnorm(w), vdot(u, v));
+    return getme__angle(vnorm(w), vdot(u, v));
 }
 
 /*
@@ -235,7 +237,7 @@ static double angle_between(const double u[3], const double v[3])
  * {a, b, p, q}: u, v the components of p - a and q - a normal to the edge;
  * the angle is that between u and v.  The ends are ranked by the cosine
  * u.v / (|u| |v|) (1, i.e. angle 0, when u or v vanishes), and only the two
- * extreme ones get the accurate atan2 form.
+ * extreme ones get the accurate atan2 form (getme__angle, angle.h).
  */
 static void dihedral3(const dihedral_ends *d, const double *x, double *lo,
                       double *hi)
@@ -397,7 +399,7 @@ static double gamma_quad(const double *x)
         int k1 = (k + 1) % 4, k2 = (k + 2) % 4;
         /* edges from k1: back to k is -(x[k1] - x[k]) */
         double cr = -cross_xy(x, k1, k, k2), dt = -dot_xy(x, k1, k, k2);
-        double a = atan2(fabs(cr), dt);
+        double a = getme__angle(fabs(cr), dt);
         dev = fmax(dev, fabs(0.5 * M_PI_ - a));
         if (cr < 0.0)
             sign = -1.0;
@@ -713,7 +715,8 @@ getme_status getme_mesh_measure_stats(getme_mesh *mesh, int type,
  * loops over the lanes become vector instructions, square roots and
  * divisions included, and the mean ratio goes through quality.c's lane
  * kernel.  The dihedral ends are ranked by their cosines in the lanes;
- * only the two extreme ends of each element get atan2.
+ * only the two extreme ends of each element get an angle (getme__angle,
+ * in the lanes as well).
  */
 enum { L = GETME_LANES };
 
@@ -762,7 +765,8 @@ static void atan2_args_lanes(double (*u)[L], double (*v)[L],
 
 /* dihedral3 of the lanes, in degrees as measure() gives them.  The
    extreme ends' u and v are kept in the lanes as they are ranked (no end
-   evaluated twice) and only the two atan2 per element are scalar. */
+   evaluated twice); the two angles per element, getme__angle, are in the
+   lanes too. */
 static void dihedral_lanes(const dihedral_ends *d, const double (*x)[L],
                            double *lo, double *hi)
 {
@@ -805,9 +809,10 @@ static void dihedral_lanes(const dihedral_ends *d, const double (*x)[L],
     double ylo[L], xlo[L], yhi[L], xhi[L];
     atan2_args_lanes(f, f + 3, ylo, xlo);
     atan2_args_lanes(f + 6, f + 9, yhi, xhi);
+#pragma omp simd
     for (int l = 0; l < L; l++) {
-        lo[l] = atan2(ylo[l], xlo[l]) * RAD2DEG;
-        hi[l] = atan2(yhi[l], xhi[l]) * RAD2DEG;
+        lo[l] = getme__angle(ylo[l], xlo[l]) * RAD2DEG;
+        hi[l] = getme__angle(yhi[l], xhi[l]) * RAD2DEG;
     }
 }
 
