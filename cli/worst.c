@@ -4,6 +4,7 @@
  */
 #include "cli.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 
 /* The element's id in the file (tag, Abaqus id, CGNS element number), or
@@ -39,14 +40,19 @@ void cli_print_worst(const cli_log *log, const getme_doc *doc,
 {
     if (w->count == 0)
         return;
-    cli_info(log, "Worst %d element%s%s (tag, type, quality, worst corner, "
-                  "free nodes: why it stays):",
+    cli_info(log, "Worst %d element%s%s (tag, type, quality, worst corner "
+                  "scaled Jacobian if not a simplex, free nodes: why it stays):",
              (int)w->count, w->count == 1 ? "" : "s", which);
     for (int32_t i = 0; i < w->count; i++) {
         const getme_worst_element *x = &w->items[i];
-        cli_info(log, "  %lld %s q %.4f sj %.4f, %d/%d free: %s",
+        /* a simplex's corner_sj is 1 by definition (getme.h): printed, it
+           read as the scaled Jacobian of a tet of quality 0.2 */
+        char sj[32] = "";
+        if (x->type != GETME_TET && x->type != GETME_TRI)
+            snprintf(sj, sizeof sj, " sj %.4f", x->corner_sj);
+        cli_info(log, "  %lld %s q %.4f%s, %d/%d free: %s",
                  cli_element_tag(doc, x->element), getme_type_name(x->type),
-                 x->quality, x->corner_sj, x->num_free, x->num_nodes,
+                 x->quality, sj, x->num_free, x->num_nodes,
                  getme_worst_reason_string(x->reason));
     }
 }

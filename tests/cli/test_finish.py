@@ -107,6 +107,9 @@ tag = paper["worst_free_elements"][0]["tag"]
 check(q.returncode == 0 and len(lines) == 4, "quality --worst 2 lists 2 + 2 elements")
 check(lines and lines[0].split()[2] == str(tag) and "4/4 free: a node move can still raise it" in lines[0],
       f"quality --worst names the locked tet {tag}: {lines[:1]}")
+# a tet's corner scaled Jacobian is 1 by definition: not printed as if
+# it were the element's (it read "tet q 0.22 sj 1.0000")
+check(lines and all(" sj " not in ln for ln in lines), f"no corner sj on tet lines: {lines[:1]}")
 
 print(f"locked ring: q*min {q_in[free_el].min():.4f} -> paper {paper['after']['q_min_star']:.4f}, "
       f"finishing step {rep1['after']['q_min_star']:.4f} in {len(passes)} passes; "
