@@ -2,6 +2,7 @@
  * log.c -- Gmsh-style log lines and common parsing for the getme command.
  */
 #include "cli.h"
+#include "getme_alloc.h"
 
 #include <errno.h>
 #include <limits.h>
@@ -124,7 +125,9 @@ static getme_formats_status check_measured(getme_doc *doc, cli_measured *mb)
 {
     getme_mesh *mesh = getme_doc_mesh(doc);
     int32_t ne = getme_mesh_num_elements(mesh);
-    mb->q = malloc((size_t)(ne ? ne : 1) * sizeof *mb->q);
+    /* one double per element, written in the measures' sweep: on huge
+       pages (getme_alloc.h), or its first touch was 4 KiB page faults */
+    mb->q = getme__malloc((size_t)(ne ? ne : 1) * sizeof *mb->q);
     mb->ok = cli_measures_compute(mesh, &mb->m, mb->q) == 0;
     if (!mb->ok) {
         free(mb->q);

@@ -6,6 +6,7 @@
  * dist/test_mpi_options compare them).
  */
 #include "cli.h"
+#include "getme_alloc.h"
 
 #include <errno.h>
 #include <stdlib.h>
@@ -62,7 +63,7 @@ int cli_smooth_end_run(const cli_smooth_opts *so, const cli_smooth_end *e,
     /* every element evaluated once: the measures' sweep also gives the
        qualities that the statistics and the worst lists rank */
     int32_t ne = getme_mesh_num_elements(mesh);
-    double *q = malloc((size_t)(ne ? ne : 1) * sizeof *q);
+    double *q = getme__malloc((size_t)(ne ? ne : 1) * sizeof *q); /* as log.c */
     if (!q) {
         cli_error("%s: out of memory", e->input);
         return CLI_EXIT_INTERNAL;

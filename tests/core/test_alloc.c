@@ -81,6 +81,11 @@ int main(void)
     CHECK(advised(m, big) == want);
     memset(m, 0xa5, big);
     CHECK(m[0] == 0xa5 && m[big - 1] == 0xa5);
+    /* the partial pages at both ends too: advice that left out the first
+       page split a large block's mapping in two, and glibc's realloc
+       could then no longer grow it in place (mremap failed, EFAULT) */
+    CHECK(vma_has_flag(m, "hg") == want);
+    CHECK(vma_has_flag(m + big - 1, "hg") == want);
 
     size_t k = big / sizeof(double);
     double *c = getme__calloc(k, sizeof *c);
@@ -100,6 +105,12 @@ int main(void)
     CHECK(r != NULL);
     CHECK(r[0] == 0x5a && r[small - 1] == 0x5a);
     CHECK(advised(r, big) == want);
+
+    /* a large block grown: its bytes kept, the whole block advised */
+    m = getme__realloc(m, 2 * big);
+    CHECK(m != NULL);
+    CHECK(m[0] == 0xa5 && m[big - 1] == 0xa5);
+    CHECK(vma_has_flag(m, "hg") == want && advised(m, 2 * big) == want);
 
     free(plain);
     free(m);
