@@ -153,6 +153,19 @@ GETME_API getme_status getme_mesh_add_elements(getme_mesh *mesh,
                                                const int32_t *conn,
                                                const int32_t *region);
 
+/*
+ * As getme_mesh_add_elements(), but the mesh takes conn instead of a copy
+ * of it: conn must come from malloc() (or calloc/realloc), and belongs to
+ * the mesh from the call on, which frees it with free() -- at once if the
+ * call fails or count is 0.  For callers that build the connectivity only
+ * to hand it over (libgetme_formats' readers): one copy of the largest
+ * input array less, and its fresh pages.
+ */
+GETME_API getme_status getme_mesh_take_elements(getme_mesh *mesh,
+                                                getme_elem_type type,
+                                                int32_t count, int32_t *conn,
+                                                const int32_t *region);
+
 GETME_API int getme_mesh_dim(const getme_mesh *mesh);
 GETME_API int32_t getme_mesh_num_nodes(const getme_mesh *mesh);
 GETME_API int32_t getme_mesh_num_elements(const getme_mesh *mesh);

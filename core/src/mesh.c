@@ -8,6 +8,7 @@
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -108,9 +109,12 @@ int getme__element_nodes_ok(const int32_t *c, int nv, int32_t num_nodes)
     return 1;
 }
 
-getme_status getme_mesh_add_elements(getme_mesh *mesh, getme_elem_type type,
-                                     int32_t count, const int32_t *conn,
-                                     const int32_t *region)
+/* getme_mesh_add_elements, and with owned set getme_mesh_take_elements:
+   the block then keeps conn itself instead of a copy (the caller's array
+   is freed on failure, by the public function). */
+static getme_status add_elements(getme_mesh *mesh, getme_elem_type type,
+                                 int32_t count, int32_t *conn,
+                                 const int32_t *region, int owned)
 {
     if (!mesh)
         return GETME_ERR_ARGUMENT;
@@ -159,7 +163,8 @@ getme_status getme_mesh_add_elements(getme_mesh *mesh, getme_elem_type type,
     b->type = type;
     b->first = mesh->num_elements;
     b->count = count;
-    b->conn = getme__malloc((size_t)count * nv * sizeof(int32_t));
+    b->conn = owned ? conn
+                    : getme__malloc((size_t)count * nv * sizeof(int32_t));
     int32_t same = 1; /* one region for the whole block: no array */
     for (int32_t e = 1; region && same && e < count; e++)
         same = region[e] == region[0];
@@ -170,17 +175,39 @@ getme_status getme_mesh_add_elements(getme_mesh *mesh, getme_elem_type type,
     if (region)
         b->region = getme__malloc((size_t)count * sizeof(int32_t));
     if (!b->conn || (region && !b->region)) {
-        free(b->conn);
+        if (!owned) /* an owned conn is the caller's to free on failure */
+            free(b->conn);
         free(b->region);
         return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
     }
-    memcpy(b->conn, conn, (size_t)count * nv * sizeof(int32_t));
+    if (!owned)
+        memcpy(b->conn, conn, (size_t)count * nv * sizeof(int32_t));
     if (region)
         memcpy(b->region, region, (size_t)count * sizeof(int32_t));
     mesh->num_blocks++;
     mesh->num_elements += count;
     mesh->mirror = -1; /* orientation of planar meshes: decide again */
     return GETME_OK;
+}
+
+getme_status getme_mesh_add_elements(getme_mesh *mesh, getme_elem_type type,
+                                     int32_t count, const int32_t *conn,
+                                     const int32_t *region)
+{
+    /* not written to: owned is 0 */
+    return add_elements(mesh, type, count, (int32_t *)(uintptr_t)conn, region,
+                        0);
+}
+
+getme_status getme_mesh_take_elements(getme_mesh *mesh, getme_elem_type type,
+                                      int32_t count, int32_t *conn,
+                                      const int32_t *region)
+{
+    getme_status st = add_elements(mesh, type, count, conn, region, 1);
+    /* count 0 adds no block: nothing keeps conn either */
+    if (st != GETME_OK || count == 0)
+        free(conn);
+    return st;
 }
 
 int getme_mesh_dim(const getme_mesh *mesh) { return mesh ? mesh->dim : 0; }

@@ -219,10 +219,16 @@ static getme_status add_run(getme__model_in *in, getme__model_out *out,
         getme_status gs =
             ho >= 0 ? getme_mesh_add_elements_ho(out->mesh, (getme_ho_type)ho,
                                                  (int32_t)count, conn, region)
-                    : getme_mesh_add_elements(
+                    : getme_mesh_take_elements(
                           out->mesh,
                           (getme_elem_type)getme__msh_type_getme(b->type),
                           (int32_t)count, conn, region);
+        /* the mesh took (or freed) conn: no copy of the largest array */
+        if (ho < 0) {
+            if (conn == b->conn)
+                b->conn = NULL;
+            conn = NULL;
+        }
         if (gs != GETME_OK)
             st = mesh_error(out, gs);
     }
