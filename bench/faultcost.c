@@ -1,0 +1,66 @@
+/*
+ * faultcost.c -- what a first touch of fresh memory costs on this machine,
+ * on 4 KiB pages and on transparent huge pages (issue #13, session 18:
+ * why page faults were a tenth of a `getme smooth` run on the benchmark VM).
+ *
+ *     gcc -O2 -o /tmp/faultcost bench/faultcost.c && /tmp/faultcost 256
+ *
+ * For each mode, three rounds of: map MiB fresh anonymous memory (2 MiB
+ * aligned), optionally madvise it MADV_HUGEPAGE and/or pre-fault it with
+ * MADV_POPULATE_WRITE, write one byte per cache line, unmap.  Prints the
+ * seconds of the map (+ populate) and of the writes.  The later rounds
+ * show memory the kernel had just freed, the first one memory it had not
+ * handed out before.  Not a library file: a measuring aid, like
+ * bench/heappeak.c.
+ */
+#define _GNU_SOURCE
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <sys/mman.h>
+#include <time.h>
+
+#ifndef MADV_POPULATE_WRITE
+#define MADV_POPULATE_WRITE 23 /* Linux 5.14 */
+#endif
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static void round_of(size_t n, int huge, int populate)
+{
+    const size_t align = (size_t)2 << 20;
+    double t0 = now();
+    char *m = mmap(NULL, n + align, PROT_READ | PROT_WRITE,
+                   MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (m == MAP_FAILED) {
+        perror("mmap");
+        exit(1);
+    }
+    char *a = (char *)(((uintptr_t)m + align - 1) & ~(uintptr_t)(align - 1));
+    (void)madvise(a, n, huge ? MADV_HUGEPAGE : MADV_NOHUGEPAGE);
+    if (populate && madvise(a, n, MADV_POPULATE_WRITE) != 0)
+        perror("MADV_POPULATE_WRITE");
+    double t1 = now();
+    for (size_t i = 0; i < n; i += 64)
+        a[i] = 1;
+    double t2 = now();
+    printf("%-9s %-9s %6zu MiB: map%s %.3f s, first writes %.3f s, "
+           "total %.3f s\n",
+           huge ? "huge" : "4 KiB", populate ? "populate" : "", n >> 20,
+           populate ? "+populate" : "", t1 - t0, t2 - t1, t2 - t0);
+    munmap(m, n + align);
+}
+
+int main(int argc, char **argv)
+{
+    size_t mib = argc > 1 ? (size_t)atol(argv[1]) : 256;
+    for (int mode = 0; mode < 4; mode++)
+        for (int r = 0; r < 3; r++)
+            round_of(mib << 20, mode & 1, mode >> 1);
+    return 0;
+}
