@@ -8,7 +8,6 @@
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
-#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -109,12 +108,13 @@ int getme__element_nodes_ok(const int32_t *c, int nv, int32_t num_nodes)
     return 1;
 }
 
-/* getme_mesh_add_elements, and with owned set getme_mesh_take_elements:
-   the block then keeps conn itself instead of a copy (the caller's array
-   is freed on failure, by the public function). */
+/* getme_mesh_add_elements, and with take (conn itself, writable) set
+   getme_mesh_take_elements: the block then keeps take instead of a copy
+   of conn (the caller's array is freed on failure, by the public
+   function). */
 static getme_status add_elements(getme_mesh *mesh, getme_elem_type type,
-                                 int32_t count, int32_t *conn,
-                                 const int32_t *region, int owned)
+                                 int32_t count, const int32_t *conn,
+                                 const int32_t *region, int32_t *take)
 {
     if (!mesh)
         return GETME_ERR_ARGUMENT;
@@ -163,8 +163,8 @@ static getme_status add_elements(getme_mesh *mesh, getme_elem_type type,
     b->type = type;
     b->first = mesh->num_elements;
     b->count = count;
-    b->conn = owned ? conn
-                    : getme__malloc((size_t)count * nv * sizeof(int32_t));
+    b->conn = take ? take
+                   : getme__malloc((size_t)count * nv * sizeof(int32_t));
     int32_t same = 1; /* one region for the whole block: no array */
     for (int32_t e = 1; region && same && e < count; e++)
         same = region[e] == region[0];
@@ -175,12 +175,12 @@ static getme_status add_elements(getme_mesh *mesh, getme_elem_type type,
     if (region)
         b->region = getme__malloc((size_t)count * sizeof(int32_t));
     if (!b->conn || (region && !b->region)) {
-        if (!owned) /* an owned conn is the caller's to free on failure */
+        if (!take) /* a taken conn is the caller's to free on failure */
             free(b->conn);
         free(b->region);
         return getme__fail(mesh, GETME_ERR_NOMEM, "out of memory");
     }
-    if (!owned)
+    if (!take)
         memcpy(b->conn, conn, (size_t)count * nv * sizeof(int32_t));
     if (region)
         memcpy(b->region, region, (size_t)count * sizeof(int32_t));
@@ -194,16 +194,14 @@ getme_status getme_mesh_add_elements(getme_mesh *mesh, getme_elem_type type,
                                      int32_t count, const int32_t *conn,
                                      const int32_t *region)
 {
-    /* not written to: owned is 0 */
-    return add_elements(mesh, type, count, (int32_t *)(uintptr_t)conn, region,
-                        0);
+    return add_elements(mesh, type, count, conn, region, NULL);
 }
 
 getme_status getme_mesh_take_elements(getme_mesh *mesh, getme_elem_type type,
                                       int32_t count, int32_t *conn,
                                       const int32_t *region)
 {
-    getme_status st = add_elements(mesh, type, count, conn, region, 1);
+    getme_status st = add_elements(mesh, type, count, conn, region, conn);
     /* count 0 adds no block: nothing keeps conn either */
     if (st != GETME_OK || count == 0)
         free(conn);
