@@ -43,9 +43,15 @@ gmsh.finalize()
 PY
     mesh=$raw ;;
 esac
+# the allocation helper (core/alloc since round 17; older trees had it
+# among the core's sources)
+alloc_inc= alloc_src=
+if [ -d "$src/core/alloc" ]; then
+    alloc_inc=-I"$src/core/alloc" alloc_src="$src/core/alloc/getme_alloc.c"
+fi
 gcc -std=c11 -O3 -fno-math-errno ${MARCH--march=native} -fopenmp -Wall -Wextra \
-    -I"$src/core/include" -I"$src/core/src" "$here/bench/setup.c" \
-    $(ls "$src"/core/src/*.c | grep -v '/adjacency\.c$') -lm -o "$out"
+    -I"$src/core/include" -I"$src/core/src" $alloc_inc "$here/bench/setup.c" \
+    $(ls "$src"/core/src/*.c | grep -v '/adjacency\.c$') $alloc_src -lm -o "$out"
 if [ -n "$CPU" ]; then
     OMP_WAIT_POLICY=passive taskset -c "$CPU" "$out" "$mesh" "$@"
 else
