@@ -11,6 +11,7 @@
  * finds the distinct nodes, so the result does not depend on the threads.
  */
 #include "block_local.h"
+#include "block_edges.h"
 #include "internal.h"
 
 #include <math.h>
@@ -32,11 +33,13 @@ void getme__blocks_free(getme_blocks *blk)
     free(blk->group.ptr);
     free(blk->group.cnt);
     free(blk->group.pos);
+    getme__blocks_free_edges(blk);
     memset(blk, 0, sizeof *blk);
 }
 
 void getme__blocks_free_local(getme_blocks *blk)
 {
+    getme__blocks_free_edges(blk);
     free(blk->nptr);
     free(blk->nodes);
     free(blk->local);

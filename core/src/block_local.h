@@ -80,6 +80,15 @@ typedef struct getme_blocks {
                             like ws->conn from the block's first element,
                             each entry the node's index in its list       */
     } *scratch;         /* ws->nt                                         */
+    /* The blocks' own edge lists (block_edges.h), or ledge NULL: block
+       b's edges are edges[eptr[b] .. eptr[b + 1]) (global edge ids, -1
+       for a missing slot), tet e's edge j is entry ledge[6 e + j] of its
+       block's list; esl holds ws->nt local S_e arrays, estride apart. */
+    int64_t *eptr;
+    int32_t *edges;
+    uint16_t *ledge;
+    int64_t *esl;
+    int32_t estride;
     /* The visiting order (see above): at level l, part p's interior
        blocks are order[part_ptr[l np + p] .. part_ptr[l np + p + 1]); then
        the blocks left, of colour c, order[col_ptr[c] .. col_ptr[c + 1])

@@ -24,6 +24,7 @@
  *    q*_min in its last, unsuccessful cycle).
  */
 #include "adjacency.h"
+#include "block_edges.h"
 #include "best.h"
 #include "gather_lanes.h"
 #include "revert.h"
@@ -189,6 +190,22 @@ weights_3d(int t, const getme_run *run, int32_t e0, int32_t e1,
     const int nv = getme__nv[t], ned = getme__edges[t].num_edges;
     const int nf = getme__faces[t].num_faces;
     const double qs = adj->qscale;
+    /* tets: the block's S_e gathered once into the thread's local array,
+       read through the tets' list indices (block_edges.h) */
+    const int64_t *esl = NULL;
+    if (t == GETME_TET && adj->blk.ledge) {
+        const getme_blocks *blk = &adj->blk;
+        int64_t *l = getme__blocks_esl(blk, omp_get_thread_num());
+        int32_t b = getme__blocks_of(blk, ws, t, e0);
+        const int32_t *be = blk->edges + blk->eptr[b];
+        int32_t nbe = (int32_t)(blk->eptr[b + 1] - blk->eptr[b]);
+        for (int32_t k = 0; k < nbe; k++) {
+            if (k + PREFETCH_AHEAD < nbe && be[k + PREFETCH_AHEAD] >= 0)
+                __builtin_prefetch(adj->esum + be[k + PREFETCH_AHEAD], 0, 3);
+            l[k] = be[k] >= 0 ? adj->esum[be[k]] : 0;
+        }
+        esl = l;
+    }
     for (int32_t c0 = e0; c0 < e1; c0 += WEIGHT_CHUNK) {
         int32_t c1 = c0 + WEIGHT_CHUNK < e1 ? c0 + WEIGHT_CHUNK : e1;
         int32_t eid[WEIGHT_CHUNK][12], fnb[WEIGHT_CHUNK][6];
@@ -200,10 +217,13 @@ weights_3d(int t, const getme_run *run, int32_t e0, int32_t e1,
             kind[e - c0] = (uint8_t)k;
             if (k != 1)
                 continue;
-            getme__adj_edge_ids(adj, getme__ws_nodes(ws, t, e), t,
-                                getme__adj_slots(adj, ws, t, e), eid[e - c0]);
-            for (int j = 0; j < ned; j++)
-                __builtin_prefetch(adj->esum + eid[e - c0][j], 0, 3);
+            if (!esl) {
+                getme__adj_edge_ids(adj, getme__ws_nodes(ws, t, e), t,
+                                    getme__adj_slots(adj, ws, t, e),
+                                    eid[e - c0]);
+                for (int j = 0; j < ned; j++)
+                    __builtin_prefetch(adj->esum + eid[e - c0][j], 0, 3);
+            }
             int32_t *f = fnb[e - c0];
             getme__adj_faces(adj, ws, t, e, f);
             for (int j = 0; j < nf; j++) /* no neighbour (-1): e itself */
@@ -223,8 +243,14 @@ weights_3d(int t, const getme_run *run, int32_t e0, int32_t e1,
             uint64_t sv = 0, se = 0;
             for (int i = 0; i < nv; i++)
                 sv += (uint64_t)ls[lc[i]];
-            for (int j = 0; j < ned; j++)
-                se += (uint64_t)adj->esum[eid[e - c0][j]];
+            if (esl) {
+                const uint16_t *le = getme__blocks_ledge(&adj->blk, e);
+                for (int j = 0; j < ned; j++)
+                    se += (uint64_t)esl[le[j]];
+            } else {
+                for (int j = 0; j < ned; j++)
+                    se += (uint64_t)adj->esum[eid[e - c0][j]];
+            }
             /* getme__adj_nsum_sv's wrapping sum, from the same pieces */
             num[e - c0] = getme__adj_nsum_3d(
                 adj, sv, se, getme__adj_face_q(adj, q, f, nf),
@@ -1746,6 +1772,9 @@ getme_status getme__adaptive(getme_run *run)
     set_bounds(run);
     if (!run->comm)
         mark_last(run);
+    /* tets: the q_mean stage's edge sums block by block (block_edges.h;
+       without memory for it, the global path: the same result) */
+    getme__blocks_edges(&run->adj->blk, run->adj, ws);
     if (run->slot && assign_slots(run) != GETME_OK) {
         st = GETME_ERR_NOMEM;
         goto done;

@@ -7,6 +7,7 @@
  * number of threads.
  */
 #include "adjacency.h"
+#include "block_edges.h"
 #include "gather_lanes.h"
 #include "smooth_internal.h"
 
@@ -83,7 +84,7 @@ static inline void set_q(getme_run *run, int t, int32_t e, double v)
    one writes (trial_check reads the coordinates only). */
 __attribute__((always_inline))
 static inline void set_q_lanes(getme_run *run, int t, const int32_t *elems,
-                               int32_t n, double *q)
+                               int32_t n, double *q, int64_t *esl)
 {
     getme_adj *adj = run->live;
     for (int32_t l = 0; l < n; l++)
@@ -93,10 +94,20 @@ static inline void set_q_lanes(getme_run *run, int t, const int32_t *elems,
         for (int32_t l = 0; l < n; l++)
             d[l] = (uint64_t)getme__fx64(q[l], adj->qscale) -
                    (uint64_t)getme__fx64(run->q[elems[l]], adj->qscale);
-        for (int32_t l = 0; l < n; l++)
-            if (d[l])
-                getme__adj_add(adj, run->ws, t, elems[l],
-                               getme__ws_nodes(run->ws, t, elems[l]), d[l]);
+        if (esl) /* tets: S_e in the block's local array (block_edges.h) */
+            for (int32_t l = 0; l < n; l++) {
+                const int32_t *c = getme__ws_nodes(run->ws, t, elems[l]);
+                const uint16_t *le = getme__blocks_ledge(&adj->blk, elems[l]);
+                for (int i = 0; i < getme__nv[t]; i++)
+                    adj->nsum[c[i]] = (int64_t)((uint64_t)adj->nsum[c[i]] + d[l]);
+                for (int j = 0; j < getme__edges[t].num_edges; j++)
+                    esl[le[j]] = (int64_t)((uint64_t)esl[le[j]] + d[l]);
+            }
+        else
+            for (int32_t l = 0; l < n; l++)
+                if (d[l])
+                    getme__adj_add(adj, run->ws, t, elems[l],
+                                   getme__ws_nodes(run->ws, t, elems[l]), d[l]);
     }
     for (int32_t l = 0; l < n; l++)
         run->q[elems[l]] = q[l];
@@ -105,10 +116,11 @@ static inline void set_q_lanes(getme_run *run, int t, const int32_t *elems,
 /* trial_quality of the n <= GETME_LANES elements elems[0..n) into run->q
    (set_q), their mean ratios in one lane kernel (quality.c) when they are
    all of type t and t has one: the same bits, several times faster.  A
-   short batch repeats its first element in the unused lanes. */
+   short batch repeats its first element in the unused lanes.  esl: the
+   running block's local S_e (tets, trial_block), or NULL. */
 __attribute__((always_inline)) /* t is a constant in trial_block's copies */
 static inline void trial_batch(int t, getme_run *run, const int32_t *elems,
-                               int32_t n)
+                               int32_t n, int64_t *esl)
 {
     const getme_ws *ws = run->ws;
     double x[3 * GETME_MAX_NV][GETME_LANES], q[GETME_LANES];
@@ -121,7 +133,7 @@ static inline void trial_batch(int t, getme_run *run, const int32_t *elems,
             c[l] = getme__ws_nodes(ws, t, elems[l < n ? l : 0]);
         getme__gather_lanes(ws->x, c, getme__nv[t], x);
         if (getme__quality_lanes(t, (const double(*)[GETME_LANES])x, q)) {
-            set_q_lanes(run, t, elems, n, q);
+            set_q_lanes(run, t, elems, n, q, esl);
             return;
         }
     }
@@ -147,7 +159,21 @@ static inline void trial_block(int t, getme_run *run, int32_t b,
                                int64_t *bad)
 {
     const getme_ws *ws = run->ws;
-    int32_t *list = run->adj->blk.scratch[omp_get_thread_num()].list;
+    getme_adj *adj = run->live;
+    const getme_blocks *blk = &adj->blk;
+    int th = omp_get_thread_num();
+    int32_t *list = blk->scratch[th].list;
+    /* tets: the S_e changes summed per block edge, then added once each
+       (block_edges.h) */
+    int64_t *esl = NULL;
+    const int32_t *bedges = NULL;
+    int32_t nbe = 0;
+    if (t == GETME_TET && blk->ledge) {
+        esl = getme__blocks_esl(blk, th);
+        bedges = blk->edges + blk->eptr[b];
+        nbe = (int32_t)(blk->eptr[b + 1] - blk->eptr[b]);
+        memset(esl, 0, (size_t)nbe * sizeof *esl);
+    }
     int32_t n = 0;
     for (int32_t e = ws->block_start[b]; e < ws->block_start[b + 1]; e++)
         if (ws->free_elem[e])
@@ -159,8 +185,13 @@ static inline void trial_block(int t, getme_run *run, int32_t b,
                 __builtin_prefetch(ws->x + 3 * (int64_t)c[i], 0, 3);
         }
         trial_batch(t, run, list + j,
-                    n - j < GETME_LANES ? n - j : GETME_LANES);
+                    n - j < GETME_LANES ? n - j : GETME_LANES, esl);
     }
+    for (int32_t k = 0; k < nbe; k++)
+        if (bedges[k] >= 0) { /* -1: a missing slot, as getme__adj_add */
+            int64_t *sum = &adj->esum[bedges[k]];
+            *sum = (int64_t)((uint64_t)*sum + (uint64_t)esl[k]);
+        }
     for (int32_t k = 0; k < n; k++)
         *bad += !(run->q[list[k]] > 0.0);
 }
@@ -398,7 +429,7 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
 #pragma omp parallel for schedule(static) num_threads(nt) if (ne > GETME_PAR_MIN)
         for (int32_t j = 0; j < nbatch; j++)
             trial_batch(getme__ws_type(ws, elems[j * GETME_LANES]), run,
-                        elems + j * GETME_LANES, GETME_LANES);
+                        elems + j * GETME_LANES, GETME_LANES, NULL);
         for (int32_t k = nbatch * GETME_LANES; k < ne; k++)
             q[elems[k]] = trial_quality(run, elems[k]);
         invalid = run->comm ? 0 : count_invalid(run);

@@ -11,6 +11,7 @@
  * functions.
  */
 #include "adjacency.h"
+#include "block_edges.h"
 #include "check.h"
 
 #include <stdlib.h>
@@ -862,6 +863,101 @@ static void check_threads(const char *kind, int duplicates)
     N = n0;
 }
 
+/* The blocks' own edge lists (block_edges.h) against the global edge ids:
+   every tet edge's list entry is its id, no list holds an edge twice,
+   every edge is in some list, and 1, 2 and 3 threads build the same
+   lists; other meshes get none (their sweeps take the global path).
+   With duplicates (twin tets, irregular faces) too. */
+static void check_block_edges(const char *kind, int duplicates)
+{
+    int n0 = N;
+    N = 13; /* more than 3 blocks */
+    gen g = make(kind);
+    for (int t = 0; t < GETME_NUM_TYPES && duplicates; t++)
+        for (int32_t e = 0; e < g.count[t]; e += 97) {
+            int32_t c[GETME_MAX_NV];
+            memcpy(c, g.conn[t] + (size_t)e * getme__nv[t],
+                   (size_t)getme__nv[t] * sizeof *c);
+            add_elem(&g, t, c);
+        }
+    getme_mesh *mesh = to_mesh(&g);
+    int64_t *ref_ptr = NULL;
+    int32_t *ref_edges = NULL;
+    uint16_t *ref_ledge = NULL;
+    for (int nt = 1; nt <= 3; nt++) {
+        getme_ws ws;
+        getme_adj adj;
+        CHECK(getme__ws_build(&ws, mesh, 1, nt) == GETME_OK);
+        CHECK(getme__adj_build(&adj, &ws) == GETME_OK);
+        getme__blocks_edges(&adj.blk, &adj, &ws);
+        const getme_blocks *blk = &adj.blk;
+        if (strcmp(kind, "tet")) {
+            CHECK(blk->ledge == NULL && blk->edges == NULL);
+            getme__adj_free(&adj);
+            getme__ws_free(&ws);
+            continue;
+        }
+        CHECK(blk->ledge != NULL && blk->edges != NULL && ws.num_blocks > 3);
+        int64_t total = blk->eptr[ws.num_blocks];
+        uint8_t *seen = calloc((size_t)adj.num_edges + 1, 1);
+        int32_t *inlist = calloc((size_t)adj.num_edges + 1, sizeof *inlist);
+        int missing = 0;
+        for (int32_t b = 0; b < ws.num_blocks; b++) {
+            int64_t n = blk->eptr[b + 1] - blk->eptr[b];
+            CHECK(n > 0 && n <= blk->estride);
+            for (int64_t k = blk->eptr[b]; k < blk->eptr[b + 1]; k++) {
+                int32_t id = blk->edges[k];
+                CHECK(id >= -1 && id < adj.num_edges);
+                /* distinct within the block: the last block it was in */
+                CHECK(inlist[id + 1] != b + 1);
+                inlist[id + 1] = b + 1;
+                seen[id + 1] = 1;
+            }
+            for (int32_t e = ws.block_start[b]; e < ws.block_start[b + 1]; e++) {
+                int32_t id[12];
+                getme__adj_edge_ids(&adj, getme__ws_nodes(&ws, GETME_TET, e),
+                                    GETME_TET,
+                                    getme__adj_slots(&adj, &ws, GETME_TET, e),
+                                    id);
+                const uint16_t *le = getme__blocks_ledge(blk, e);
+                CHECK_EQ_INT(getme__blocks_of(blk, &ws, GETME_TET, e), b);
+                for (int j = 0; j < 6; j++) {
+                    CHECK(le[j] < n);
+                    CHECK_EQ_INT(blk->edges[blk->eptr[b] + le[j]], id[j]);
+                    missing += id[j] < 0;
+                }
+            }
+        }
+        int32_t listed = 0;
+        for (int32_t i = 1; i <= adj.num_edges; i++)
+            listed += seen[i];
+        CHECK_EQ_INT(listed, adj.num_edges);
+        CHECK_EQ_INT(missing, 0); /* twins share their edges' slots */
+        free(seen), free(inlist);
+        if (!ref_ptr) {
+            ref_ptr = malloc((size_t)(ws.num_blocks + 1) * sizeof *ref_ptr);
+            ref_edges = malloc((size_t)total * sizeof *ref_edges);
+            ref_ledge = malloc((size_t)ws.ne * 6 * sizeof *ref_ledge);
+            memcpy(ref_ptr, blk->eptr, (size_t)(ws.num_blocks + 1) * sizeof *ref_ptr);
+            memcpy(ref_edges, blk->edges, (size_t)total * sizeof *ref_edges);
+            memcpy(ref_ledge, blk->ledge, (size_t)ws.ne * 6 * sizeof *ref_ledge);
+        } else {
+            CHECK(memcmp(ref_ptr, blk->eptr,
+                         (size_t)(ws.num_blocks + 1) * sizeof *ref_ptr) == 0);
+            CHECK(memcmp(ref_edges, blk->edges, (size_t)total * sizeof *ref_edges) == 0);
+            CHECK(memcmp(ref_ledge, blk->ledge, (size_t)ws.ne * 6 * sizeof *ref_ledge) == 0);
+        }
+        getme__blocks_free_local(&adj.blk);
+        CHECK(adj.blk.ledge == NULL && adj.blk.edges == NULL);
+        getme__adj_free(&adj);
+        getme__ws_free(&ws);
+    }
+    free(ref_ptr), free(ref_edges), free(ref_ledge);
+    getme_mesh_free(mesh);
+    free_gen(&g);
+    N = n0;
+}
+
 int main(void)
 {
     const char *kinds[] = {"tet", "hex", "mixed", "tri", "quad", "tri+quad"};
@@ -871,6 +967,10 @@ int main(void)
     check_block_order();
     check_live_sums();
     check_tail_bookkeeping();
+    check_block_edges("tet", 0);
+    check_block_edges("tet", 1);
+    check_block_edges("hex", 0);
+    check_block_edges("mixed", 0);
     check_ring_orders("tet");
     check_ring_orders("hex");
     check_ring_orders("mixed");
