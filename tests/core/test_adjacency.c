@@ -48,6 +48,19 @@ static void add_elem(gen *g, int t, const int32_t *c)
     g->count[t]++;
 }
 
+/* A twin of every 97th element of each type: faces of three sides and
+   twin simplices, so the irregular paths run. */
+static void add_twins(gen *g)
+{
+    for (int t = 0; t < GETME_NUM_TYPES; t++)
+        for (int32_t e = 0; e < g->count[t]; e += 97) {
+            int32_t c[GETME_MAX_NV]; /* add_elem may move g->conn[t] */
+            memcpy(c, g->conn[t] + (size_t)e * getme__nv[t],
+                   (size_t)getme__nv[t] * sizeof *c);
+            add_elem(g, t, c);
+        }
+}
+
 static void free_gen(gen *g)
 {
     free(g->xyz);
@@ -819,13 +832,8 @@ static void check_threads(const char *kind, int duplicates)
     gen g = make(kind);
     /* duplicate elements: faces of three sides and twin simplices, so
        the irregular paths run too */
-    for (int t = 0; t < GETME_NUM_TYPES && duplicates; t++)
-        for (int32_t e = 0; e < g.count[t]; e += 97) {
-            int32_t c[GETME_MAX_NV]; /* add_elem may move g.conn[t] */
-            memcpy(c, g.conn[t] + (size_t)e * getme__nv[t],
-                   (size_t)getme__nv[t] * sizeof *c);
-            add_elem(&g, t, c);
-        }
+    if (duplicates)
+        add_twins(&g);
     /* with duplicates, also three nodes used by no element: they are
        numbered last, after the first-touch numbering (which 2 and 3
        threads do by ranges merged in order), so its count must be
@@ -873,13 +881,8 @@ static void check_block_edges(const char *kind, int duplicates)
     int n0 = N;
     N = 13; /* more than 3 blocks */
     gen g = make(kind);
-    for (int t = 0; t < GETME_NUM_TYPES && duplicates; t++)
-        for (int32_t e = 0; e < g.count[t]; e += 97) {
-            int32_t c[GETME_MAX_NV];
-            memcpy(c, g.conn[t] + (size_t)e * getme__nv[t],
-                   (size_t)getme__nv[t] * sizeof *c);
-            add_elem(&g, t, c);
-        }
+    if (duplicates)
+        add_twins(&g);
     getme_mesh *mesh = to_mesh(&g);
     int64_t *ref_ptr = NULL;
     int32_t *ref_edges = NULL;
