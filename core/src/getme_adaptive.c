@@ -882,56 +882,23 @@ static int64_t scatter_some_block(void *ctx, int32_t b)
 }
 
 /* A ring whose stars hold at least ne / RING_SWEEP_DIV element entries is
-   listed in ascending order by a sweep over every element (ring_sweep)
-   instead of in first-occurrence order (a sweep over every element would
-   cost more than it saves on a small ring).  From ne / RING_NODES_DIV
-   entries on, the sweep tests each element's nodes against I_T instead
-   of reading marks that a serial walk of the stars set: full tets' first
-   q*_min iteration, 2 threads, 1.5M star entries: marking 25 ms and the
-   sweep 12 ms, against one sweep of ~15 ms that reads the connectivity. */
+   listed by a sweep over the element flags (ring_sweep) instead of in
+   first-occurrence order (a sweep over every element would cost more than
+   it saves on a small ring). */
 #define RING_SWEEP_DIV 32
-#define RING_NODES_DIV 8
 #ifdef GETME_CHECK_SUMS
-/* Test builds: 2 threads always sweep the marks, 3 the nodes, other
-   counts never, so that tests/core/test_adjacency.c's comparison of 1 to
-   4 threads compares the orders of run->elems (and the serial and
-   block-grouped sums). */
-#define RING_SWEEP(ws, stars) ((ws)->nt == 2 || (ws)->nt == 3)
-#define RING_NODES(ws, stars) ((ws)->nt == 3)
+/* Test builds: 2 threads always sweep, other counts never, so that
+   tests/core/test_adjacency.c's comparison of 1, 2 and 3 threads compares
+   the two orders of run->elems (and the serial and block-grouped sums). */
+#define RING_SWEEP(ws, stars) ((ws)->nt == 2)
 #else
 #define RING_SWEEP(ws, stars) ((stars) >= (ws)->ne / RING_SWEEP_DIV)
-#define RING_NODES(ws, stars) ((stars) >= (ws)->ne / RING_NODES_DIV)
 #endif
 /* Elements per chunk of ring_sweep's parallel count and placement. */
 #define RING_CHUNK 16384
 
-/* 1 if element e has a node in I_T (run->in_t). */
-static inline int touches_t(const getme_run *run, int32_t e)
-{
-    const getme_ws *ws = run->ws;
-    int t = getme__ws_type(ws, e);
-    const int32_t *c = getme__ws_nodes(ws, t, e);
-    int any = 0;
-    for (int i = 0; i < getme__nv[t]; i++)
-        any |= run->in_t[c[i]];
-    return any != 0;
-}
-
-/* Element e is in the ring: by_nodes, it has a node in I_T; else it is
-   marked in run->eflag (the mark cleared as it is read). */
-static inline int in_ring(getme_run *run, int32_t e, int by_nodes, int clear)
-{
-    if (by_nodes)
-        return touches_t(run, e);
-    int in = run->eflag[e] != 0;
-    if (clear)
-        run->eflag[e] = 0;
-    return in;
-}
-
-/* The ring's elements in ascending order into run->elems, clearing the
-   marks (by_nodes: run->in_t decides, see in_ring); returns how many.
-   Why ascending: scatter_some's
+/* The elements marked in run->eflag, in ascending order, into run->elems,
+   clearing the marks; returns how many.  Why ascending: scatter_some's
    and update_after's block sweeps and the relaxation's first pass then
    walk each block's elements in memory order, so the per-element arrays
    (q, connectivity, face neighbours, edge slots) stream and neighbouring
@@ -943,24 +910,27 @@ static inline int in_ring(getme_run *run, int32_t e, int by_nodes, int clear)
    transformation list.  A parallel count per chunk, then each chunk
    places its elements (serial if the counts have no room: the same
    list). */
-static int32_t ring_sweep(getme_run *run, int by_nodes)
+static int32_t ring_sweep(getme_run *run)
 {
     const getme_ws *ws = run->ws;
+    uint8_t *eflag = run->eflag;
     int32_t *out = run->elems, n = ws->ne;
     int32_t nc = (n + RING_CHUNK - 1) / RING_CHUNK;
     int32_t *cnt = getme__malloc(((size_t)nc + 1) * sizeof *cnt);
     if (!cnt) {
         int32_t m = 0;
         for (int32_t e = 0; e < n; e++)
-            if (in_ring(run, e, by_nodes, 1))
+            if (eflag[e]) {
+                eflag[e] = 0;
                 out[m++] = e;
+            }
         return m;
     }
 #pragma omp parallel for schedule(static) num_threads(ws->nt)
     for (int32_t c = 0; c < nc; c++) {
         int32_t end = c < nc - 1 ? (c + 1) * RING_CHUNK : n, m = 0;
         for (int32_t e = c * RING_CHUNK; e < end; e++)
-            m += in_ring(run, e, by_nodes, 0);
+            m += eflag[e] != 0;
         cnt[c + 1] = m;
     }
     cnt[0] = 0;
@@ -970,8 +940,10 @@ static int32_t ring_sweep(getme_run *run, int by_nodes)
     for (int32_t c = 0; c < nc; c++) {
         int32_t end = c < nc - 1 ? (c + 1) * RING_CHUNK : n, m = cnt[c];
         for (int32_t e = c * RING_CHUNK; e < end; e++)
-            if (in_ring(run, e, by_nodes, 1))
+            if (eflag[e]) {
+                eflag[e] = 0;
                 out[m++] = e;
+            }
     }
     int32_t total = cnt[nc];
     free(cnt);
@@ -1022,15 +994,13 @@ static int32_t scatter_some(getme_run *run, double qt, double sigma)
     int64_t stars = 0; /* the elements around I_T, with repeats */
     for (int32_t k = 0; k < nn; k++)
         stars += getme__star_size(ws, run->nodes[k]);
-    if (RING_NODES(ws, stars)) { /* in order, by their nodes */
-        ne = ring_sweep(run, 1);
-    } else if (RING_SWEEP(ws, stars)) { /* marked, then in order */
+    if (RING_SWEEP(ws, stars)) { /* marked, then in order */
         for (int32_t k = 0; k < nn; k++) {
             getme_star_it it = getme__star_open(ws, run->nodes[k]);
             for (int32_t e; getme__star_next(&it, &e);)
                 run->eflag[e] = 1;
         }
-        ne = ring_sweep(run, 0);
+        ne = ring_sweep(run);
     } else {
         for (int32_t k = 0; k < nn; k++) {
             getme_star_it it = getme__star_open(ws, run->nodes[k]);
