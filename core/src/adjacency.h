@@ -127,6 +127,24 @@ getme__adj_edge_ids(const getme_adj *adj, const int32_t *c, int t,
     }
 }
 
+/* getme__adj_add with the element's edge ids already worked out (id,
+   -1 for a missing slot; read only in 3-D): the sweeps that compute them
+   ahead to prefetch the sums (update_block, relax.c's step_chunk). */
+__attribute__((always_inline)) static inline void
+getme__adj_add_ids(getme_adj *adj, const getme_ws *ws, int t,
+                   const int32_t *c, const int32_t *id, uint64_t d)
+{
+    for (int i = 0; i < getme__nv[t]; i++)
+        adj->nsum[c[i]] = (int64_t)((uint64_t)adj->nsum[c[i]] + d);
+    if (ws->dim != 3)
+        return;
+    for (int j = 0; j < getme__edges[t].num_edges; j++)
+        if (id[j] >= 0) {
+            int64_t *s = &adj->esum[id[j]];
+            *s = (int64_t)((uint64_t)*s + d);
+        }
+}
+
 /* Add d to the S_v of element e's nodes and the S_e of its edges (type
    t; nodes c), in wrapping uint64 arithmetic: d is an element's
    fixed-point quality, or the difference of its new and old ones, which

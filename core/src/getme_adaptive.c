@@ -1129,19 +1129,10 @@ static int64_t update_block(void *ctx, int32_t b)
                 if (eid[i][j] >= 0)
                     __builtin_prefetch(adj->esum + eid[i][j], 1, 3);
         }
-        for (int32_t i = 0; i < n; i++) { /* getme__adj_add's sums */
-            uint64_t d = dd[i];
-            if (!d)
-                continue;
-            const int32_t *c = getme__ws_nodes(ws, t, el[i]);
-            for (int v = 0; v < nv; v++)
-                adj->nsum[c[v]] = (int64_t)((uint64_t)adj->nsum[c[v]] + d);
-            for (int j = 0; j < ned; j++)
-                if (eid[i][j] >= 0) {
-                    int64_t *p = &adj->esum[eid[i][j]];
-                    *p = (int64_t)((uint64_t)*p + d);
-                }
-        }
+        for (int32_t i = 0; i < n; i++) /* getme__adj_add's sums */
+            if (dd[i])
+                getme__adj_add_ids(adj, ws, t, getme__ws_nodes(ws, t, el[i]),
+                                   eid[i], dd[i]);
     }
     *tsum += ts;
     return 0;

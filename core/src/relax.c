@@ -414,17 +414,9 @@ static void step_chunk(getme_run *run, step_scratch *sc, int32_t n)
                     __builtin_prefetch(adj->esum + sc->id[k + STEP_AHEAD][j],
                                        1, 3);
         }
-        uint64_t d = sc->d[k];
-        if (d) { /* getme__adj_add, its edge ids from the parallel pass */
-            const int32_t *c = getme__ws_nodes(ws, t, e);
-            for (int i = 0; i < getme__nv[t]; i++)
-                adj->nsum[c[i]] = (int64_t)((uint64_t)adj->nsum[c[i]] + d);
-            for (int j = 0; ws->dim == 3 && j < getme__edges[t].num_edges; j++)
-                if (sc->id[k][j] >= 0) {
-                    int64_t *p = &adj->esum[sc->id[k][j]];
-                    *p = (int64_t)((uint64_t)*p + d);
-                }
-        }
+        if (sc->d[k]) /* its edge ids from the parallel pass */
+            getme__adj_add_ids(adj, ws, t, getme__ws_nodes(ws, t, e),
+                               sc->id[k], sc->d[k]);
         run->q[e] = sc->q[k];
         run->eflag[e] &= 0x7f; /* step_nodes' mark */
     }
