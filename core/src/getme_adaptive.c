@@ -729,12 +729,20 @@ static void lists_all(getme_run *run)
 }
 
 /* Below this many elements around I_T, scatter_some and update_after's
-   sums run on one thread: grouping the list by block and the block sweep's
-   parallel regions would cost more than they save. */
-#ifdef GETME_CHECK_SUMS /* test builds: the grouped path on any mesh */
-#define SOME_PAR_MIN 1
+   sums run element by element in list order: grouping the list by block
+   and the block sweep's parallel regions would cost more than they save.
+   Above it the grouped path runs on one thread too, for its chunked
+   prefetching (some_chunks, update_block): on the full tets' q*_min stage
+   at one thread, scatter_some took 0.32-0.33 s against 0.37-0.63 s
+   element by element, update_after 0.21-0.22 s against 0.23-0.30 s
+   (docs/bench.md, session 23). */
+#ifdef GETME_CHECK_SUMS
+/* Test builds: the grouped path on any mesh, except with 3 threads, so
+   that tests/core/test_adjacency.c's comparison of 1, 2 and 3 threads
+   compares it with the element-by-element path. */
+#define SOME_GROUPED(ws, ne) ((ws)->nt != 3 && (ne) >= 1)
 #else
-#define SOME_PAR_MIN 4096
+#define SOME_GROUPED(ws, ne) ((ne) >= 4096)
 #endif
 
 /* What a block of scatter_some's or update_after's parallel sweep needs. */
@@ -1016,7 +1024,7 @@ static int32_t scatter_some(getme_run *run, double qt, double sigma)
     run->num_nodes = nn;
     run->num_elems = ne;
     run->adj->blk.group.n = -1; /* run->elems changed */
-    if (ws->nt > 1 && ne >= SOME_PAR_MIN &&
+    if (SOME_GROUPED(ws, ne) &&
         getme__blocks_group(&run->adj->blk, ws, run->elems, ne) == GETME_OK) {
         /* update_after's sums use the same grouping (run->elems stays) */
         struct some_ctx s = {run, qt, sigma, NULL};

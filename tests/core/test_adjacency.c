@@ -426,10 +426,12 @@ static void check_live_sums(void)
 /* The q*_min stage's lists and sums (getme_adaptive.c): its ring of
    elements around I_T is listed in ascending order (ring_sweep) or in
    first-occurrence order, and its Eq. 9 contributions and sum updates run
-   serially (1 thread) or block by block in chunks (some_chunks,
-   update_block).  None of that may change a bit: this test is built with
-   GETME_CHECK_SUMS, where 2 threads always take the sweep and 3 never, so
-   every output coordinate of 1, 2 and 3 threads must be the same bits.
+   element by element in list order or block by block in chunks
+   (some_chunks, update_block).  None of that may change a bit: this test
+   is built with GETME_CHECK_SUMS, where 2 threads always take the sweep
+   and 1 and 3 never, and 3 threads always go element by element and 1 and
+   2 never, so every output coordinate of 1, 2 and 3 threads must be the
+   same bits.
    Tets, hexes and a mixed mesh (blocks of several types, irregular
    elements' union weights), each distorted as the benchmark meshes. */
 static void check_ring_orders(const char *kind)
