@@ -132,6 +132,18 @@ GETME_API getme_status getme_mesh_create(getme_mesh **mesh, int dim,
                                          int32_t num_nodes,
                                          const double *coords);
 
+/*
+ * As getme_mesh_create(), but the mesh takes coords instead of a copy of
+ * it: coords must come from malloc() (or calloc/realloc), and belongs to
+ * the mesh from the call on, which frees it with free() -- at once if the
+ * call fails or num_nodes is 0.  For callers that build the coordinates
+ * only to hand them over (libgetme_formats' readers): one copy of the
+ * coordinates less, and its fresh pages (docs/bench.md, session 23).
+ */
+GETME_API getme_status getme_mesh_create_take(getme_mesh **mesh, int dim,
+                                              int32_t num_nodes,
+                                              double *coords);
+
 GETME_API void getme_mesh_free(getme_mesh *mesh);
 
 /* The message of the last failed call on this mesh ("" if none). */

@@ -46,37 +46,60 @@ const char *getme_mesh_error(const getme_mesh *mesh)
     return mesh ? mesh->error : "no mesh";
 }
 
-getme_status getme_mesh_create(getme_mesh **out, int dim, int32_t num_nodes,
-                               const double *coords)
+/* getme_mesh_create (take NULL) and getme_mesh_create_take (take ==
+   coords, freed on every path where the mesh does not keep it). */
+static getme_status create(getme_mesh **out, int dim, int32_t num_nodes,
+                           const double *coords, double *take)
 {
+    getme_status st = GETME_ERR_ARGUMENT;
+    getme_mesh *m = NULL;
     if (!out)
-        return GETME_ERR_ARGUMENT;
+        goto fail;
     *out = NULL;
     if ((dim != 2 && dim != 3) || num_nodes < 0 ||
         (num_nodes > 0 && !coords) || num_nodes > INT32_MAX / 3)
-        return GETME_ERR_ARGUMENT;
-    getme_mesh *m = getme__calloc(1, sizeof *m);
+        goto fail;
+    st = GETME_ERR_NOMEM;
+    m = getme__calloc(1, sizeof *m);
     if (!m)
-        return GETME_ERR_NOMEM;
+        goto fail;
     m->dim = dim;
     m->num_nodes = num_nodes;
     size_t n = (size_t)num_nodes;
-    m->coords = getme__malloc((n ? n : 1) * 3 * sizeof(double));
+    if (take && n) {
+        m->coords = take; /* freed with the mesh from here on */
+        take = NULL;
+    } else {
+        m->coords = getme__malloc((n ? n : 1) * 3 * sizeof(double));
+    }
     m->fixed = getme__calloc(n ? n : 1, 1);
-    if (!m->coords || !m->fixed) {
-        getme_mesh_free(m);
-        return GETME_ERR_NOMEM;
-    }
-    if (n)
+    if (!m->coords || !m->fixed)
+        goto fail;
+    if (n && m->coords != coords)
         memcpy(m->coords, coords, n * 3 * sizeof(double));
-    for (size_t i = 0; i < 3 * n; i++) {
-        if (!isfinite(m->coords[i])) {
-            getme_mesh_free(m);
-            return GETME_ERR_ARGUMENT;
-        }
-    }
+    st = GETME_ERR_ARGUMENT;
+    for (size_t i = 0; i < 3 * n; i++)
+        if (!isfinite(m->coords[i]))
+            goto fail;
+    free(take); /* num_nodes 0: nothing taken */
     *out = m;
     return GETME_OK;
+fail:
+    getme_mesh_free(m);
+    free(take);
+    return st;
+}
+
+getme_status getme_mesh_create(getme_mesh **out, int dim, int32_t num_nodes,
+                               const double *coords)
+{
+    return create(out, dim, num_nodes, coords, NULL);
+}
+
+getme_status getme_mesh_create_take(getme_mesh **out, int dim,
+                                    int32_t num_nodes, double *coords)
+{
+    return create(out, dim, num_nodes, coords, coords);
 }
 
 void getme_mesh_free(getme_mesh *mesh)

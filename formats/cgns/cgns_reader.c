@@ -515,18 +515,25 @@ getme_formats_status cgns_read(getme_doc *doc, cgns_impl *impl, int fn,
     if (!coords)
         return oom(doc);
     st = read_coords(doc, impl, fn, coords, (int32_t)total);
-    if (st == GETME_FORMATS_OK &&
-        getme_mesh_create(&doc->mesh, impl->dim, (int32_t)total, coords) !=
-            GETME_OK)
-        st = getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL,
-                            "%s: cannot create the mesh", doc->path);
+    if (st != GETME_FORMATS_OK) {
+        free(coords);
+        return st;
+    }
     for (int z = 0; z < impl->num_zones; z++)
         single |= impl->zones[z].single;
-    if (st == GETME_FORMATS_OK && single)
-        impl->orig = coords; /* kept for the RealSingle rounding check */
-    else
+    /* The mesh takes the coordinates (no copy), unless they are kept for
+       the RealSingle rounding check; a failed take frees them. */
+    getme_status gs =
+        single ? getme_mesh_create(&doc->mesh, impl->dim, (int32_t)total,
+                                   coords)
+               : getme_mesh_create_take(&doc->mesh, impl->dim,
+                                        (int32_t)total, coords);
+    if (single && gs == GETME_OK)
+        impl->orig = coords;
+    else if (single)
         free(coords);
-    if (st != GETME_FORMATS_OK)
-        return st;
+    if (gs != GETME_OK)
+        return getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL,
+                              "%s: cannot create the mesh", doc->path);
     return build_mesh(doc, impl, fn, opts, (int32_t)total);
 }

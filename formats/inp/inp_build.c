@@ -779,14 +779,14 @@ static getme_formats_status build_mesh(builder *b, const getme_doc_options *opts
             b->nsmooth += d->eblocks[k].count;
     }
     getme_mesh *mesh = NULL;
-    getme_status gs = getme_mesh_create(
+    /* the mesh takes the coordinates (no copy; freed if it fails) */
+    getme_status gs = getme_mesh_create_take(
         &mesh, b->smooth == INP_KIND_SOLID ? 3 : 2, d->nnodes, d->xyz);
+    d->xyz = NULL;
     if (gs != GETME_OK)
         return getme_doc_fail(b->doc, GETME_FORMATS_ERR_INTERNAL, "%s: %s",
                               inp_file_name(d, 0), getme_status_string(gs));
     b->doc->mesh = mesh;
-    free(d->xyz); /* the mesh has its own copy */
-    d->xyz = NULL;
     int32_t nfixed = 0;
     if ((st = add_blocks(b, mesh)) || (st = fix_nodes(b, opts, mesh, &nfixed)) ||
         (st = make_ids(b)))

@@ -294,14 +294,22 @@ getme_status getme__model_finish(getme__model_in *in, getme__model_out *out)
                                    in->blocks, in->num_blocks, out->msg,
                                    sizeof out->msg);
     if (st == GETME_OK) {
-        st = getme_mesh_create(&out->mesh, in->dim, out->num_nodes, out->xyz);
+        /* Unless the caller keeps ours, the mesh takes it: no copy, and
+           ours never coexists with the elements and the boundary search
+           (24 B per node less at the reading's peak). */
+        if (in->keep_copies) {
+            st = getme_mesh_create(&out->mesh, in->dim, out->num_nodes,
+                                   out->xyz);
+        } else {
+            st = getme_mesh_create_take(&out->mesh, in->dim, out->num_nodes,
+                                        out->xyz);
+            out->xyz = NULL; /* the mesh's, or freed */
+        }
         if (st != GETME_OK)
             snprintf(out->msg, sizeof out->msg,
                      "Could not create the mesh: %s", getme_status_string(st));
     }
-    /* The mesh has its own copy: ours goes before the elements and the
-       boundary search (24 B per node less at the reading's peak). */
-    if (!in->keep_copies) {
+    if (!in->keep_copies) { /* also when the planar frame failed */
         free(out->xyz);
         out->xyz = NULL;
     }

@@ -1,17 +1,19 @@
 /*
- * test_take.c -- getme_mesh_take_elements(): the mesh keeps the caller's
- * malloc'd connectivity instead of a copy, and the result is the mesh that
- * getme_mesh_add_elements() builds: the same elements back, and the same
- * smoothed coordinates bit for bit, for every element type of the
+ * test_take.c -- getme_mesh_take_elements() and getme_mesh_create_take():
+ * the mesh keeps the caller's malloc'd connectivity and coordinates
+ * instead of copies, and the result is the mesh that getme_mesh_create()
+ * and getme_mesh_add_elements() build: the same elements back, and the
+ * same smoothed coordinates bit for bit, for every element type of the
  * generator (tets, hexes, mixed, planar).  A call that fails (a node out of
- * range, a repeated node, a wrong type) or adds nothing frees the array, so
- * that nothing leaks and nothing is freed twice: the ASan + UBSan build
- * runs this with LeakSanitizer.
+ * range, a repeated node, a wrong type, a coordinate not finite) or adds
+ * nothing frees the array, so that nothing leaks and nothing is freed
+ * twice: the ASan + UBSan build runs this with LeakSanitizer.
  */
 #include "check.h"
 #include "getme.h"
 #include "gen_mesh.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -24,12 +26,24 @@ static int32_t *dup_ints(const int32_t *c, size_t n)
     return d;
 }
 
+/* A malloc'd copy of n doubles of x. */
+static double *dup_doubles(const double *x, size_t n)
+{
+    double *d = malloc((n ? n : 1) * sizeof *d);
+    if (d && n)
+        memcpy(d, x, n * sizeof *d);
+    return d;
+}
+
 /* g's mesh as gen_mesh.h's distorted() builds it, with take instead of
-   add; its elements checked against g's. */
+   create and add; its elements checked against g's. */
 static getme_mesh *taken(const gen *g)
 {
     getme_mesh *m = NULL;
-    CHECK(getme_mesh_create(&m, g->dim, g->nn, g->xyz) == GETME_OK);
+    double *x = dup_doubles(g->xyz, (size_t)g->nn * 3);
+    CHECK(getme_mesh_create_take(&m, g->dim, g->nn, x) == GETME_OK);
+    /* kept, not copied */
+    CHECK(getme_mesh_coords(m) == x);
     for (int t = 0; t < GETME_NUM_TYPES; t++) {
         if (!g->count[t])
             continue;
@@ -107,6 +121,41 @@ int main(void)
           !memcmp(nodes, good + 4, 4 * sizeof *nodes));
     CHECK(getme_mesh_take_elements(NULL, GETME_TET, 1, dup_ints(good, 4), NULL) ==
           GETME_ERR_ARGUMENT);
+    getme_mesh_free(m);
+
+    /* getme_mesh_create_take's failures free the coordinates too, and
+       leave no mesh */
+    double bad[5 * 3];
+    memcpy(bad, xyz, sizeof bad);
+    bad[7] = NAN;
+    getme_mesh *other = NULL;
+    CHECK(getme_mesh_create(&other, 3, 5, xyz) == GETME_OK);
+    m = other; /* a failed call sets it to NULL */
+    CHECK(getme_mesh_create_take(&m, 3, 5, dup_doubles(bad, 15)) ==
+          GETME_ERR_ARGUMENT);
+    CHECK(m == NULL);
+    getme_mesh_free(other);
+    bad[7] = INFINITY;
+    CHECK(getme_mesh_create_take(&m, 3, 5, dup_doubles(bad, 15)) ==
+          GETME_ERR_ARGUMENT);
+    CHECK(getme_mesh_create_take(&m, 4, 5, dup_doubles(xyz, 15)) ==
+          GETME_ERR_ARGUMENT);
+    CHECK(getme_mesh_create_take(&m, 3, -1, dup_doubles(xyz, 15)) ==
+          GETME_ERR_ARGUMENT);
+    CHECK(getme_mesh_create_take(NULL, 3, 5, dup_doubles(xyz, 15)) ==
+          GETME_ERR_ARGUMENT);
+    CHECK(getme_mesh_create_take(&m, 3, 5, NULL) == GETME_ERR_ARGUMENT);
+    CHECK(m == NULL);
+    /* no nodes: the array is freed, the mesh has its own (empty) one */
+    CHECK(getme_mesh_create_take(&m, 3, 0, dup_doubles(xyz, 3)) == GETME_OK);
+    CHECK(m != NULL && getme_mesh_num_nodes(m) == 0);
+    getme_mesh_free(m);
+    /* a taken mesh's coordinates are the caller's values */
+    double *x = dup_doubles(xyz, 15);
+    CHECK(getme_mesh_create_take(&m, 3, 5, x) == GETME_OK);
+    double back[15];
+    CHECK(getme_mesh_get_coords(m, back) == GETME_OK);
+    CHECK(!memcmp(back, xyz, sizeof back));
     getme_mesh_free(m);
     return check_summary("core_take");
 }
