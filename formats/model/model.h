@@ -112,6 +112,12 @@ typedef struct getme__model_in {
     int dim;                       /* 3, or 2 (planar surfaces)            */
     size_t num_nodes;              /* the caller's nodes, any order:       */
     const double *xyz;             /* 3 per node                           */
+    double *xyz_give;              /* NULL, or xyz itself (malloc'd) if the
+                                      caller gives it up: when the numbering
+                                      keeps every node in place, step 1
+                                      makes it out->xyz instead of a copy
+                                      and sets this to NULL (the caller then
+                                      must not free it)                    */
     uint8_t *flags;                /* GETME__NODE_* per node               */
     const getme__node_range *ranges; /* Gmsh's node order over them        */
     size_t num_ranges;

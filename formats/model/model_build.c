@@ -69,6 +69,22 @@ static getme_status check_blocks(const getme__model_in *in,
     return GETME_OK;
 }
 
+/* Does the numbering below keep every caller's node in place (mesh node
+   k = caller's node k)?  When all n nodes are used and the ranges are
+   [0, num_nodes) in order: a Gmsh volume mesh's file, typically. */
+static int in_place(const getme__model_in *in, int32_t n)
+{
+    if ((size_t)n != in->num_nodes)
+        return 0;
+    size_t at = 0;
+    for (size_t r = 0; r < in->num_ranges; r++) {
+        if (in->ranges[r].first != at)
+            return 0;
+        at += in->ranges[r].count;
+    }
+    return at == in->num_nodes;
+}
+
 getme_status getme__model_number(getme__model_in *in, getme__model_out *out)
 {
     memset(out, 0, sizeof *out);
@@ -86,7 +102,12 @@ getme_status getme__model_number(getme__model_in *in, getme__model_out *out)
     out->num_nodes = n;
     out->loc =
         getme__malloc((in->num_nodes ? in->num_nodes : 1) * sizeof *out->loc);
-    out->xyz = getme__malloc((n ? (size_t)n : 1) * 3 * sizeof *out->xyz);
+    if (in->xyz_give && in_place(in, n)) { /* no copy */
+        out->xyz = in->xyz_give;
+        in->xyz_give = NULL;
+    } else {
+        out->xyz = getme__malloc((n ? (size_t)n : 1) * 3 * sizeof *out->xyz);
+    }
     out->fixed = getme__malloc(n ? (size_t)n : 1);
     if (!out->loc || !out->xyz || !out->fixed)
         return oom(out);
@@ -99,8 +120,9 @@ getme_status getme__model_number(getme__model_in *in, getme__model_out *out)
             uint8_t f = in->flags[i];
             if (!(f & GETME__NODE_USED))
                 continue;
-            memcpy(out->xyz + 3 * (size_t)k, in->xyz + 3 * i,
-                   3 * sizeof *out->xyz);
+            if (out->xyz != in->xyz) /* else k == i: in place */
+                memcpy(out->xyz + 3 * (size_t)k, in->xyz + 3 * i,
+                       3 * sizeof *out->xyz);
             out->fixed[k] = !(f & GETME__NODE_OWN) || (f & GETME__NODE_FIXGRP);
             out->loc[i] = k++;
         }

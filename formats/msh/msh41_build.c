@@ -239,6 +239,7 @@ static getme_formats_status make_input(msh41_reader *r, getme__model_in *in,
         .dim = r->top_dim,
         .num_nodes = r->nnodes,
         .xyz = r->xyz,
+        .xyz_give = r->xyz,
         .flags = r->flag,
         .ranges = *ranges,
         .num_ranges = r->nnb,
@@ -308,6 +309,8 @@ getme_formats_status msh41_build(msh41_reader *r, msh41_doc *m)
     getme_status gs = GETME_OK;
     if (st == GETME_FORMATS_OK) {
         gs = getme__model_number(&in, &out);
+        if (!in.xyz_give) /* out's now (freed with it on failure) */
+            r->xyz = NULL;
         if (gs != GETME_OK)
             st = model_fail(r, gs, out.msg);
     }
