@@ -230,8 +230,9 @@ static getme_status add_run(getme__model_in *in, getme__model_out *out,
         if (conn != b->conn)
             memcpy(conn + at, bi->conn, block_len(bi) * sizeof *conn);
         at += block_len(bi);
-        memcpy(out->elem_ids + *first, bi->ids,
-               (size_t)bi->count * sizeof *out->elem_ids);
+        if (bi->ids) /* else add_blocks took them: in place already */
+            memcpy(out->elem_ids + *first, bi->ids,
+                   (size_t)bi->count * sizeof *out->elem_ids);
         *first += bi->count;
     }
     for (size_t i = 0; st == GETME_OK && i < count; i++)
@@ -266,9 +267,17 @@ static getme_status add_blocks(getme__model_in *in, getme__model_out *out)
 {
     int32_t *region = getme__malloc((in->num_entities ? in->num_entities : 1) *
                                     sizeof *region);
-    out->elem_ids =
-        getme__malloc((out->num_elements ? (size_t)out->num_elements : 1) *
-                      sizeof *out->elem_ids);
+    /* One block of every element (a Gmsh volume mesh's file): its ids
+       are the mesh's, taken instead of copied (8 B per element). */
+    if (in->num_blocks == 1 && in->blocks[0].ids &&
+        (size_t)in->blocks[0].count == (size_t)out->num_elements) {
+        out->elem_ids = in->blocks[0].ids;
+        in->blocks[0].ids = NULL;
+    } else {
+        out->elem_ids = getme__malloc(
+            (out->num_elements ? (size_t)out->num_elements : 1) *
+            sizeof *out->elem_ids);
+    }
     getme_status st = region && out->elem_ids ? GETME_OK : oom(out);
     if (st == GETME_OK)
         entity_regions(in, region);
