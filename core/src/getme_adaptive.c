@@ -1689,7 +1689,14 @@ static void free_adaptive(getme_run *run)
     free(run->qold);
     free(run->facc);
     free(run->slot);
-    free(run->xold);
+    /* The old coordinates' array (3 per node) becomes the workspace's
+       spare, which the coordinates go back to the mesh in
+       (getme__ws_return_x): its pages are faulted in, a fresh block's
+       would be (16 MiB on the full tets, 61 MiB on the full hexes). */
+    if (run->xold && run->ws->x_lent && !run->ws->x_spare)
+        run->ws->x_spare = run->xold;
+    else
+        free(run->xold);
     run->facc = NULL;
     run->slot = NULL;
     run->xold = NULL;

@@ -31,6 +31,7 @@ void getme__ws_free(getme_ws *ws)
     if (ws->maps_packed != 2) /* else inside elem_orig's block */
         free(ws->node_orig);
     free(ws->x);
+    free(ws->x_spare);
     free(ws->fixed);
     free(ws->free_elem);
     free(ws->star_ptr);
@@ -674,11 +675,13 @@ static void permute_rows_in_place(void *rows, size_t size, int32_t *dest,
    are independent, where the in-place cycles are one chain of misses
    (4M tets' connectivity: 0.6 -> 0.05 s).  Callers free the run's arrays
    first, so the copy stays below the smoothing's peak; without memory it
-   permutes in place (the same result). */
+   permutes in place (the same result).  into: NULL, or a malloc'd block
+   of n rows to permute into (it is then the result). */
 static void *permute_rows(void *rows, size_t size, int32_t *dest, int32_t n,
-                          int nt)
+                          int nt, void *into)
 {
-    unsigned char *out = getme__malloc((size_t)(n ? n : 1) * size);
+    unsigned char *out =
+        into ? into : getme__malloc((size_t)(n ? n : 1) * size);
     if (!out) {
         permute_rows_in_place(rows, size, dest, n);
         return rows;
@@ -707,7 +710,7 @@ void getme__ws_return_conn(getme_ws *ws, getme_mesh *mesh)
     for (int64_t k = 0; k < len; k++)
         c[k] = ws->node_orig[c[k]];
     bl->conn = permute_rows(c, (size_t)nv * sizeof *c, ws->elem_orig, ws->ne,
-                            ws->nt);
+                            ws->nt, NULL);
     ws->conn = NULL;
     ws->conn_lent = 0;
 }
@@ -768,8 +771,11 @@ void getme__ws_return_x(getme_ws *ws, getme_mesh *mesh)
 #pragma omp parallel for schedule(static) num_threads(ws->nt)
         for (int32_t i = 0; i < ws->nn; i++)
             ws->x[3 * (int64_t)i + 1] = -ws->x[3 * (int64_t)i + 1];
+    /* into a run's spare array if it left one (its pages are in) */
+    double *into = ws->x_spare;
+    ws->x_spare = NULL;
     mesh->coords = permute_rows(ws->x, 3 * sizeof *ws->x, ws->node_orig,
-                                ws->nn, ws->nt);
+                                ws->nn, ws->nt, into);
     ws->x = NULL;
     ws->x_lent = 0;
 }

@@ -72,6 +72,9 @@ typedef struct getme_ws {
                              (getme__ws_lend_conn)                          */
     int x_lent;           /* the mesh lent its coordinates (getme__ws_lend_x)
                                                                             */
+    double *x_spare;      /* NULL, or 3 * nn doubles (malloc'd) that a run
+                             no longer needs: getme__ws_return_x puts the
+                             coordinates there instead of in fresh pages  */
     /* elem_orig and node_orig while packed (getme__ws_pack_map), both then
        NULL; maps_packed: 0 never, 1 packed, 2 unpacked into ws->star's
        block (node_orig then points inside it, after elem_orig)            */
