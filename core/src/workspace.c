@@ -152,6 +152,16 @@ static int radix_sort(uint32_t *key, int32_t *idx, int32_t n, int nt,
     return 0;
 }
 
+/* Entries in ws->conn and in ws->star: one per element corner (ws->coff
+   set). */
+static int64_t star_total(const getme_ws *ws)
+{
+    return ws->coff[GETME_NUM_TYPES - 1] +
+           (int64_t)(ws->tstart[GETME_NUM_TYPES] -
+                     ws->tstart[GETME_NUM_TYPES - 1]) *
+               getme__nv[GETME_NUM_TYPES - 1];
+}
+
 /* The workspace's connectivity array (corners only, types in order),
    unfilled; ws->coff set.  GETME_OK or GETME_ERR_NOMEM. */
 static getme_status alloc_conn(getme_ws *ws)
@@ -330,17 +340,12 @@ static getme_status first_touch_parallel(const getme_ws *ws, int32_t *c,
 static getme_status number_nodes(getme_ws *ws, const getme_mesh *mesh,
                                  int renumber)
 {
-    int64_t total = ws->coff[GETME_NUM_TYPES - 1] +
-                    (int64_t)(ws->tstart[GETME_NUM_TYPES] -
-                              ws->tstart[GETME_NUM_TYPES - 1]) *
-                        getme__nv[GETME_NUM_TYPES - 1];
+    int64_t total = star_total(ws);
     /* ws->conn: order_elements' (its scratch until now) */
     int32_t *newid =
         getme__malloc((size_t)(ws->nn ? ws->nn : 1) * sizeof *newid);
-    if (!ws->conn || !newid) {
-        free(newid);
+    if (!newid)
         return GETME_ERR_NOMEM;
-    }
 #pragma omp parallel for schedule(static) num_threads(ws->nt)
     for (int32_t i = 0; i < ws->nn; i++)
         newid[i] = renumber ? -1 : i;
@@ -408,10 +413,7 @@ static getme_status number_nodes(getme_ws *ws, const getme_mesh *mesh,
 static getme_status build_stars(getme_ws *ws)
 {
     ws->star_ptr = getme__calloc((size_t)ws->nn + 1, sizeof *ws->star_ptr);
-    int64_t total = ws->coff[GETME_NUM_TYPES - 1] +
-                    (int64_t)(ws->tstart[GETME_NUM_TYPES] -
-                              ws->tstart[GETME_NUM_TYPES - 1]) *
-                        getme__nv[GETME_NUM_TYPES - 1];
+    int64_t total = star_total(ws);
     if (total > INT32_MAX)
         return GETME_ERR_NOMEM; /* star_ptr is 32-bit (workspace.h) */
     ws->star = getme__malloc((size_t)(total ? total : 1) * sizeof *ws->star);
@@ -713,15 +715,6 @@ void getme__ws_return_conn(getme_ws *ws, getme_mesh *mesh)
                             ws->nt, NULL);
     ws->conn = NULL;
     ws->conn_lent = 0;
-}
-
-/* Entries in ws->star. */
-static int64_t star_total(const getme_ws *ws)
-{
-    return ws->coff[GETME_NUM_TYPES - 1] +
-           (int64_t)(ws->tstart[GETME_NUM_TYPES] -
-                     ws->tstart[GETME_NUM_TYPES - 1]) *
-               getme__nv[GETME_NUM_TYPES - 1];
 }
 
 void getme__ws_pack_map(getme_ws *ws)
