@@ -148,8 +148,7 @@ def main(argv):
         print(__doc__.split("\n\n")[1], file=sys.stderr)
         return 2
     root = argv[1]
-    if os.path.exists(os.path.join(root, ".git")) and \
-            os.path.isdir(os.path.join(root, ".git")):
+    if os.path.isdir(os.path.join(root, ".git")):  # a worktree's is a file
         print("refusing to instrument a main checkout (use a git worktree)",
               file=sys.stderr)
         return 2
