@@ -16,6 +16,7 @@
 #include "getme_alloc.h"
 #include "model.h"
 
+#include <omp.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stddef.h>
@@ -134,15 +135,37 @@ static getme_formats_status undefined_node(builder *b, size_t k, int32_t e,
                           b->d->elem_id[e], b->d->eblocks[k].type, node);
 }
 
-/* Raw node ids in conn -> node indices, in place. */
-static getme_formats_status resolve_conn(builder *b)
+/* Raw node ids in conn -> node indices, in place.  A block of one
+   element type (nv nodes each) is looked up in parallel: each entry is
+   written only by its own iteration, and a missing node is the first in
+   conn order (a minimum over the threads), so the message is the one a
+   serial pass gives, for any thread count.  On 4M tets the serial
+   lookups were ~0.2 s of the read. */
+static getme_formats_status resolve_conn(builder *b, int threads)
 {
     inp_deck *d = b->d;
     for (size_t k = 0; k < d->neblocks; k++) {
         const inp_elem_block *eb = &d->eblocks[k];
         int64_t p = eb->conn_beg;
+        if (eb->nv) {
+            int64_t n = (int64_t)eb->count * eb->nv, bad = n;
+            int32_t *conn = d->conn + p;
+#pragma omp parallel for schedule(static) num_threads(threads) \
+    reduction(min : bad) if (threads > 1 && n >= 65536)
+            for (int64_t i = 0; i < n; i++) {
+                int32_t idx = inp_ids_get(&b->nodes, eb->scope, conn[i]);
+                if (idx < 0)
+                    bad = i < bad ? i : bad; /* conn[i] stays the id */
+                else
+                    conn[i] = idx;
+            }
+            if (bad < n)
+                return undefined_node(b, k, eb->first + (int32_t)(bad / eb->nv),
+                                      conn[bad]);
+            continue;
+        }
         for (int32_t e = eb->first; e < eb->first + eb->count; e++) {
-            int32_t n = eb->nv ? eb->nv : d->conn[p++];
+            int32_t n = d->conn[p++];
             for (int32_t j = 0; j < n; j++, p++) {
                 int32_t idx = inp_ids_get(&b->nodes, eb->scope, d->conn[p]);
                 if (idx < 0)
@@ -765,7 +788,10 @@ static getme_formats_status build_mesh(builder *b, const getme_doc_options *opts
 {
     inp_deck *d = b->d;
     getme_formats_status st;
-    if ((st = choose_kind(b)) || (st = build_maps(b)) || (st = resolve_conn(b)))
+    int threads = opts->num_threads > 0 ? opts->num_threads
+                                        : omp_get_max_threads();
+    if ((st = choose_kind(b)) || (st = build_maps(b)) ||
+        (st = resolve_conn(b, threads)))
         return st;
     if (b->smooth == INP_KIND_PLANAR && (st = check_plane(b)))
         return st;

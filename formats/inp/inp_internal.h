@@ -70,6 +70,12 @@ void inp_lines_close(inp_lines *r);
    path (inp_fast.c), which consumes whole lines with inp_lines_consume. */
 const char *inp_lines_window(inp_lines *r, size_t want, size_t *avail);
 void inp_lines_consume(inp_lines *r, size_t bytes, size_t lines);
+/* For the writer: the bytes from the next line's start up to byte offset
+   to of the file, copied to out as they are (no line is split; the line
+   count follows).  to = INT64_MAX: to the end of the file.  0; 1 if the
+   file ends before to, or to is not at a line's start (the file is not
+   the one read); -1 on a read or write error. */
+int inp_lines_copy(inp_lines *r, int64_t to, FILE *out);
 
 enum { INP_LINE_BLANK, INP_LINE_COMMENT, INP_LINE_KEYWORD, INP_LINE_DATA };
 int inp_line_kind(const char *text, size_t len);

@@ -234,27 +234,38 @@ int inp_format_real(double v, char *buf)
 
 const char *inp_lines_window(inp_lines *r, size_t want, size_t *avail)
 {
-    /* Refill when less than want is left, or less than 1/16 of the
+    /* Refill when less than want is left and less than 1/16 of the
        buffer: a refill moves what is left to the front, at most a 16th of
-       what it then reads. */
+       what it then reads.  A buffer smaller than want grows at once,
+       however much is left in it: the line reader (inp_lines_next, which
+       runs after every stop of the fast path) refills only up to the
+       buffer's size, so waiting for the rest to run low kept every window
+       just under the first buffer's 256 KiB, below linepar's threshold
+       for splitting a run across threads: the INP fast path ran on one
+       thread.  Growing moves at most that first buffer, once per
+       doubling of want. */
     size_t low = want < r->cap / 16 ? want : r->cap / 16;
-    if (r->end - r->beg < low && !r->eof) {
+    int grow = want > r->cap;
+    if ((r->end - r->beg < low || grow) && !r->eof) {
         if (r->beg > 0) {
             memmove(r->buf, r->buf + r->beg, r->end - r->beg);
             r->end -= r->beg;
             r->beg = 0;
         }
-        if (want > r->cap) {
+        if (grow) {
             char *b = getme__realloc(r->buf, want + 1);
-            if (b) {
+            if (b) { /* else the window stays the buffer's size */
                 r->buf = b;
                 r->cap = want;
             }
         }
-        size_t got = fread(r->buf + r->end, 1, r->cap - r->end, r->fp);
-        if (got == 0 && !ferror(r->fp))
-            r->eof = 1; /* a read error shows at the next inp_lines_next */
-        r->end += got;
+        /* a full buffer reads nothing: that is not the end of the file */
+        if (r->end < r->cap) {
+            size_t got = fread(r->buf + r->end, 1, r->cap - r->end, r->fp);
+            if (got == 0 && !ferror(r->fp))
+                r->eof = 1; /* a read error shows at the next inp_lines_next */
+            r->end += got;
+        }
     }
     size_t n = r->end - r->beg;
     *avail = n < want ? n : want;
@@ -267,4 +278,37 @@ void inp_lines_consume(inp_lines *r, size_t bytes, size_t lines)
     r->next_offset += (int64_t)bytes;
     r->offset = r->next_offset;
     r->lineno += (uint32_t)lines;
+}
+
+int inp_lines_copy(inp_lines *r, int64_t to, FILE *out)
+{
+    int at_start = 1; /* the last byte copied ends a line */
+    if (to < r->next_offset)
+        return 1;
+    while (r->next_offset < to) {
+        if (r->beg == r->end) {
+            if (r->eof)
+                return to == INT64_MAX ? 0 : 1;
+            if (refill(r))
+                return -1;
+            continue;
+        }
+        size_t n = r->end - r->beg;
+        if ((int64_t)n > to - r->next_offset)
+            n = (size_t)(to - r->next_offset);
+        const char *p = r->buf + r->beg, *end = p + n;
+        if (fwrite(p, 1, n, out) != n)
+            return -1;
+        uint32_t lines = 0;
+        while ((p = memchr(p, '\n', (size_t)(end - p))) != NULL) {
+            p++;
+            lines++;
+        }
+        at_start = end[-1] == '\n';
+        r->beg += n;
+        r->next_offset += (int64_t)n;
+        r->lineno += lines;
+    }
+    r->offset = r->next_offset;
+    return at_start ? 0 : 1;
 }

@@ -271,9 +271,25 @@ static getme_formats_status write_file(writer *w, int file)
     static const size_t outbuf = 1 << 20;
     setvbuf(out, NULL, _IOFBF, outbuf);
     cursor c = {next_nblock(st, 0, file), next_inc(st, 0, file), 0, 0};
-    int rc = 0, r;
-    while (rc == 0 && (r = inp_lines_next(&in)) == 1)
+    int rc = 0, r = 1;
+    while (rc == 0) {
+        /* Outside node blocks, up to the next node block or *INCLUDE
+           line, the file is copied as it is, in the reader's buffers
+           (line by line, the copy of the element lines and sets was most
+           of the writing: 0.77 s for 4M tets). */
+        if (c.remain == 0) {
+            int64_t to = INT64_MAX;
+            if (c.nb < st->nnblocks)
+                to = st->nblocks[c.nb].offset;
+            if (c.inc < st->nincs && st->incs[c.inc].offset < to)
+                to = st->incs[c.inc].offset;
+            if ((rc = inp_lines_copy(&in, to, out)) != 0 || to == INT64_MAX)
+                break;
+        }
+        if ((r = inp_lines_next(&in)) != 1)
+            break;
         rc = copy_line(w, out, &in, file, &c);
+    }
     if (rc == 0 && (r < 0 || c.remain > 0 || c.nb < st->nnblocks))
         rc = 1;
     int werr = rc < 0 || ferror(out);

@@ -12,7 +12,8 @@
  *    and so the pieces the threads get, move around);
  *  - damage: one or two bad records at random lines give one error, the
  *    same text for every thread count, naming the file and the first bad
- *    line in file order.
+ *    line in file order (INP: bad numbers, and elements naming nodes that
+ *    are not in *NODE, which the build looks up in parallel).
  */
 #define _POSIX_C_SOURCE 200809L
 #include "check.h"
@@ -39,6 +40,9 @@ typedef struct out {
     int nbad;
     long damage_at[2]; /* record numbers to damage                       */
     uint32_t one_in;   /* RESHAPE: one line in this many                  */
+    int undefined;     /* DAMAGE of INP elements: a node id not in *NODE
+                          (read, then refused by the build) instead of 0
+                          (refused by the line reader)                    */
 } out;
 
 static void put_line(out *o, const char *s)
@@ -184,8 +188,10 @@ static void write_inp(const char *path, out *o)
     put_line(o, "*ELEMENT, TYPE=C3D4, ELSET=Block");
     for (int e = 0; e < NE; e++, rec++) {
         element_tokens(e, tbuf, tok);
+        char undef[40];
+        snprintf(undef, sizeof undef, "%d", NN + 1 + e % 1000);
         if (damaged(o, rec))
-            tok[2] = "0";
+            tok[2] = o->undefined ? undef : "0";
         put_record(o, tok, 5, 0, 1, 0);
     }
     put_line(o, "*SOLID SECTION, ELSET=Block, MATERIAL=Steel\n,");
@@ -239,6 +245,9 @@ static void run_format(int msh)
     for (int seed = 1; seed <= 6; seed++) {
         rng_state = 2000 + (uint64_t)seed + 100 * (uint64_t)msh;
         o.mode = DAMAGE;
+        /* INP, seeds 4-6: elements name missing nodes, which the build
+           finds (in parallel: the first one in file order is named) */
+        o.undefined = !msh && seed > 3;
         o.damage_at[0] = (long)(rnd() % (uint32_t)nrec);
         o.damage_at[1] = seed % 2 ? (long)(rnd() % (uint32_t)nrec) : -1;
         (msh ? write_msh : write_inp)(name, &o);
