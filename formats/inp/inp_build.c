@@ -31,6 +31,7 @@ typedef struct builder {
     int32_t *sfirst;       /* per element block: first smoothed index      */
     int32_t nsmooth;
     uint8_t *fixed;
+    int threads;           /* the options' thread count, resolved          */
     uint32_t *stamp[2];    /* per set: traversal that visited it, per depth */
     uint32_t now[2];
     int32_t *stack[2];
@@ -775,6 +776,7 @@ static getme_formats_status keep_for_writer(builder *b)
     st->nnblocks = d->nnblocks;
     st->node_id = d->node_id;
     st->nnodes = d->nnodes;
+    st->threads = b->threads;
     d->files = NULL;
     d->nfiles = 0;
     d->incs = NULL;
@@ -788,10 +790,10 @@ static getme_formats_status build_mesh(builder *b, const getme_doc_options *opts
 {
     inp_deck *d = b->d;
     getme_formats_status st;
-    int threads = opts->num_threads > 0 ? opts->num_threads
-                                        : omp_get_max_threads();
+    b->threads = opts->num_threads > 0 ? opts->num_threads
+                                       : omp_get_max_threads();
     if ((st = choose_kind(b)) || (st = build_maps(b)) ||
-        (st = resolve_conn(b, threads)))
+        (st = resolve_conn(b, b->threads)))
         return st;
     if (b->smooth == INP_KIND_PLANAR && (st = check_plane(b)))
         return st;

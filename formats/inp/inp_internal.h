@@ -336,6 +336,7 @@ typedef struct inp_doc {
     size_t nnblocks;
     int32_t *node_id;         /* per node, to check the file did not change */
     int32_t nnodes;
+    int threads;              /* the writer's node lines (the reader's)      */
 } inp_doc;
 
 getme_formats_status inp_build(inp_deck *deck, getme_doc *doc,
@@ -348,5 +349,36 @@ void inp_doc_free(inp_doc *st);
    field limit (else the most digits that fit).  Returns the length written
    to buf (size >= 32). */
 int inp_format_real(double v, char *buf);
+
+/* ---- the writer's node lines (inp_write_nodes.c) ------------------------- */
+
+/* Bytes a node line may grow by: three coordinates of up to 31 characters
+   replaced or appended with ", " (and inp_format_real's NUL, overwritten
+   by what follows it). */
+#define INP_NODE_GROW 128
+
+typedef struct inp_node_out {
+    const int32_t *node_id; /* per node: its number in the deck          */
+    const double *xyz;      /* the smoothed coordinates                   */
+    double keep_tol;        /* moves up to this keep the line's text      */
+    int threads;
+    char *buf;              /* a run's output (grown as needed, owned)    */
+    size_t cap;
+} inp_node_out;
+
+/* Node node's data line text[0..len) (no terminator) as it is written,
+   into dst (room for len + INP_NODE_GROW bytes): its length, or -1 if the
+   line is not that node's (the file changed).  *moved counts the lines
+   whose coordinates change. */
+long inp_node_text(const inp_node_out *o, const char *text, size_t len,
+                   int32_t node, char *dst, int32_t *moved);
+
+/* Inside a node block: the next plain node data lines of in (at most
+   *remain; nodes *node, *node + 1...) rewritten to out, on o->threads
+   threads, the same bytes as one by one; *node and *remain advance.  1 if
+   it took lines, 0 if the next line is for the line-by-line path (not a
+   plain data line of its node, or no memory), -1 on a write error. */
+int inp_node_run(inp_node_out *o, inp_lines *in, int32_t *node,
+                 int32_t *remain, FILE *out, int32_t *moved);
 
 #endif /* GETME_INP_INTERNAL_H */

@@ -2,8 +2,10 @@
  * inp_writer.c -- write the deck back with the smoothed coordinates.
  *
  * Every file (the deck and each *INCLUDE occurrence) is re-read and copied
- * line by line, byte for byte, with its own line endings.  Two kinds of
- * lines change:
+ * byte for byte, with its own line endings: what lies between node blocks
+ * and *INCLUDE lines as it is, a buffer at a time; node lines in runs
+ * rewritten on several threads (inp_write_nodes.c); the rest line by
+ * line.  Two kinds of lines change:
  *  - a *NODE data line whose node moved: the coordinate fields get the new
  *    values, everything else on the line (node number, spacing, extra
  *    fields) stays; a node that did not move, or moved by no more than
@@ -40,7 +42,8 @@ typedef struct writer {
     char (*out)[PATH_BUF]; /* final name per file occurrence        */
     char (*tmp)[PATH_BUF]; /* temporary name per file occurrence    */
     int32_t moved;         /* node lines rewritten                  */
-    double keep_tol;       /* moves up to this keep the line (below) */
+    inp_node_out nodes;    /* coordinates, tolerance, run buffer     */
+    char *line;            /* one node line (INP_MAX_LINE + GROW)    */
 } writer;
 
 static const char *base_name(const char *p)
@@ -110,58 +113,12 @@ static int put(FILE *out, const char *s, size_t n)
     return n && fwrite(s, 1, n, out) != n ? -1 : 0;
 }
 
-static int put_real(FILE *out, double v)
-{
-    char buf[32];
-    int n = inp_format_real(v, buf);
-    return put(out, buf, (size_t)n);
-}
-
 /* 1: the line is not node `id` (the file changed); -1: write error. */
 static int node_line(writer *w, FILE *out, const inp_lines *in, int32_t node)
 {
-    const char *p = in->text, *end = in->text + in->len;
-    inp_field f[4];
-    int last = 0, nf = 0;
-    while (nf < 4 && !last && inp_next_field(&p, end, &f[nf], &last))
-        nf++;
-    int64_t id;
-    if (nf < 1 || inp_parse_int(&f[0], &id) || id != w->st->node_id[node])
-        return 1;
-    const double *x = w->xyz + 3 * (size_t)node;
-    double old[3] = {0, 0, 0};
-    int moved = 0, ncoord = nf - 1;
-    for (int k = 0; k < 3; k++) {
-        if (k < ncoord && inp_parse_real(&f[k + 1], &old[k]))
-            return 1;
-        moved |= !(fabs(x[k] - old[k]) <= w->keep_tol);
-    }
-    /* A node that moved by no more than keep_tol in every coordinate keeps
-       its line, so it is back exactly where the deck had it. */
-    if (!moved)
-        return put(out, in->text, in->len);
-    w->moved++;
-    /* Replace the number of each changed coordinate field in place; a
-       coordinate that kept its value keeps its text. */
-    const char *cur = in->text;
-    for (int k = 0; k < ncoord; k++) {
-        if (fabs(x[k] - old[k]) <= w->keep_tol)
-            continue; /* this coordinate keeps its text */
-        if (put(out, cur, (size_t)(f[k + 1].s - cur)) || put_real(out, x[k]))
-            return -1;
-        cur = f[k + 1].s + f[k + 1].n;
-    }
-    /* Coordinates the line left out (0 in Abaqus) that are not 0 now. */
-    int need = ncoord;
-    for (int k = ncoord; k < 3; k++)
-        if (!(fabs(x[k]) <= w->keep_tol))
-            need = k + 1;
-    if (need > ncoord && put(out, cur, (size_t)(end - cur)))
-        return -1;
-    for (int k = ncoord; k < need; k++)
-        if (put(out, ", ", 2) || put_real(out, x[k]))
-            return -1;
-    return need > ncoord ? 0 : put(out, cur, (size_t)(end - cur));
+    long n = inp_node_text(&w->nodes, in->text, in->len, node, w->line,
+                           &w->moved);
+    return n < 0 ? 1 : put(out, w->line, (size_t)n);
 }
 
 /* ---- one file --------------------------------------------------------------- */
@@ -286,6 +243,13 @@ static getme_formats_status write_file(writer *w, int file)
             if ((rc = inp_lines_copy(&in, to, out)) != 0 || to == INT64_MAX)
                 break;
         }
+        /* inside a node block: its plain data lines a run at a time */
+        if (c.remain > 0 &&
+            (rc = inp_node_run(&w->nodes, &in, &c.node, &c.remain, out,
+                               &w->moved)) != 0) {
+            rc = rc < 0 ? -1 : 0;
+            continue;
+        }
         if ((r = inp_lines_next(&in)) != 1)
             break;
         rc = copy_line(w, out, &in, file, &c);
@@ -377,14 +341,20 @@ getme_formats_status inp_write(getme_doc *doc, const inp_doc *st,
     w.st = st;
     w.xyz = getme_mesh_coords(doc->mesh);
     w.dim = getme_mesh_dim(doc->mesh);
-    w.keep_tol = keep_tolerance(w.xyz, st->nnodes);
+    w.nodes.node_id = st->node_id;
+    w.nodes.xyz = w.xyz;
+    w.nodes.keep_tol = keep_tolerance(w.xyz, st->nnodes);
+    w.nodes.threads = st->threads > 0 ? st->threads : 1;
     w.out = getme__malloc(st->nfiles * sizeof *w.out);
     w.tmp = getme__malloc(st->nfiles * sizeof *w.tmp);
-    getme_formats_status s = w.out && w.tmp
+    w.line = getme__malloc(INP_MAX_LINE + INP_NODE_GROW + 1);
+    getme_formats_status s = w.out && w.tmp && w.line
                             ? write_all(&w, out_path)
                             : getme_doc_fail(doc, GETME_FORMATS_ERR_INTERNAL,
                                              "out of memory");
     free(w.out);
     free(w.tmp);
+    free(w.line);
+    free(w.nodes.buf);
     return s;
 }

@@ -10,6 +10,11 @@
  *    plain file, for 1, 2, 3 and 7 threads, with one line in 8, 500 or
  *    20000 reshaped (so the places where the fast path stops and resumes,
  *    and so the pieces the threads get, move around);
+ *  - writing (INP): decks plain and reshaped, every other node moved,
+ *    written with 1, 2, 3 and 7 threads (the node lines are rewritten in
+ *    pieces on several threads): the same bytes, the moved coordinates
+ *    read back (to Abaqus' 20 characters), every other line kept byte for
+ *    byte;
  *  - damage: one or two bad records at random lines give one error, the
  *    same text for every thread count, naming the file and the first bad
  *    line in file order (INP: bad numbers, and elements naming nodes that
@@ -22,6 +27,7 @@
 #include "kuhn_cube.h"
 #include "getme_formats.h"
 
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -278,6 +284,131 @@ static void run_format(int msh)
     doc_read_free(&plain);
 }
 
+/* ---- writing INP node lines ------------------------------------------- */
+
+static char *slurp(const char *path, long *size)
+{
+    FILE *f = fopen(path, "rb");
+    char *b = NULL;
+    *size = 0;
+    if (f && fseek(f, 0, SEEK_END) == 0 && (*size = ftell(f)) >= 0) {
+        rewind(f);
+        b = malloc((size_t)*size + 1);
+        if (b && fread(b, 1, (size_t)*size, f) != (size_t)*size) {
+            free(b);
+            b = NULL;
+        }
+        if (b)
+            b[*size] = '\0';
+    }
+    if (f)
+        fclose(f);
+    return b;
+}
+
+/* Node i's new position: two in three nodes move (some in one coordinate
+   only, by amounts whose text is long), the others stay. */
+static void moved_xyz(const double *x, int32_t nn, double *y)
+{
+    for (int32_t i = 0; i < nn; i++)
+        for (int k = 0; k < 3; k++)
+            y[3 * i + k] = x[3 * i + k] +
+                           (i % 3 == 0 ? 0.0
+                            : i % 3 == 1 && k != 1 ? 0.0
+                                                   : 1e-3 / (1 + i % 7 + k));
+}
+
+/* The reshaped INP decks written with moved nodes (the writer's node lines
+   run in pieces on several threads): the same bytes for every thread
+   count; read back, exactly the moved coordinates; every line but the
+   moved nodes' the input's, byte for byte. */
+static void write_format(void)
+{
+    const char *name = "fastw.inp";
+    out o;
+    memset(&o, 0, sizeof o);
+    static const uint32_t one_in[] = {0, 8, 500};
+    for (int seed = 0; seed < 3; seed++) {
+        rng_state = 3000 + (uint64_t)seed;
+        o.mode = seed ? RESHAPE : PLAIN;
+        o.one_in = one_in[seed];
+        write_inp(name, &o);
+        long in_size;
+        char *in_text = slurp(name, &in_size);
+        char *first = NULL;
+        long first_size = 0;
+        for (int t = 0; t < NT; t++) {
+            getme_doc_options opt;
+            getme_doc_options_init(&opt);
+            opt.num_threads = THREADS[t];
+            getme_doc *doc = NULL;
+            CHECK(getme_doc_open(&doc, name, &opt) == GETME_FORMATS_OK);
+            getme_mesh *m = doc ? getme_doc_mesh(doc) : NULL;
+            int32_t nn = m ? getme_mesh_num_nodes(m) : 0;
+            CHECK_EQ_INT(nn, NN);
+            double *x = malloc(3 * (size_t)NN * sizeof *x);
+            double *y = malloc(3 * (size_t)NN * sizeof *y);
+            if (m && nn == NN) {
+                getme_mesh_get_coords(m, x);
+                moved_xyz(x, NN, y);
+                CHECK(getme_mesh_set_coords(m, y) == GETME_OK);
+                CHECK(getme_doc_write(doc, "fastw-out.inp") == GETME_FORMATS_OK);
+            }
+            getme_doc_close(doc);
+            long size;
+            char *text = slurp("fastw-out.inp", &size);
+            CHECK(text != NULL);
+            if (t == 0) {
+                first = text;
+                first_size = size;
+                /* read back: the moved coordinates (to the digits that
+                   Abaqus' 20-character fields hold: 0.000333333333333333
+                   for 0.00033333333333333332), the others exactly */
+                doc_read r = doc_read_file("fastw-out.inp", 1);
+                int ok = r.st == GETME_FORMATS_OK && r.nn == NN;
+                for (int i = 0; ok && i < 3 * NN; i++) {
+                    ok = (i / 3) % 3 == 0 ? r.x[i] == y[i]
+                                          : fabs(r.x[i] - y[i]) <=
+                                                1e-15 * (1 + fabs(y[i]));
+                    if (!ok)
+                        fprintf(stderr, "node %d: %.17g read back as %.17g\n",
+                                i / 3 + 1, y[i], r.x[i]);
+                }
+                CHECK(ok);
+                doc_read_free(&r);
+                /* line by line: only moved nodes' lines differ, and keep
+                   their node number */
+                char *a = in_text, *b = text;
+                long differ = 0, bad = 0;
+                while (a && b && *a && *b) {
+                    char *ea = strchr(a, '\n'), *eb = strchr(b, '\n');
+                    if (!ea || !eb)
+                        break;
+                    size_t la = (size_t)(ea - a), lb = (size_t)(eb - b);
+                    if (la != lb || memcmp(a, b, la) != 0) {
+                        differ++;
+                        long ida = strtol(a, NULL, 10), idb = strtol(b, NULL, 10);
+                        bad += ida != idb || ida < 1 || (ida - 1) % 3 == 0;
+                    }
+                    a = ea + 1;
+                    b = eb + 1;
+                }
+                CHECK(a && b && strcmp(a, b) == 0); /* the same last bytes */
+                CHECK_EQ_INT(bad, 0);
+                CHECK_EQ_INT(differ, NN - (NN + 2) / 3);
+            } else {
+                CHECK(text && size == first_size &&
+                      memcmp(text, first, (size_t)size) == 0);
+                free(text);
+            }
+            free(x);
+            free(y);
+        }
+        free(first);
+        free(in_text);
+    }
+}
+
 int main(void)
 {
     /* the files go to a folder of their own, named in the messages */
@@ -289,6 +420,7 @@ int main(void)
     make_mesh(7);
     run_format(1);
     run_format(0);
+    write_format();
     snprintf(cmd, sizeof cmd, "cd .. && rm -rf %s", dir);
     if (system(cmd) != 0)
         return 1;
