@@ -130,6 +130,46 @@ static const char *element_line(void *vc, const char *p, const char *end,
     return p;
 }
 
+/* A set's data line of exactly nv ids (items go to conn0 + i * nv of the
+   pool), a trailing comma allowed. */
+static const char *set_line(void *vc, const char *p, const char *end,
+                            size_t i)
+{
+    fast_ctx *c = vc;
+    int32_t *dst = c->d->items + c->conn0 + (int64_t)i * c->nv;
+    int more = 1;
+    (void)end;
+    for (int k = 0; k < c->nv; k++)
+        if (!more || !(p = fast_id(p, &dst[k], &more)))
+            return NULL;
+    if (more) { /* "..., 10," then nothing but blanks */
+        p = skip_blanks(p);
+        if (*p == '\r')
+            p++;
+        if (*p != '\n')
+            return NULL;
+        p++;
+    }
+    return p;
+}
+
+/* The ids on the line at p if it is a plain set line (set_line's shape),
+   at most 64; else 0. */
+static int set_line_ids(const char *p)
+{
+    int k = 0, more = 1;
+    int32_t v;
+    while (more) {
+        const char *q = skip_blanks(p);
+        if (k > 0 && (*q == '\n' || (q[0] == '\r' && q[1] == '\n')))
+            break; /* a trailing comma */
+        if (k == 64 || !(p = fast_id(p, &v, &more)))
+            return 0;
+        k++;
+    }
+    return k;
+}
+
 #define WANT_MIN ((size_t)4096)
 #define WANT_MAX ((size_t)8 << 20)
 
@@ -171,6 +211,32 @@ size_t inp_fast_run(inp_deck *d, inp_lines *in, int nv, int threads,
         d->nelems += (int32_t)got;
         d->nconn += (int64_t)(got * (size_t)nv);
     }
+    inp_lines_consume(in, bytes, got);
+    if (got < max)
+        *want = WANT_MIN;
+    else if (*want < WANT_MAX)
+        *want *= 2;
+    return got;
+}
+
+size_t inp_fast_set(inp_deck *d, inp_lines *in, int threads, size_t *want)
+{
+    if (*want < WANT_MIN)
+        *want = WANT_MIN;
+    size_t avail;
+    const char *w = inp_lines_window(in, *want, &avail);
+    const char *nl = avail ? memrchr(w, '\n', avail) : NULL;
+    int k = nl ? set_line_ids(w) : 0;
+    if (!k)
+        return 0;
+    size_t len = (size_t)(nl + 1 - w), max = linepar_count(w, nl + 1);
+    if (in->lineno + max >= UINT32_MAX ||
+        (size_t)d->nitems + max * (size_t)k >= INT32_MAX ||
+        INP_RESERVE(d->items, d->cap_items, (size_t)d->nitems + max * (size_t)k))
+        return 0; /* the line reader says why */
+    fast_ctx c = {d, 0, 0, d->nitems, in->lineno + 1, k};
+    size_t bytes, got = linepar_run(w, len, max, threads, set_line, &c, &bytes);
+    d->nitems += (int64_t)(got * (size_t)k);
     inp_lines_consume(in, bytes, got);
     if (got < max)
         *want = WANT_MIN;

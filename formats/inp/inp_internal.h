@@ -295,6 +295,13 @@ int inp_reserve_elems(inp_deck *deck, size_t n);
    the caller between calls. */
 size_t inp_fast_run(inp_deck *deck, inp_lines *in, int nv, int threads,
                     size_t *want);
+/* Inside a *NSET or *ELSET block (not GENERATE): the plain data lines at
+   the reader's position that hold as many ids as the first of them (1 to
+   64 numbers, blanks and a trailing comma allowed) appended to the pool of
+   set items, on threads threads; stops before the first other line (a set
+   name, another count, the block's last, shorter line...).  Returns how
+   many lines were taken. */
+size_t inp_fast_set(inp_deck *deck, inp_lines *in, int threads, size_t *want);
 void inp_deck_free(inp_deck *deck);
 
 /* Where an element / node was read, for messages: "file:line". */

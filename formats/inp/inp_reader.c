@@ -864,7 +864,8 @@ static getme_formats_status line(reader *rd, inp_lines *in)
 }
 
 /* Inside a *NODE block, or an *ELEMENT block of a fixed-size type between
-   elements, once its first line opened the block in this file: the plain
+   elements, once its first line opened the block in this file, or a set's
+   ids once its first line made the set's chunk in this file: the plain
    data lines that follow go through the fast path, which stops at the
    first other line (read by line() as always). */
 static void fast_lines(reader *rd, inp_lines *in)
@@ -883,6 +884,12 @@ static void fast_lines(reader *rd, inp_lines *in)
         d->eblocks[rd->eblock].count += (int32_t)got;
         d->eblocks[rd->eblock].conn_end = d->nconn;
         d->count_kind[rd->kind] += (int32_t)got;
+    } else if ((rd->mode == M_NSET || rd->mode == M_ELSET) && !rd->generate &&
+               rd->chunk >= 0 && d->chunks[rd->chunk].file == rd->file &&
+               d->chunks[rd->chunk].end == d->nitems) {
+        /* a set's ids after its first line (set_item made the chunk) */
+        inp_fast_set(d, in, rd->threads, &rd->fast_want);
+        d->chunks[rd->chunk].end = d->nitems;
     }
     rd->line = in->lineno;
 }

@@ -3,7 +3,8 @@
  * msh41_fast.c, INP inp_fast.c) against the readers' own line and token
  * paths, on meshes large enough for runs to be split across threads
  * (82,944 tets: megabytes of element lines, runs of up to 8 MiB):
- *  - property: a file whose lines are randomly reshaped (blanks, tabs,
+ *  - property (INP also with a *NSET of every third node, fixed by name):
+ *    a file whose lines are randomly reshaped (blanks, tabs,
  *    CRLF, '+' signs, exponents, records split over two lines or joined,
  *    blank and comment lines; each such line is refused by the fast path
  *    and read by the token / line reader) gives exactly the mesh of the
@@ -200,6 +201,27 @@ static void write_inp(const char *path, out *o)
             tok[2] = o->undefined ? undef : "0";
         put_record(o, tok, 5, 0, 1, 0);
     }
+    /* every third node pinned, listed 12 times (a set may repeat ids:
+       over 256 KiB of lines, so runs split across threads), 16 ids a line
+       (every third line with a trailing comma, as Abaqus and Gmsh write
+       them), reshaped as above; the last line shorter */
+    put_line(o, "*NSET, NSET=Pinned");
+    char ib[16][24];
+    const char *it[16];
+    int n = 0;
+    long setline = 0;
+    for (long k = 0; k < 12L * ((NN + 2) / 3); k++) {
+        int i = 1 + 3 * (int)(k % ((NN + 2) / 3));
+        snprintf(ib[n], sizeof ib[n], "%d", i);
+        it[n] = ib[n];
+        n++;
+        if (n == 16 || k + 1 == 12L * ((NN + 2) / 3)) {
+            if (setline++ % 3 == 0)
+                strcat(ib[n - 1], ",");
+            put_record(o, it, n, 0, 1, 0);
+            n = 0;
+        }
+    }
     put_line(o, "*SOLID SECTION, ELSET=Block, MATERIAL=Steel\n,");
     fclose(o->f);
 }
@@ -212,11 +234,12 @@ static const int THREADS[] = {1, 2, 3, 7};
 static void run_format(int msh)
 {
     const char *name = msh ? "fast.msh" : "fast.inp";
+    const char *fix = msh ? NULL : "Pinned"; /* INP: the *NSET's nodes */
     out o;
     memset(&o, 0, sizeof o);
     o.mode = PLAIN;
     (msh ? write_msh : write_inp)(name, &o);
-    doc_read plain = doc_read_file(name, 1);
+    doc_read plain = doc_read_file_fix(name, 1, fix);
     CHECK(plain.st == GETME_FORMATS_OK);
     CHECK_EQ_INT(plain.nn, NN);
     CHECK_EQ_INT(plain.ne, NE);
@@ -225,8 +248,13 @@ static void run_format(int msh)
     for (int i = 0; exact && i < 3 * NN; i++)
         exact = plain.x[i] == xyz[i];
     CHECK(exact);
+    /* INP: the set's nodes are fixed */
+    int pinned = plain.st == GETME_FORMATS_OK && plain.nn == NN;
+    for (int i = 0; !msh && pinned && i < NN; i += 3)
+        pinned = plain.fixed[i] != 0;
+    CHECK(pinned);
     for (int t = 1; t < NT; t++) {
-        doc_read r = doc_read_file(name, THREADS[t]);
+        doc_read r = doc_read_file_fix(name, THREADS[t], fix);
         CHECK(doc_read_same(&plain, &r));
         doc_read_free(&r);
     }
@@ -239,7 +267,7 @@ static void run_format(int msh)
         o.one_in = one_in[seed - 1];
         (msh ? write_msh : write_inp)(name, &o);
         for (int t = 0; t < NT; t++) {
-            doc_read r = doc_read_file(name, THREADS[t]);
+            doc_read r = doc_read_file_fix(name, THREADS[t], fix);
             CHECK(doc_read_same(&plain, &r));
             if (r.st != GETME_FORMATS_OK)
                 fprintf(stderr, "reshaped %s seed %d: %s\n", name, seed,
@@ -269,7 +297,7 @@ static void run_format(int msh)
             snprintf(want, sizeof want, "%s:%ld: ", name, first);
         char first_error[1024] = "";
         for (int t = 0; t < NT; t++) {
-            doc_read r = doc_read_file(name, THREADS[t]);
+            doc_read r = doc_read_file_fix(name, THREADS[t], fix);
             CHECK(r.st != GETME_FORMATS_OK);
             CHECK(strstr(r.error, want) == r.error);
             if (t == 0)
