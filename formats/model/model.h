@@ -129,6 +129,8 @@ typedef struct getme__model_in {
     int z_plane_only;              /* planar: stop (declined = 1) instead of
                                       rotating a mesh outside z = const    */
     unsigned fix_flags;            /* GETME_FIX_SKIN | GETME_FIX_INTERFACES */
+    int regions_by_entity;         /* 1: every entity is its own region
+                                      (MSH 2.2: see entity_regions)        */
     int nodes_distinct;            /* 1: the caller refused, with its own
                                       message, every element that has a node
                                       twice; the builder does not look again */

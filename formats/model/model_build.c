@@ -148,7 +148,15 @@ static int cmp_int(const void *a, const void *b)
 }
 
 /* Region id per entity: the index of the first entity with the same
-   non-empty sorted set of physical tags. */
+   non-empty sorted set of physical tags.  Faces between regions are fixed
+   (GETME_FIX_INTERFACES), in addition to the nodes classified on lower
+   dimensions.  With regions_by_entity every entity is its own region: an
+   MSH 2.2 file has no node classification of its own (a node is put on
+   the lowest entity among its elements), so when only volumes were saved
+   the surfaces between two volumes of one physical group have no
+   elements and their nodes would move, off the CAD's internal faces (an
+   embedded sphere's surface moved by 1.27 in a measured case); MSH 4.1
+   and INP keep them. */
 static void entity_regions(const getme__model_in *in, int32_t *region)
 {
     for (size_t i = 0; i < in->num_entities; i++) {
@@ -156,7 +164,7 @@ static void entity_regions(const getme__model_in *in, int32_t *region)
         if (ni > 1)
             qsort(in->phys[i], ni, sizeof(int), cmp_int);
         region[i] = (int32_t)i;
-        for (size_t j = 0; ni && j < i; j++)
+        for (size_t j = 0; ni && !in->regions_by_entity && j < i; j++)
             if (in->num_phys[j] == ni &&
                 memcmp(in->phys[j], in->phys[i], ni * sizeof(int)) == 0) {
                 region[i] = region[j];

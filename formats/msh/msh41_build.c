@@ -190,6 +190,12 @@ static void describe(msh41_reader *r, size_t num_entities)
              r->top_dim == 3 ? "volume" : "surface",
              num_entities > 1 ? "s" : "", (long)getme_mesh_num_elements(m),
              (long)getme_mesh_num_nodes(m), (long)getme_mesh_num_fixed(m));
+    size_t n = strlen(r->doc->info);
+    if (r->repeated22 > 0 && n < sizeof r->doc->info)
+        snprintf(r->doc->info + n, sizeof r->doc->info - n,
+                 "; %lld elements listed again under another physical group "
+                 "(MSH 2.2) read once",
+                 (long long)r->repeated22);
 }
 
 
@@ -252,6 +258,8 @@ static getme_formats_status make_input(msh41_reader *r, getme__model_in *in,
         /* msh41_store_element refused every kept element with a node
            twice, naming the element and the node */
         .nodes_distinct = 1,
+        /* MSH 2.2: the faces between elementary volumes are interfaces */
+        .regions_by_entity = r->v22,
         .fix_flags = r->partitioned ? 0u /* the caller's, across parts */
                      : (o && !o->fix_skin ? 0u : GETME_FIX_SKIN) |
                        (o && !o->fix_interfaces ? 0u : GETME_FIX_INTERFACES)};

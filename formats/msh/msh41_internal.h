@@ -189,6 +189,8 @@ typedef struct msh41_reader {
     int (*ent22)[3];          /* (dim, elementary, physical) seen         */
     size_t nent22, cap_ent22;
     size_t cap_cur;           /* room in the last element block            */
+    int phys_cur;             /* the physical tag of its elements          */
+    int64_t repeated22;       /* elements dropped as repeats (finish22)    */
     int threads;              /* for the ASCII fast path                   */
     size_t fast_want;         /* its window (msh41_fast.c)                 */
     /* binary: the offset a message names when it is not where the input

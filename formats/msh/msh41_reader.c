@@ -1164,17 +1164,21 @@ static int fix_group22(msh41_reader *r, int dim, int phys)
 }
 
 /* The element block an element of (tag, type) of the top dimension goes
-   to: the last one if it is the same (entity, type), else a new one. */
+   to: the last one if it is the same (entity, type, physical tag), else a
+   new one (a repeat of an entity under another physical group starts its
+   own block: drop_repeats22). */
 static getme_formats_status block22(msh41_reader *r, int dim, int etag, int type,
-                               int nv, msh41_eblock **out)
+                               int phys, int nv, msh41_eblock **out)
 {
     msh41_eblock *b = r->neb ? &r->eb[r->neb - 1] : NULL;
-    if (!b || dim > r->top_dim || b->tag != etag || b->type != type) {
+    if (!b || dim > r->top_dim || b->tag != etag || b->type != type ||
+        r->phys_cur != phys) {
         getme_formats_status st = new_eblock(r, dim, etag, type, 1, nv, &b);
         if (st != GETME_FORMATS_OK)
             return st;
         b->count = 0; /* room for 1, grown below */
         r->cap_cur = 1;
+        r->phys_cur = phys;
     }
     if (b->conn && (size_t)b->count == r->cap_cur) {
         size_t cap = r->cap_cur ? 2 * r->cap_cur : 64;
@@ -1226,7 +1230,7 @@ static getme_formats_status element22(msh41_reader *r, int type, int ntags,
     msh41_eblock *b = NULL;
     getme_formats_status st = GETME_FORMATS_OK;
     if (dim >= 2 && dim >= r->top_dim)
-        st = block22(r, dim, etag, type, nv, &b);
+        st = block22(r, dim, etag, type, phys, nv, &b);
     if (st == GETME_FORMATS_OK)
         st = take_element(r, b, b ? (size_t)b->count : 0, rec, nv,
                           fix_group22(r, dim, phys));
@@ -1440,11 +1444,47 @@ static getme_formats_status nodes22(msh41_reader *r)
     return st;
 }
 
+/* Gmsh's MSH 2.2 writer lists an element once for every physical group
+   that holds it, under a new element tag each time: the elements of an
+   entity in groups "Steel" and "All" are in the file twice.  Kept twice,
+   every face between the copies is a doubled (irregular) face, every node
+   is fixed, and smoothing does nothing, silently (measured on a Gmsh
+   assembly with a group over all volumes).  A block that repeats an
+   earlier block of the same entity and type element for element (the
+   same nodes in the same order) is such a copy: it leaves the mesh (the
+   file keeps it; only coordinates are written), and its physical tag
+   stays the entity's.  Anything short of an exact repeat is kept, as
+   before. */
+static void drop_repeats22(msh41_reader *r)
+{
+    size_t kept = 0;
+    for (size_t b = 0; b < r->neb; b++) {
+        msh41_eblock *e = &r->eb[b];
+        size_t len = (size_t)e->count * (size_t)msh41_type_nodes(e->type, NULL);
+        int rep = 0;
+        for (size_t a = 0; a < kept && !rep && e->conn && e->count; a++) {
+            const msh41_eblock *f = &r->eb[a];
+            rep = f->conn && f->tag == e->tag && f->type == e->type &&
+                  f->count == e->count &&
+                  memcmp(f->conn, e->conn, len * sizeof *e->conn) == 0;
+        }
+        if (rep) {
+            r->repeated22 += e->count;
+            free(e->conn);
+            free(e->ids);
+            continue;
+        }
+        r->eb[kept++] = *e;
+    }
+    r->neb = kept;
+}
+
 /* After the file: entities and node blocks, as MSH 4.1 would have them. */
 static getme_formats_status finish22(msh41_reader *r)
 {
     if (!r->have_nodes || !r->have_elements)
         return GETME_FORMATS_OK; /* msh41_build says there is no mesh */
+    drop_repeats22(r);
     getme_formats_status st = entities22(r);
     return st == GETME_FORMATS_OK ? nodes22(r) : st;
 }

@@ -10,8 +10,11 @@ same elements per element tag (read back with the gmsh Python API), the
 same `getme quality` report, and the same log (fixed counts, qualities).
 The native output must equal the input outside $Nodes (binary: same size),
 and every node that is not free in the mesh must keep its input bytes.
-Then the error cases: exit code, one error line naming the file (and the
-line for ASCII), input untouched, no output, no temporary file left.
+MSH 2.2 against 4.1 on volumes of one physical group (with and without
+a second group over one of them): the same coordinates, the surfaces
+between the volumes fixed.  Then the error cases: exit code, one error
+line naming the file (and the line for ASCII), input untouched, no
+output, no temporary file left.
 """
 import hashlib
 import os
@@ -201,6 +204,65 @@ def to_binary(src, dst):
     gmsh.clear()
     gmsh.open(path(src))
     write(dst, True)
+
+
+def one_group(overlap):
+    """Three boxes fragmented into one body, all in one physical volume
+    group (MSH 2.2 then has no elements on the surfaces between them);
+    with overlap also a group of the first box alone, so that Gmsh's MSH
+    2.2 writer lists that box's elements twice."""
+    start("overlap" if overlap else "onegroup")
+    occ = gmsh.model.occ
+    boxes = [occ.addBox(i, 0, 0, 1, 1, 1) for i in range(3)]
+    occ.fragment([(3, boxes[0])], [(3, b) for b in boxes[1:]])
+    occ.synchronize()
+    vols = [t for _, t in gmsh.model.getEntities(3)]
+    gmsh.model.addPhysicalGroup(3, vols, 1)
+    gmsh.model.setPhysicalName(3, 1, "all")
+    if overlap:
+        gmsh.model.addPhysicalGroup(3, [vols[0]], 2)
+        gmsh.model.setPhysicalName(3, 2, "first")
+    gmsh.option.setNumber("Mesh.MeshSizeMax", 0.25)
+    gmsh.model.mesh.generate(3)
+
+
+def same_as_41(name):
+    """The MSH 2.2 copies (ASCII, binary) of name-ascii.msh smooth to the
+    same coordinates as the 4.1 file, bit for bit: the surfaces between
+    the volumes stay fixed though 2.2 saved no elements on them, and
+    elements listed once per physical group are read once."""
+    outs = {}
+    for flavour in ("ascii", "bin", "22a", "22b"):
+        src = path("%s-%s.msh" % (name, flavour))
+        out = path("%s-%s.out.msh" % (name, flavour))
+        rc, log = run(["smooth", src, "-o", out, "-v"])
+        check(rc == 0, "%s: exit %d\n%s" % (src, rc, log))
+        fixed = re.search(r"Done reading .*\((\d+) fixed\)", log)
+        outs[flavour] = (load(out) if rc == 0 else None,
+                         fixed.group(1) if fixed else None, log)
+    for flavour in ("22a", "22b"):
+        # ASCII files hold Gmsh's %.16g, binary ones the doubles
+        ref = outs["ascii" if flavour == "22a" else "bin"]
+        got = outs[flavour]
+        if ref[0] is None or got[0] is None:
+            continue
+        check(got[1] == ref[1], "%s-%s: %s fixed nodes, 4.1: %s" %
+              (name, flavour, got[1], ref[1]))
+        check(np.array_equal(got[0][0], ref[0][0]) and
+              got[0][1].tobytes() == ref[0][1].tobytes(),
+              "%s-%s: coordinates differ from the 4.1 file's" % (name, flavour))
+        if name == "overlap":
+            check("listed again under another physical group" in got[2],
+                  "%s-%s: no note of the repeated elements" % (name, flavour))
+    fixed = lower_dim_nodes(path(name + "-ascii.msh"), 3)
+    i = load(path(name + "-ascii.msh"))
+    ref = outs["ascii"]
+    if ref[0] is not None:
+        same = np.all(i[1] == ref[0][1], axis=1)
+        moved = {int(t) for t, s in zip(i[0], same) if not s}
+        check(moved and not (moved & fixed), "%s: %d moved, %d on surfaces" %
+              (name, len(moved), len(moved & fixed)))
+    print("ok %-28s 2.2 = 4.1" % name, flush=True)
 
 
 # ---- running getme ----------------------------------------------------------
@@ -423,6 +485,13 @@ def main():
     compare("partial-bin.msh", 3, ["--fix", "third"])
     compare("two-22b.msh", 3, ["--fix", "left"])
     compare("two-22a.msh", 3, ["--fix", "3:12", "--free-interfaces"])
+    for overlap, name in ((False, "onegroup"), (True, "overlap")):
+        one_group(overlap)
+        write(name + "-ascii.msh", False)
+        write(name + "-bin.msh", True)
+        write(name + "-22a.msh", False, 2.2)
+        write(name + "-22b.msh", True, 2.2)
+        same_as_41(name)
     errors()
     gmsh.finalize()
     print("test_msh_native: %d failures" % len(FAILED))
