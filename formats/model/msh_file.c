@@ -30,16 +30,35 @@ int getme__msh_probe(const char *path)
     return ok;
 }
 
+/* Lines before "$MeshFormat" looked at: Gmsh skips sections it does not
+   know ($Comments...) wherever they are, so they may come first; a mesh
+   section first, or this many lines of something else, is not MSH. */
+#define HEADER_SCAN_LINES 100000
+
 int getme__msh_header(const char *path, double *version, int *binary)
 {
     FILE *f = fopen(path, "rb");
     if (!f)
         return -1;
     char line[128] = "";
-    int b = 0, ok = fgets(line, sizeof line, f) &&
-                    !strncmp(line, "$MeshFormat", 11) &&
-                    fgets(line, sizeof line, f) &&
-                    sscanf(line, "%lf %d", version, &b) == 2;
+    int b = 0, ok = 0, at_start = 1;
+    for (long n = 0; !ok && n < HEADER_SCAN_LINES &&
+                     fgets(line, sizeof line, f);
+         n++) {
+        /* only at a line's start (a long line comes in pieces) */
+        int start = at_start;
+        at_start = strchr(line, '\n') != NULL;
+        if (!start || line[0] != '$')
+            continue;
+        if (!strncmp(line, "$MeshFormat", 11)) {
+            ok = fgets(line, sizeof line, f) &&
+                 sscanf(line, "%lf %d", version, &b) == 2;
+            break;
+        }
+        if (!strncmp(line, "$Nodes", 6) || !strncmp(line, "$Elements", 9) ||
+            !strncmp(line, "$Entities", 9))
+            break;
+    }
     fclose(f);
     *binary = b != 0;
     return ok ? 0 : -2;

@@ -162,7 +162,10 @@ int msh41_in_line(msh41_input *in, char *buf, size_t size)
     for (; c >= 0 && c != '\n'; c = msh41_in_getc(in))
         if (n + 1 < size)
             buf[n++] = (char)c;
-    if (n && buf[n - 1] == '\r')
+    /* CR and trailing blanks: Gmsh takes "$Nodes " for "$Nodes" */
+    while (n && (buf[n - 1] == '\r' || buf[n - 1] == ' ' ||
+                 buf[n - 1] == '\t' || buf[n - 1] == '\f' ||
+                 buf[n - 1] == '\v'))
         n--;
     buf[n] = 0;
     return 0;

@@ -240,14 +240,27 @@ static getme_formats_status read_format(msh41_reader *r)
     char line[TOK];
     double version = 0;
     int file_type = -1, data_size = 0;
-    r->section = "MeshFormat";
+    /* Sections Gmsh skips ($Comments...) may come first, as may text
+       between sections; a mesh section may not. */
+    for (;;) {
+        r->section = "MeshFormat";
+        if (msh41_in_line(&r->in, line, sizeof line) ||
+            strcmp(line, "$Nodes") == 0 || strcmp(line, "$Elements") == 0 ||
+            strcmp(line, "$Entities") == 0)
+            return line_fail(r, GETME_FORMATS_ERR_PARSE,
+                             "not a Gmsh MSH file (no $MeshFormat header)");
+        if (strcmp(line, "$MeshFormat") == 0)
+            break;
+        getme_formats_status st;
+        if (line[0] == '$' && (st = skip_section(r, line + 1)) != GETME_FORMATS_OK)
+            return st;
+    }
     if (msh41_in_line(&r->in, line, sizeof line) ||
-        strcmp(line, "$MeshFormat") != 0 ||
-        msh41_in_line(&r->in, line, sizeof line) ||
         sscanf(line, "%lf %d %d", &version, &file_type, &data_size) != 3 ||
         (file_type != 0 && file_type != 1))
         return line_fail(r, GETME_FORMATS_ERR_PARSE,
-                         "bad $MeshFormat header (want \"4.1 0|1 8\")");
+                         "bad $MeshFormat header (want \"4.1 0|1 8\" or "
+                         "\"2.2 0|1 8\")");
     if (version != 4.1 && version != 2.2)
         return msh41_decline(r, "not MSH 4.1 or 2.2");
     r->v22 = version == 2.2;
@@ -1503,6 +1516,8 @@ static getme_formats_status read_section(msh41_reader *r, const char *name)
         return r->v22 ? read_elements22(r) : read_elements(r);
     if (strcmp(name, "PartitionedEntities") == 0 && !r->v22)
         return read_partitioned_entities(r);
+    if (strcmp(name, "ParametricNodes") == 0) /* MSH 2.2's, for Gmsh */
+        return msh41_decline(r, "parametric nodes");
     if (strcmp(name, "MeshFormat") == 0) {
         r->section = "MeshFormat";
         return msh41_fail(r, GETME_FORMATS_ERR_PARSE, "second $MeshFormat");

@@ -669,8 +669,12 @@ static int patch_file(const char *in_path, const char *out_path, int binary,
     int rc = in && out && load_nodes(&t) == 0 ? 0 : -1;
     int loaded = rc == 0;
     char line[512];
+    /* MSH 2.2 ASCII with Mesh.SaveParametric has "$ParametricNodes"
+       instead, lines "tag x y z dim entity [u [v]]": the coordinates are
+       patched the same way, the rest of each line kept */
     while (rc == 0 && (rc = copy_line(in, out, line, sizeof line)) == 0)
-        if (strncmp(line, "$Nodes", 6) == 0)
+        if (strncmp(line, "$Nodes", 6) == 0 ||
+            (!binary && strncmp(line, "$ParametricNodes", 16) == 0))
             break;
     if (rc == 0)
         rc = body(in, out, &t, binary);

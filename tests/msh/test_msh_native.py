@@ -12,7 +12,9 @@ The native output must equal the input outside $Nodes (binary: same size),
 and every node that is not free in the mesh must keep its input bytes.
 MSH 2.2 against 4.1 on volumes of one physical group (with and without
 a second group over one of them): the same coordinates, the surfaces
-between the volumes fixed.  Then the error cases: exit code, one error
+between the volumes fixed.  Sections before $MeshFormat and blanks after
+section names read as Gmsh reads them; MSH 2.2 with $ParametricNodes
+smoothed with only coordinates changed.  Then the error cases: exit code, one error
 line naming the file (and the line for ASCII), input untouched, no
 output, no temporary file left.
 """
@@ -265,6 +267,57 @@ def same_as_41(name):
     print("ok %-28s 2.2 = 4.1" % name, flush=True)
 
 
+def lenient():
+    """What Gmsh's reader accepts, the native one too: sections it does not
+    know before $MeshFormat, blanks after section names; and MSH 2.2 with
+    $ParametricNodes (Mesh.SaveParametric), read and written through the
+    Gmsh path."""
+    for name in ("two-ascii.msh", "two-22a.msh"):
+        plain = path(name[:-4] + ".plain.out.msh")
+        rc, log = run(["smooth", path(name), "-o", plain])
+        check(rc == 0, "%s: exit %d\n%s" % (name, rc, log))
+        data = open(path(name), "rb").read()
+        variants = {
+            "comments": b"$Comments\nmade by hand\n$EndComments\n" + data,
+            "blanks": re.sub(rb"(?m)^(\$\w+)\n", rb"\1 \t\n", data)}
+        for what, text in variants.items():
+            src = path("%s.%s.msh" % (name[:-4], what))
+            out = path("%s.%s.out.msh" % (name[:-4], what))
+            open(src, "wb").write(text)
+            rc, log = run(["smooth", src, "-o", out], "native")
+            check(rc == 0, "%s: exit %d\n%s" % (src, rc, log))
+            if rc == 0 and os.path.exists(plain):
+                a, b = load(plain), load(out)
+                check(np.array_equal(a[0], b[0]) and
+                      a[1].tobytes() == b[1].tobytes(),
+                      "%s: coordinates differ from the plain file's" % src)
+    start("param")
+    gmsh.model.occ.addSphere(0, 0, 0, 1)
+    gmsh.model.occ.synchronize()
+    gmsh.option.setNumber("Mesh.MeshSizeMax", 0.3)
+    gmsh.model.mesh.generate(3)
+    gmsh.option.setNumber("Mesh.SaveParametric", 1)
+    write("param-22a.msh", False, 2.2)
+    gmsh.option.setNumber("Mesh.SaveParametric", 0)
+    src, out = path("param-22a.msh"), path("param-22a.out.msh")
+    check(b"$ParametricNodes" in open(src, "rb").read(), "no $ParametricNodes")
+    rc, log = run(["smooth", src, "-o", out])
+    check(rc == 0, "param-22a.msh: exit %d\n%s" % (rc, log))
+    if rc == 0:
+        a, b = open(src).read().split("\n"), open(out).read().split("\n")
+        check(len(a) == len(b), "param-22a.msh: line count changed")
+        # only node lines change, and in them only x y z
+        changed = [(x, y) for x, y in zip(a, b) if x != y]
+        check(changed and all(x.split()[0] == y.split()[0] and
+                              x.split()[4:] == y.split()[4:]
+                              for x, y in changed),
+              "param-22a.msh: %d lines changed, not only coordinates" %
+              len(changed))
+        i, o = load(src), load(out)
+        check(np.array_equal(i[0], o[0]), "param-22a.msh: node tags differ")
+    print("ok lenient headers, parametric 2.2", flush=True)
+
+
 # ---- running getme ----------------------------------------------------------
 
 def run(args, reader=None):
@@ -485,6 +538,7 @@ def main():
     compare("partial-bin.msh", 3, ["--fix", "third"])
     compare("two-22b.msh", 3, ["--fix", "left"])
     compare("two-22a.msh", 3, ["--fix", "3:12", "--free-interfaces"])
+    lenient()
     for overlap, name in ((False, "onegroup"), (True, "overlap")):
         one_group(overlap)
         write(name + "-ascii.msh", False)
