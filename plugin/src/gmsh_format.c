@@ -19,8 +19,8 @@
  * Writing keeps the input's MSH version and ASCII/binary flavour, its node
  * and element tags and its physical groups; only coordinates of moved nodes
  * differ.  MSH 4.1 and 2.2 are the input copied with new coordinates in
- * $Nodes (patch_file); MSH 4.0 goes through Gmsh's writer
- * (gmshWrite); when the input has physical groups but also elements
+ * $Nodes (patch_file), as is MSH 4.0 ASCII; binary MSH 4.0 goes through
+ * Gmsh's writer (gmshWrite); when the input has physical groups but also elements
  * outside of them, Mesh.SaveAll is set so that no element is dropped.
  *
  * Split partition files (Mesh.PartitionSplitMeshFiles=1: NAME_1.msh ..
@@ -917,6 +917,28 @@ static fstatus write_split(getme_doc *doc, msh_impl *impl, const char *tmp,
     return GETME_FORMATS_OK;
 }
 
+/* MSH 4.0 ASCII: numEntityBlocks numNodes, then per block "tagEntity
+   dimEntity parametric numNodes" and numNodes lines "tag x y z [u v w]",
+   patched as MSH 2.2's (Gmsh's writer would zero the entities' bounding
+   boxes, as for 4.1 above).  Binary 4.0 files: -1, Gmsh writes them. */
+static int msh40_nodes(FILE *in, FILE *out, const node_table *t, int binary)
+{
+    char line[512];
+    size_t blocks, total;
+    if (binary || copy_line(in, out, line, sizeof line) != 0 ||
+        sscanf(line, "%zu %zu", &blocks, &total) != 2)
+        return -1;
+    for (size_t b = 0; b < blocks; b++) {
+        int tag, dim, param;
+        long n;
+        if (copy_line(in, out, line, sizeof line) != 0 ||
+            sscanf(line, "%d %d %d %ld", &tag, &dim, &param, &n) != 4 ||
+            n < 0 || patch_ascii_nodes(in, out, t, n) != 0)
+            return -1;
+    }
+    return 0;
+}
+
 static fstatus write_model(getme_doc *doc, msh_impl *impl,
                                    const char *out_path)
 {
@@ -944,10 +966,9 @@ static fstatus write_model(getme_doc *doc, msh_impl *impl,
     if (impl->version < 3)
         ierr = patch_file(getme_doc_path(doc), tmp_msh, impl->binary,
                           msh2_nodes) != 0;
-    else if (impl->version != 4.1 ||
-             patch_file(getme_doc_path(doc), tmp_msh, impl->binary,
-                        msh41_nodes) != 0)
-        gmshWrite(tmp_msh, &ierr); /* MSH 4.0 (or a 4.1 file laid out otherwise) */
+    else if (patch_file(getme_doc_path(doc), tmp_msh, impl->binary,
+                        impl->version == 4.0 ? msh40_nodes : msh41_nodes) != 0)
+        gmshWrite(tmp_msh, &ierr); /* binary 4.0, or a file laid out otherwise */
     FILE *check = ierr ? NULL : fopen(tmp_msh, "rb");
     if (check)
         fclose(check);
