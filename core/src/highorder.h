@@ -88,6 +88,10 @@ void getme__ho_free(getme_ho_ws *ho);
    coords (dependent nodes placed from them); 1 for linear elements. */
 int getme__ho_valid(const struct getme_ws *ws, const double *coords,
                     int32_t e);
+/* min / max of det J over element e's nodes (as getme__ho_valid places
+   them): <= 0 if invalid, 1 for linear elements. */
+double getme__ho_ratio(const struct getme_ws *ws, const double *coords,
+                       int32_t e);
 
 /* Pull the free dependent nodes of elements that are invalid only at
    their non-corner nodes (corners valid) toward their straight positions,

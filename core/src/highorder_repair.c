@@ -10,7 +10,14 @@
  * round after round: in each element still invalid with valid corners, that
  * of its free curved dependent node farthest (relative to its edge or face)
  * from its straight position, until no such element is left or 64 rounds
- * (2^-64 of the offset: straight to rounding) are done.  Pinned nodes
+ * (2^-64 of the offset: straight to rounding) are done.  An element found
+ * invalid is pulled on until the ratio of its smallest to its largest
+ * det J at the nodes is REPAIR_RATIO (Gmsh's default target for its own
+ * high-order optimizer, Mesh.HighOrderThresholdMin) or its free nodes are
+ * straight: stopping as soon as it is valid left elements valid by a
+ * rounding (ratio 0.0000 on a sphere whose mid-nodes were displaced, five
+ * of them below 1e-6 by Gmsh's measure), which no solver accepts.
+ * Elements valid in the input are not touched.  Pinned nodes
  * (skin, fixed edges and faces, fixed groups) never move.  The rounds are
  * serial and visit elements and nodes in index order, so the result does
  * not depend on the thread count.
@@ -23,6 +30,7 @@
 #include <string.h>
 
 #define REPAIR_ROUNDS 64
+#define REPAIR_RATIO 0.1
 
 static int corners_valid(const getme_ws *ws, int32_t e)
 {
@@ -56,10 +64,13 @@ static double rel_offset(const getme_ho_ws *ho, int32_t h)
     return l > 0.0 ? sqrt(o / l) : 0.0;
 }
 
-static int needs_repair(const getme_ws *ws, int32_t e)
+/* Invalid at a node with valid corners; or found so before (was_bad) and
+   not yet REPAIR_RATIO. */
+static int needs_repair(const getme_ws *ws, int32_t e, int was_bad)
 {
     return ws->ho->etype[e] >= 0 && corners_valid(ws, e) &&
-           !getme__ho_valid(ws, ws->x, e);
+           (was_bad ? getme__ho_ratio(ws, ws->x, e) < REPAIR_RATIO
+                    : !getme__ho_valid(ws, ws->x, e));
 }
 
 getme_status getme__ho_repair(getme_ws *ws, int32_t *num_found,
@@ -82,7 +93,7 @@ getme_status getme__ho_repair(getme_ws *ws, int32_t *num_found,
         int any = 0;
         memset(mark, 0, (size_t)ho->nh);
         for (int32_t e = 0; e < ws->ne; e++) {
-            if (!needs_repair(ws, e))
+            if (!needs_repair(ws, e, bad[e]))
                 continue;
             bad[e] = 1;
             /* the free node farthest from its straight position, relative

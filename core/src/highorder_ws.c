@@ -392,6 +392,23 @@ fail:
     return st;
 }
 
+double getme__ho_ratio(const getme_ws *ws, const double *coords, int32_t e)
+{
+    const getme_ho_ws *ho = ws->ho;
+    int t = ho->etype[e];
+    if (t < 0)
+        return 1.0;
+    const getme_ho_info *in = &ho->info[t];
+    double x[3 * GETME_HO_MAX_NV];
+    getme__ws_gather(ws, coords, in->lin, e, x);
+    const int32_t *hs = ho->eho + ho->eptr[e];
+    for (int k = in->nlin; k < in->nv; k++)
+        ho_pos(ho, hs[k - in->nlin], coords, x + 3 * k);
+    double lo, hi;
+    getme__ho_det_range(in, x, &lo, &hi);
+    return lo > 0.0 && hi > 0.0 ? lo / hi : (lo > 0.0 ? 0.0 : lo);
+}
+
 int getme__ho_valid(const getme_ws *ws, const double *coords, int32_t e)
 {
     const getme_ho_ws *ho = ws->ho;

@@ -326,6 +326,42 @@ def midnode_repair_case(kind, gtype, k, a, b):
           (tag, w0, n0, w1), flush=True)
 
 
+def midnode_repair_margin():
+    """An interior tet10 mid-edge node pulled to 0.05 of its edge: one
+    halving of its offset makes the element valid by little (node det J
+    ratio 0.1 / 1.9); the repair goes on to a ratio of at least 0.1
+    (Gmsh's default target), checked without smoothing (max_iter=0,
+    finish=0), so the repair alone is measured."""
+    tag = "mid-node repair margin"
+    gmsh.clear()
+    gmsh.open(path("tet10-4.1.msh"))
+    inner = set(gmsh.model.mesh.getNodes(3, -1)[0].tolist())
+    et, nt = gmsh.model.mesh.getElementsByType(11)
+    conn = np.array(nt).reshape(-1, 10)
+    row = next(r for r in conn if r[4] in inner and r[0] in inner)
+    pa = np.array(gmsh.model.mesh.getNode(row[0])[0])
+    pb = np.array(gmsh.model.mesh.getNode(row[1])[0])
+    gmsh.model.mesh.setNode(int(row[4]), (pa + 0.05 * (pb - pa)).tolist(), [])
+    bad, out = path("tet10-margin.msh"), path("tet10-margin-out.msh")
+    gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+    gmsh.option.setNumber("Mesh.Binary", 0)
+    gmsh.write(bad)
+    r = run("smooth", bad, "-o", out, "--param", "max_iter=0", "--param",
+            "finish=0")
+    check(r.returncode == 0, "%s: exit %d %s" % (tag, r.returncode,
+                                                 r.stderr[-300:]))
+    gmsh.clear()
+    gmsh.open(out)
+    p = gmsh.model.mesh.getElementProperties(11)
+    tags, dets, _ = gmsh.model.mesh.getJacobians(11, p[4])
+    d = np.array(dets).reshape(-1, p[3])
+    ratio = (d.min(axis=1) / d.max(axis=1)).min()
+    check(ratio >= 0.1 - 1e-9, "%s: worst node det J ratio %.4f < 0.1" %
+          (tag, ratio))
+    print("%s: worst node det J ratio after the repair %.4f" % (tag, ratio),
+          flush=True)
+
+
 def pull_midnode(conn, inner, k, a, b, want_inner):
     """Move mid-edge node k of the first element whose node k and corner a
     are interior (or node k on the skin) to 0.2 of its edge a-b."""
@@ -394,6 +430,7 @@ for kind, gtype in (("tet10", 11), ("hex27", 12), ("prism18", 13)):
     curved_case(kind, gtype)
 midnode_repair_case("tet10", 11, 4, 0, 1)
 midnode_repair_case("hex20", 17, 8, 0, 1)
+midnode_repair_margin()
 midnode_pinned_case()
 gmsh.finalize()
 print("%d failure(s)" % len(FAILED))
