@@ -74,7 +74,13 @@ typedef struct getme_ho_ws {
     int64_t *eptr;    /* ne + 1: into eho                                  */
     int32_t *eho;     /* dependent node index of each slot k >= nlin       */
     getme_ho_info *info; /* GETME_NUM_HO_TYPES, filled for types present   */
+    double *floor;    /* ne, or NULL: the node det J ratio a move may not
+                         go below (getme__ho_floor_start)                  */
 } getme_ho_ws;
+
+/* The node det J ratio (min / max of det J at the nodes) smoothing keeps
+   an element at: it never goes below min(this, its ratio at the start). */
+#define GETME_HO_RATIO_FLOOR 0.1
 
 /* Attach the mesh's second-order elements to a freshly built workspace
    (ws->ho stays NULL if there are none): getme_smooth, getme_mesh_untangle
@@ -92,6 +98,13 @@ int getme__ho_valid(const struct getme_ws *ws, const double *coords,
    them): <= 0 if invalid, 1 for linear elements. */
 double getme__ho_ratio(const struct getme_ws *ws, const double *coords,
                        int32_t e);
+/* Smoothing's floors: per element, min(GETME_HO_RATIO_FLOOR, its ratio
+   at ws->x now).  GETME_OK or GETME_ERR_NOMEM; nothing without ws->ho. */
+getme_status getme__ho_floor_start(struct getme_ws *ws);
+/* Element e may take the shape at coords: valid at every node, and its
+   node det J ratio not below its floor (when floors were set). */
+int getme__ho_accept(const struct getme_ws *ws, const double *coords,
+                     int32_t e);
 
 /* Pull the free dependent nodes of elements that are invalid only at
    their non-corner nodes (corners valid) toward their straight positions,

@@ -44,6 +44,7 @@ void getme__ho_free(getme_ho_ws *ho)
     free(ho->eptr);
     free(ho->eho);
     free(ho->info);
+    free(ho->floor);
     free(ho);
 }
 
@@ -407,6 +408,41 @@ double getme__ho_ratio(const getme_ws *ws, const double *coords, int32_t e)
     double lo, hi;
     getme__ho_det_range(in, x, &lo, &hi);
     return lo > 0.0 && hi > 0.0 ? lo / hi : (lo > 0.0 ? 0.0 : lo);
+}
+
+/* Why a floor: smoothing moves the corners toward their GETMe positions
+   and curved elements follow (their dependent nodes keep their offsets),
+   so with validity alone as the test a curved element could end valid by
+   a rounding (a repaired sphere element: node det J ratio 0.1 -> 2e-9),
+   which Gmsh and solvers reject.  An element's ratio at the start always
+   passes, so a relaxation that resets a node still finds every element
+   acceptable, as with the corner guard. */
+getme_status getme__ho_floor_start(getme_ws *ws)
+{
+    getme_ho_ws *ho = ws->ho;
+    if (!ho)
+        return GETME_OK;
+    free(ho->floor);
+    ho->floor = getme__malloc((size_t)(ws->ne ? ws->ne : 1) * sizeof *ho->floor);
+    if (!ho->floor)
+        return GETME_ERR_NOMEM;
+#pragma omp parallel for schedule(static) num_threads(ws->nt)
+    for (int32_t e = 0; e < ws->ne; e++) {
+        double r = ho->etype[e] >= 0 ? getme__ho_ratio(ws, ws->x, e) : 1.0;
+        ho->floor[e] = r < GETME_HO_RATIO_FLOOR ? r : GETME_HO_RATIO_FLOOR;
+    }
+    return GETME_OK;
+}
+
+int getme__ho_accept(const getme_ws *ws, const double *coords, int32_t e)
+{
+    const getme_ho_ws *ho = ws->ho;
+    if (!ho->floor)
+        return getme__ho_valid(ws, coords, e);
+    if (ho->etype[e] < 0)
+        return 1;
+    double r = getme__ho_ratio(ws, coords, e);
+    return r > 0.0 && r >= ho->floor[e];
 }
 
 int getme__ho_valid(const getme_ws *ws, const double *coords, int32_t e)

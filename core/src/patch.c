@@ -98,8 +98,8 @@ static double elem_finish(const getme_patch *p, int32_t i, const double *x,
        same (sj < floor implies sj < any old corner >= floor) */
     if (sj && p->guard && getme__has_corners(t) && !(q >= p->skip_q[t]))
         *sj = getme__corner_sj(t, x);
-    if (q > 0.0 && p->ws && p->ws->ho && !getme__ho_valid(p->ws, p->x, p->id[i]))
-        return 0.0; /* second order: det J > 0 at every node */
+    if (q > 0.0 && p->ws && p->ws->ho && !getme__ho_accept(p->ws, p->x, p->id[i]))
+        return 0.0; /* second order: det J > 0 at every node, ratio floor */
     return q;
 }
 

@@ -34,8 +34,8 @@ static inline double trial_check(const getme_run *run, int32_t e, int t,
                                  double q)
 {
     const getme_ws *ws = run->ws;
-    if (q > 0.0 && ws->ho && !getme__ho_valid(ws, ws->x, e))
-        return 0.0; /* second order: det J > 0 at every node */
+    if (q > 0.0 && ws->ho && !getme__ho_accept(ws, ws->x, e))
+        return 0.0; /* second order: det J > 0 at every node, ratio floor */
     if (!run->guard || !getme__has_corners(t) || !(q > 0.0) ||
         q >= run->guard_skip_q[t])
         return q;

@@ -381,8 +381,13 @@ getme_status getme_smooth(getme_mesh *mesh, const getme_params *params,
     getme__ws_lend_x(&ws, mesh); /* the input is checked: back at store */
     getme__ws_pack_map(&ws);     /* unread until the end */
     getme__stars_pack(&ws);      /* read node by node from here on */
-    st = params->method == GETME_METHOD_SMART_LAPLACE ? getme__laplace(&run)
-                                                      : getme__adaptive(&run);
+    /* second order: each element's node det J ratio floor */
+    st = getme__ho_floor_start(&ws);
+    if (st != GETME_OK)
+        getme__fail(mesh, st, "out of memory for second-order elements");
+    else
+        st = params->method == GETME_METHOD_SMART_LAPLACE ? getme__laplace(&run)
+                                                          : getme__adaptive(&run);
     getme__ws_unpack_map(&ws); /* into the stars' array: no allocation */
     /* run.q is at ws->x after a finished or stopped run */
     if (st == GETME_OK || st == GETME_ERR_CANCELLED)

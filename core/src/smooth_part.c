@@ -114,7 +114,9 @@ getme_status getme_smooth_part(getme_mesh *mesh, const getme_params *params,
         st = run.comm_failed ? GETME_ERR_COMM : GETME_OK;
         goto done;
     }
-    st = getme__adaptive(&run);
+    st = getme__ho_floor_start(&ws); /* second order: ratio floors */
+    if (st == GETME_OK)
+        st = getme__adaptive(&run);
     if (st == GETME_OK || st == GETME_ERR_CANCELLED) {
         c = getme__ws_corner_min(&ws);
         getme__dist_min(&run, &c, 1);

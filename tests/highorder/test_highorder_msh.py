@@ -362,6 +362,66 @@ def midnode_repair_margin():
           flush=True)
 
 
+def node_ratios(p, gtype):
+    """Per element (in tag order): min / max of Gmsh's det J at its nodes."""
+    gmsh.clear()
+    gmsh.open(p)
+    props = gmsh.model.mesh.getElementProperties(gtype)
+    tags, _ = gmsh.model.mesh.getElementsByType(gtype)
+    _, dets, _ = gmsh.model.mesh.getJacobians(gtype, props[4])
+    d = np.array(dets).reshape(-1, props[3])
+    return dict(zip(np.array(tags).tolist(), d.min(axis=1) / d.max(axis=1)))
+
+
+def ratio_floor():
+    """Interior mid-edge nodes of the tet10 mesh moved off their edges at
+    random (seeded), many elements invalid: after the repair alone
+    (max_iter=0, finish=0) every element has a node det J ratio r0; after
+    smoothing none is below min(0.1, r0) (highorder_ws.c's floor: without
+    it the corners' moves took repaired elements to a ratio near 0)."""
+    tag = "ratio floor"
+    gmsh.clear()
+    gmsh.open(path("tet10-4.1.msh"))
+    inner = gmsh.model.mesh.getNodes(3, -1)[0].tolist()
+    et, nt = gmsh.model.mesh.getElementsByType(11)
+    conn = np.array(nt).reshape(-1, 10)
+    inside = set(inner)
+    edges = [(0, 1), (1, 2), (0, 2), (0, 3), (2, 3), (1, 3)]
+    # mid-nodes of edges between two interior corners (free, not pinned)
+    mids = {}
+    for r in conn:
+        for k, (a, b) in enumerate(edges):
+            if r[4 + k] in inside and r[a] in inside and r[b] in inside:
+                mids[int(r[4 + k])] = (int(r[a]), int(r[b]))
+    rng = np.random.default_rng(7)
+    keys = sorted(mids)
+    for n in rng.choice(keys, size=max(1, len(keys) // 4), replace=False):
+        a, b = mids[int(n)]
+        pa = np.array(gmsh.model.mesh.getNode(a)[0])
+        pb = np.array(gmsh.model.mesh.getNode(b)[0])
+        x = np.array(gmsh.model.mesh.getNode(int(n))[0])
+        gmsh.model.mesh.setNode(int(n), (x + rng.normal(size=3) * 0.2 *
+                                         np.linalg.norm(pb - pa)).tolist(), [])
+    bad = path("tet10-floor.msh")
+    gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+    gmsh.option.setNumber("Mesh.Binary", 0)
+    gmsh.write(bad)
+    o0, o1 = path("tet10-floor-0.msh"), path("tet10-floor-1.msh")
+    r0 = run("smooth", bad, "-o", o0, "--param", "max_iter=0", "--param",
+             "finish=0")
+    r1 = run("smooth", bad, "-o", o1)
+    check(r0.returncode == 0 and r1.returncode == 0, "%s: exit %d/%d %s" %
+          (tag, r0.returncode, r1.returncode, r1.stderr[-300:]))
+    if r0.returncode or r1.returncode:
+        return
+    a, b = node_ratios(o0, 11), node_ratios(o1, 11)
+    low = [(e, a[e], b[e]) for e in a if b[e] < min(0.1, a[e]) - 1e-9]
+    check(not low, "%s: %d elements below min(0.1, start), e.g. %s" %
+          (tag, len(low), low[:3]))
+    print("%s: worst node det J ratio %.4f after the repair, %.4f after "
+          "smoothing" % (tag, min(a.values()), min(b.values())), flush=True)
+
+
 def pull_midnode(conn, inner, k, a, b, want_inner):
     """Move mid-edge node k of the first element whose node k and corner a
     are interior (or node k on the skin) to 0.2 of its edge a-b."""
@@ -431,6 +491,7 @@ for kind, gtype in (("tet10", 11), ("hex27", 12), ("prism18", 13)):
 midnode_repair_case("tet10", 11, 4, 0, 1)
 midnode_repair_case("hex20", 17, 8, 0, 1)
 midnode_repair_margin()
+ratio_floor()
 midnode_pinned_case()
 gmsh.finalize()
 print("%d failure(s)" % len(FAILED))
