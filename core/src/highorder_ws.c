@@ -393,20 +393,30 @@ fail:
     return st;
 }
 
-double getme__ho_ratio(const getme_ws *ws, const double *coords, int32_t e)
+/* min and max of det J at element e's nodes placed from coords; 0, or 1
+   for an element checked at its corners only (etype -1). */
+static int det_range(const getme_ws *ws, const double *coords, int32_t e,
+                     double *lo, double *hi)
 {
     const getme_ho_ws *ho = ws->ho;
     int t = ho->etype[e];
     if (t < 0)
-        return 1.0;
+        return 1;
     const getme_ho_info *in = &ho->info[t];
     double x[3 * GETME_HO_MAX_NV];
     getme__ws_gather(ws, coords, in->lin, e, x);
     const int32_t *hs = ho->eho + ho->eptr[e];
     for (int k = in->nlin; k < in->nv; k++)
         ho_pos(ho, hs[k - in->nlin], coords, x + 3 * k);
+    getme__ho_det_range(in, x, lo, hi);
+    return 0;
+}
+
+double getme__ho_ratio(const getme_ws *ws, const double *coords, int32_t e)
+{
     double lo, hi;
-    getme__ho_det_range(in, x, &lo, &hi);
+    if (det_range(ws, coords, e, &lo, &hi))
+        return 1.0;
     return lo > 0.0 && hi > 0.0 ? lo / hi : (lo > 0.0 ? 0.0 : lo);
 }
 
@@ -447,19 +457,8 @@ int getme__ho_accept(const getme_ws *ws, const double *coords, int32_t e)
 
 int getme__ho_valid(const getme_ws *ws, const double *coords, int32_t e)
 {
-    const getme_ho_ws *ho = ws->ho;
-    int t = ho->etype[e];
-    if (t < 0)
-        return 1;
-    const getme_ho_info *in = &ho->info[t];
-    double x[3 * GETME_HO_MAX_NV];
-    getme__ws_gather(ws, coords, in->lin, e, x);
-    const int32_t *hs = ho->eho + ho->eptr[e];
-    for (int k = in->nlin; k < in->nv; k++)
-        ho_pos(ho, hs[k - in->nlin], coords, x + 3 * k);
     double lo, hi;
-    getme__ho_det_range(in, x, &lo, &hi);
-    return lo > 0.0;
+    return det_range(ws, coords, e, &lo, &hi) || lo > 0.0;
 }
 
 void getme__ho_store(const getme_ws *ws, getme_mesh *mesh)

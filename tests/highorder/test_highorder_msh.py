@@ -337,11 +337,7 @@ def midnode_repair_margin():
     gmsh.open(path("tet10-4.1.msh"))
     inner = set(gmsh.model.mesh.getNodes(3, -1)[0].tolist())
     et, nt = gmsh.model.mesh.getElementsByType(11)
-    conn = np.array(nt).reshape(-1, 10)
-    row = next(r for r in conn if r[4] in inner and r[0] in inner)
-    pa = np.array(gmsh.model.mesh.getNode(row[0])[0])
-    pb = np.array(gmsh.model.mesh.getNode(row[1])[0])
-    gmsh.model.mesh.setNode(int(row[4]), (pa + 0.05 * (pb - pa)).tolist(), [])
+    pull_midnode(np.array(nt).reshape(-1, 10), inner, 4, 0, 1, True, 0.05)
     bad, out = path("tet10-margin.msh"), path("tet10-margin-out.msh")
     gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
     gmsh.option.setNumber("Mesh.Binary", 0)
@@ -422,15 +418,15 @@ def ratio_floor():
           "smoothing" % (tag, min(a.values()), min(b.values())), flush=True)
 
 
-def pull_midnode(conn, inner, k, a, b, want_inner):
+def pull_midnode(conn, inner, k, a, b, want_inner, frac=0.2):
     """Move mid-edge node k of the first element whose node k and corner a
-    are interior (or node k on the skin) to 0.2 of its edge a-b."""
+    are interior (or node k on the skin) to frac of its edge a-b."""
     row = next(r for r in conn
                if ((r[k] in inner and r[a] in inner) if want_inner
                    else r[k] not in inner))
     pa = np.array(gmsh.model.mesh.getNode(row[a])[0])
     pb = np.array(gmsh.model.mesh.getNode(row[b])[0])
-    gmsh.model.mesh.setNode(int(row[k]), (pa + 0.2 * (pb - pa)).tolist(), [])
+    gmsh.model.mesh.setNode(int(row[k]), (pa + frac * (pb - pa)).tolist(), [])
     return row
 
 
