@@ -18,7 +18,7 @@
 
 #include <string.h>
 
-#define MAX_PIECES 64
+#define MAX_PIECES LINEPAR_MAX_PIECES
 #define NMARK 256 /* line starts noted per run, where pieces may start */
 /* Below this many bytes a run is parsed by the calling thread: starting a
    team costs a few microseconds, parsing 256 KiB about a millisecond. */
@@ -59,20 +59,14 @@ static size_t parse_piece(const char **p, const char *end, size_t first,
     return i;
 }
 
-size_t linepar_run(const char *text, size_t len, size_t max, int threads,
-                   linepar_fn fn, void *ctx, size_t *bytes)
+size_t linepar_pieces(const char *text, size_t len, size_t max, int np,
+                      const char **cut, size_t *first, int *ncut)
 {
-    const char *end = text + len;
-    if (linepar_threads(threads, len) == 1) {
-        const char *p = text;
-        size_t k = parse_piece(&p, end, 0, max, fn, ctx);
-        *bytes = (size_t)(p - text);
-        return k;
-    }
     /* Find where the run's max lines end, noting a line start and its
        index about every len / NMARK bytes: one memchr per line, a few per
        cent of parsing them, and no work for lines past max (a block may
        end early in a big window). */
+    const char *end = text + len;
     const char *mark_at[NMARK + 1];
     size_t mark_line[NMARK + 1];
     int nmark = 0;
@@ -88,33 +82,51 @@ size_t linepar_run(const char *text, size_t len, size_t max, int threads,
         }
     }
     const char *run_end = p;
-    int t = linepar_threads(threads, (size_t)(run_end - text));
-    if (t == 1) {
-        p = text;
-        size_t k = parse_piece(&p, run_end, 0, nrun, fn, ctx);
-        *bytes = (size_t)(p - text);
-        return k;
-    }
-    /* Four pieces per thread, cut at the marks, handed out as threads
-       come free: on a loaded machine a thread that is not running does not
-       hold up the others for its whole share. */
-    int want = 4 * t > MAX_PIECES ? MAX_PIECES : 4 * t, np = 1, m = 0;
-    const char *cut[MAX_PIECES + 1], *stop_at[MAX_PIECES];
-    size_t first[MAX_PIECES + 1], stop[MAX_PIECES];
+    /* the cuts at the marks nearest to equal shares of the run */
+    int n = 1, m = 0;
     cut[0] = text;
     first[0] = 0;
-    for (int k = 1; k < want; k++) {
+    for (int k = 1; k < np; k++) {
         const char *target = text + (size_t)k * (size_t)(run_end - text) /
-                                        (size_t)want;
+                                        (size_t)np;
         while (m < nmark && mark_at[m] < target)
             m++;
         if (m == nmark || mark_at[m] >= run_end)
             break;
-        cut[np] = mark_at[m];
-        first[np++] = mark_line[m++];
+        cut[n] = mark_at[m];
+        first[n++] = mark_line[m++];
     }
-    cut[np] = run_end;
-    first[np] = nrun;
+    cut[n] = run_end;
+    first[n] = nrun;
+    *ncut = n;
+    return nrun;
+}
+
+size_t linepar_run(const char *text, size_t len, size_t max, int threads,
+                   linepar_fn fn, void *ctx, size_t *bytes)
+{
+    const char *end = text + len;
+    if (linepar_threads(threads, len) == 1) {
+        const char *p = text;
+        size_t k = parse_piece(&p, end, 0, max, fn, ctx);
+        *bytes = (size_t)(p - text);
+        return k;
+    }
+    /* Four pieces per thread, handed out as threads come free: on a
+       loaded machine a thread that is not running does not hold up the
+       others for its whole share. */
+    int t = linepar_threads(threads, len);
+    int want = 4 * t > MAX_PIECES ? MAX_PIECES : 4 * t, np;
+    const char *cut[MAX_PIECES + 1], *stop_at[MAX_PIECES];
+    size_t first[MAX_PIECES + 1], stop[MAX_PIECES];
+    size_t nrun = linepar_pieces(text, len, max, want, cut, first, &np);
+    const char *run_end = cut[np];
+    if (linepar_threads(threads, (size_t)(run_end - text)) == 1) {
+        const char *p = text;
+        size_t k = parse_piece(&p, run_end, 0, nrun, fn, ctx);
+        *bytes = (size_t)(p - text);
+        return k;
+    }
 #pragma omp parallel for num_threads(t) schedule(dynamic, 1)
     for (int k = 0; k < np; k++) {
         stop_at[k] = cut[k];

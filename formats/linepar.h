@@ -24,6 +24,16 @@ typedef const char *(*linepar_fn)(void *ctx, const char *line,
 size_t linepar_run(const char *text, size_t len, size_t max, int threads,
                    linepar_fn fn, void *ctx, size_t *bytes);
 
+/* The pieces linepar_run hands its threads, for callers that run their
+   own (inp_write_nodes.c): the first max lines of text[0..len) (len ends
+   a line) cut at line starts into at most np pieces of about equal bytes
+   (np <= LINEPAR_MAX_PIECES).  cut[0..*ncut] are the pieces' bounds (cut[0]
+   = text, cut[*ncut] the end of the run), first[k] the index of piece k's
+   first line (first[*ncut] = the run's line count, also returned). */
+#define LINEPAR_MAX_PIECES 64
+size_t linepar_pieces(const char *text, size_t len, size_t max, int np,
+                      const char **cut, size_t *first, int *ncut);
+
 /* The number of '\n' in [p, end). */
 size_t linepar_count(const char *p, const char *end);
 

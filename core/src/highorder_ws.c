@@ -438,7 +438,7 @@ getme_status getme__ho_floor_start(getme_ws *ws)
         return GETME_ERR_NOMEM;
 #pragma omp parallel for schedule(static) num_threads(ws->nt)
     for (int32_t e = 0; e < ws->ne; e++) {
-        double r = ho->etype[e] >= 0 ? getme__ho_ratio(ws, ws->x, e) : 1.0;
+        double r = getme__ho_ratio(ws, ws->x, e); /* 1 if not second order */
         ho->floor[e] = r < GETME_HO_RATIO_FLOOR ? r : GETME_HO_RATIO_FLOOR;
     }
     return GETME_OK;

@@ -115,7 +115,9 @@ getme_status getme_smooth_part(getme_mesh *mesh, const getme_params *params,
         goto done;
     }
     st = getme__ho_floor_start(&ws); /* second order: ratio floors */
-    if (st == GETME_OK)
+    if (st != GETME_OK)
+        getme__fail(mesh, st, "out of memory for second-order elements");
+    else
         st = getme__adaptive(&run);
     if (st == GETME_OK || st == GETME_ERR_CANCELLED) {
         c = getme__ws_corner_min(&ws);

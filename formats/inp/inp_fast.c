@@ -173,24 +173,46 @@ static int set_line_ids(const char *p)
 #define WANT_MIN ((size_t)4096)
 #define WANT_MAX ((size_t)8 << 20)
 
-size_t inp_fast_run(inp_deck *d, inp_lines *in, int nv, int threads,
-                    size_t *want)
+/* The window of whole lines at the reader's position: its start, *len
+   bytes and *max lines; NULL if it holds no whole line.  The window grows
+   while lines are taken and shrinks back after a refused one (end_window):
+   a block the fast path keeps refusing (elements continued over two
+   lines...) costs a few lines of scanning per line, not a buffer's worth. */
+static const char *window(inp_lines *in, size_t *want, size_t *len,
+                          size_t *max)
 {
-    /* The window grows while lines are taken and shrinks back after a
-       refused one: a block the fast path keeps refusing (elements
-       continued over two lines...) costs a few lines of scanning per
-       line, not a buffer's worth. */
     if (*want < WANT_MIN)
         *want = WANT_MIN;
     size_t avail;
     const char *w = inp_lines_window(in, *want, &avail);
     const char *nl = avail ? memrchr(w, '\n', avail) : NULL;
-    if (!nl)
+    if (!nl || in->lineno + (*max = linepar_count(w, nl + 1)) >= UINT32_MAX)
+        return NULL;
+    *len = (size_t)(nl + 1 - w);
+    return w;
+}
+
+/* got of the window's max lines taken, bytes long: consumed, and the next
+   window's size. */
+static size_t end_window(inp_lines *in, size_t *want, size_t bytes,
+                         size_t got, size_t max)
+{
+    inp_lines_consume(in, bytes, got);
+    if (got < max)
+        *want = WANT_MIN;
+    else if (*want < WANT_MAX)
+        *want *= 2;
+    return got;
+}
+
+size_t inp_fast_run(inp_deck *d, inp_lines *in, int nv, int threads,
+                    size_t *want)
+{
+    size_t len, max;
+    const char *w = window(in, want, &len, &max);
+    if (!w)
         return 0;
-    size_t len = (size_t)(nl + 1 - w), max = linepar_count(w, nl + 1);
     fast_ctx c = {d, d->nnodes, d->nelems, d->nconn, in->lineno + 1, nv};
-    if (in->lineno + max >= UINT32_MAX)
-        return 0;
     if (nv == 0) {
         if ((size_t)d->nnodes + max >= INT32_MAX / 3 - 1 ||
             inp_reserve_nodes(d, (size_t)d->nnodes + max))
@@ -211,36 +233,19 @@ size_t inp_fast_run(inp_deck *d, inp_lines *in, int nv, int threads,
         d->nelems += (int32_t)got;
         d->nconn += (int64_t)(got * (size_t)nv);
     }
-    inp_lines_consume(in, bytes, got);
-    if (got < max)
-        *want = WANT_MIN;
-    else if (*want < WANT_MAX)
-        *want *= 2;
-    return got;
+    return end_window(in, want, bytes, got, max);
 }
 
 size_t inp_fast_set(inp_deck *d, inp_lines *in, int threads, size_t *want)
 {
-    if (*want < WANT_MIN)
-        *want = WANT_MIN;
-    size_t avail;
-    const char *w = inp_lines_window(in, *want, &avail);
-    const char *nl = avail ? memrchr(w, '\n', avail) : NULL;
-    int k = nl ? set_line_ids(w) : 0;
-    if (!k)
-        return 0;
-    size_t len = (size_t)(nl + 1 - w), max = linepar_count(w, nl + 1);
-    if (in->lineno + max >= UINT32_MAX ||
-        (size_t)d->nitems + max * (size_t)k >= INT32_MAX ||
+    size_t len, max;
+    const char *w = window(in, want, &len, &max);
+    int k = w ? set_line_ids(w) : 0;
+    if (!k || (size_t)d->nitems + max * (size_t)k >= INT32_MAX ||
         INP_RESERVE(d->items, d->cap_items, (size_t)d->nitems + max * (size_t)k))
         return 0; /* the line reader says why */
     fast_ctx c = {d, 0, 0, d->nitems, in->lineno + 1, k};
     size_t bytes, got = linepar_run(w, len, max, threads, set_line, &c, &bytes);
     d->nitems += (int64_t)(got * (size_t)k);
-    inp_lines_consume(in, bytes, got);
-    if (got < max)
-        *want = WANT_MIN;
-    else if (*want < WANT_MAX)
-        *want *= 2;
-    return got;
+    return end_window(in, want, bytes, got, max);
 }

@@ -6,17 +6,20 @@
  * that moved (inp_node_text).  Most of a deck's node lines are plain data
  * lines, one node each, so runs of them are taken from the line reader's
  * window and rewritten on several threads (inp_node_run): the run is cut
- * into pieces at line starts, each piece writes its lines into its own
- * stretch of one output buffer (room for its bytes plus INP_NODE_GROW per
- * line), and the stretches go to the file in order.  Each line's text
+ * into pieces at line starts (linepar_pieces, as the readers' runs), each
+ * piece writes its lines into its own stretch of one output buffer (room
+ * for its bytes plus INP_NODE_GROW per line), and the stretches go to the
+ * file in order.  Each line's text
  * depends only on that line and its node, so the output is the same bytes
  * for any thread count.  A line that is not a plain data line (a comment,
  * a blank line, a keyword) or not the node expected (the file changed)
  * stops the run there; inp_writer.c then handles that line alone, as
  * before.
  */
+#define _GNU_SOURCE /* memrchr */
 #include "inp_internal.h"
 #include "getme_alloc.h"
+#include "linepar.h"
 
 #include <math.h>
 #include <omp.h>
@@ -24,7 +27,6 @@
 #include <string.h>
 
 #define NODE_WANT ((size_t)8 << 20) /* bytes of a run's window          */
-#define MAX_PIECES 64
 #define MIN_PARALLEL_LINES 4096
 
 static char *put(char *d, const char *s, size_t n)
@@ -115,36 +117,20 @@ int inp_node_run(inp_node_out *o, inp_lines *in, int32_t *node,
 {
     size_t avail;
     const char *w = inp_lines_window(in, NODE_WANT, &avail);
-    /* the run: up to *remain whole lines of the window, line starts noted
-       where pieces may begin */
-    int np = o->threads > 1 ? 4 * o->threads : 1;
-    if (np > MAX_PIECES)
-        np = MAX_PIECES;
-    const char *cut[MAX_PIECES + 1];
-    size_t first[MAX_PIECES + 1];
-    size_t interval = avail / (size_t)np + 1, nlines = 0;
-    const char *p = w, *end = w + avail, *next_cut = w + interval;
-    int ncut = 1;
-    cut[0] = w;
-    first[0] = 0;
-    while (nlines < (size_t)*remain && p < end) {
-        const char *nl = memchr(p, '\n', (size_t)(end - p));
-        if (!nl)
-            break;
-        p = nl + 1;
-        nlines++;
-        if (p >= next_cut && ncut < np) {
-            cut[ncut] = p;
-            first[ncut++] = nlines;
-            next_cut = p + interval;
-        }
-    }
+    const char *nl = avail ? memrchr(w, '\n', avail) : NULL;
+    if (!nl)
+        return 0;
+    /* the run: up to *remain whole lines of the window, in pieces */
+    int np = o->threads > 1 ? 4 * o->threads : 1, ncut;
+    if (np > LINEPAR_MAX_PIECES)
+        np = LINEPAR_MAX_PIECES;
+    const char *cut[LINEPAR_MAX_PIECES + 1];
+    size_t first[LINEPAR_MAX_PIECES + 1];
+    size_t nlines = linepar_pieces(w, (size_t)(nl + 1 - w), (size_t)*remain,
+                                   np, cut, first, &ncut);
     if (nlines == 0)
         return 0;
-    if (cut[ncut - 1] == p) /* no empty last piece */
-        ncut--;
-    cut[ncut] = p;
-    first[ncut] = nlines;
+    const char *p = cut[ncut];
     size_t bytes = (size_t)(p - w), need = bytes + nlines * INP_NODE_GROW;
     if (need > o->cap) {
         char *b = getme__realloc(o->buf, need);
@@ -153,10 +139,10 @@ int inp_node_run(inp_node_out *o, inp_lines *in, int32_t *node,
         o->buf = b;
         o->cap = need;
     }
-    const char *stop[MAX_PIECES];
-    char *dend[MAX_PIECES];
-    size_t done[MAX_PIECES];
-    int32_t mv[MAX_PIECES];
+    const char *stop[LINEPAR_MAX_PIECES];
+    char *dend[LINEPAR_MAX_PIECES];
+    size_t done[LINEPAR_MAX_PIECES];
+    int32_t mv[LINEPAR_MAX_PIECES];
     int threads = nlines >= MIN_PARALLEL_LINES ? o->threads : 1;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) \
     if (threads > 1)
