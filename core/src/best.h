@@ -44,7 +44,8 @@ getme_status getme__best_note(getme_best *b, const getme_run *run);
 
 /* run->ws->x becomes the best coordinates and run->q their qualities:
    after a log, those of the stars of the nodes put back (no other element
-   changed since the best iteration's qualities, which were current then),
+   changed since the best iteration's qualities, which were current then;
+   every element's in one parallel sweep when those stars are large),
    after a whole copy every element's.  GETME_OK; GETME_CHECK_SUMS builds
    compare with a recomputation of every element (GETME_ERR_STATE if they
    differ, or GETME_ERR_NOMEM without room for the check). */
