@@ -865,6 +865,7 @@ typedef struct sweep_ctx {
     getme_levels lv;
     sweep_rec *rec;
     int64_t cap_rec;
+    int marks_zero; /* run->elems zeroed for the levels' marks */
 } sweep_ctx;
 
 /* Replay a worker's memo events into the memo (merge after a level). */
@@ -1168,8 +1169,15 @@ static getme_status pass_sweeps(sweep_ctx *c, double *budget)
             if (!c->rec)
                 return GETME_ERR_NOMEM;
         }
+        /* the run's element list is free after the iterations: zeroed
+           once here, and levels_build leaves it zeroed */
+        if (!c->marks_zero) {
+            memset(c->run->elems, 0, (size_t)c->run->ws->ne * sizeof *c->run->elems);
+            c->marks_zero = 1;
+        }
         getme_status st = getme__levels_build(&c->lv, c->run->ws, c->list,
-                                              c->n, LEVELLED_CHUNK);
+                                              c->n, LEVELLED_CHUNK,
+                                              c->run->elems);
         if (st != GETME_OK)
             return st;
 #ifndef GETME_FINISH_TEST

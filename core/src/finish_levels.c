@@ -11,75 +11,36 @@ void getme__levels_free(getme_levels *lv)
     free(lv->level);
     free(lv->order);
     free(lv->ptr);
-    free(lv->key);
-    free(lv->mark);
+    free(lv->touched);
     free(lv->slot);
     free(lv->cfirst);
     memset(lv, 0, sizeof *lv);
 }
 
-static uint32_t probe(const getme_levels *lv, int32_t e)
-{
-    uint32_t mask = lv->mcap - 1, i = ((uint32_t)e * 2654435761u) & mask;
-    while (lv->key[i] >= 0 && lv->key[i] != e)
-        i = (i + 1) & mask;
-    return i;
-}
-
-/* Marks with room for cap (a power of two) keeping the old ones; 0 or -1
-   (then lv is as it was). */
-static int marks_grow(getme_levels *lv, uint32_t cap)
-{
-    int32_t *key = getme__malloc((size_t)cap * sizeof *key);
-    int32_t *mark = getme__malloc((size_t)cap * sizeof *mark);
-    if (!key || !mark) {
-        free(key), free(mark);
-        return -1;
-    }
-    for (uint32_t i = 0; i < cap; i++)
-        key[i] = -1;
-    getme_levels old = *lv;
-    lv->key = key, lv->mark = mark, lv->mcap = cap;
-    for (uint32_t k = 0; k < old.mcap; k++)
-        if (old.key[k] >= 0) {
-            uint32_t j = probe(lv, old.key[k]);
-            lv->key[j] = old.key[k];
-            lv->mark[j] = old.mark[k];
-        }
-    free(old.key), free(old.mark);
-    return 0;
-}
-
-/* Room in lv->slot for one patch, in the marks for its elements to be
-   added (at most half full after); 0 or -1. */
+/* Room in lv->slot for one patch of refs entries, and in lv->touched for
+   as many elements more; 0 or -1 (then lv is as it was). */
 static int reserve(getme_levels *lv, int64_t refs)
 {
     if (refs > lv->cap_s) {
-        uint32_t *s = getme__realloc(lv->slot, (size_t)refs * sizeof *s);
+        int32_t *s = getme__realloc(lv->slot, (size_t)refs * sizeof *s);
         if (!s)
             return -1;
         lv->slot = s, lv->cap_s = refs;
     }
-    uint32_t cap = lv->mcap ? lv->mcap : 1024;
-    while (2 * ((uint64_t)lv->used + (uint64_t)refs) > cap)
-        cap *= 2;
-    return cap > lv->mcap ? marks_grow(lv, cap) : 0;
-}
-
-/* The slot of element e, created with mark 0 (room reserved). */
-static uint32_t slot_of(getme_levels *lv, int32_t e)
-{
-    uint32_t i = probe(lv, e);
-    if (lv->key[i] < 0) {
-        lv->key[i] = e, lv->mark[i] = 0;
-        lv->used++;
+    if (lv->used + refs > lv->cap_t) {
+        int64_t cap = lv->used + refs > 2 * lv->cap_t ? lv->used + refs
+                                                      : 2 * lv->cap_t;
+        int32_t *t = getme__realloc(lv->touched, (size_t)cap * sizeof *t);
+        if (!t)
+            return -1;
+        lv->touched = t, lv->cap_t = cap;
     }
-    return i;
+    return 0;
 }
 
-/* Element e's patch (free nodes w[0..k)) as slots in lv->slot; their
-   count, or -1 without memory. */
-static int64_t patch_slots(getme_levels *lv, const getme_ws *ws, int32_t e,
+/* Element e's patch (free nodes w[0..k)) into lv->slot, repeats allowed;
+   its length, or -1 without memory. */
+static int64_t patch_elems(getme_levels *lv, const getme_ws *ws, int32_t e,
                            const int32_t *w, int k)
 {
     int64_t refs = 1;
@@ -89,22 +50,30 @@ static int64_t patch_slots(getme_levels *lv, const getme_ws *ws, int32_t e,
         return -1;
     int64_t m = 0;
     if (k == 0) /* it only reads its own quality */
-        lv->slot[m++] = slot_of(lv, e);
+        lv->slot[m++] = e;
     for (int j = 0; j < k; j++)
 #ifdef GETME_FINISH_MUTANT /* test builds: a broken rule must be caught */
         if (j == 0)
 #endif
         {
             getme_star_it it = getme__star_open(ws, w[j]);
-            for (int32_t e; getme__star_next(&it, &e);)
-                lv->slot[m++] = slot_of(lv, e);
+            for (int32_t a; getme__star_next(&it, &a);)
+                lv->slot[m++] = a;
         }
     return m;
 }
 
+/* The marks back to zero (every element lv->touched lists). */
+static void clear_marks(getme_levels *lv, int32_t *mark)
+{
+    for (int64_t i = 0; i < lv->used; i++)
+        mark[lv->touched[i]] = 0;
+    lv->used = 0;
+}
+
 getme_status getme__levels_build(getme_levels *lv, const getme_ws *ws,
                                  const getme_ranked *list, int32_t n,
-                                 int32_t chunk)
+                                 int32_t chunk, int32_t *mark)
 {
     int32_t nc = n ? (n - 1) / chunk + 1 : 0;
     if (nc + 1 > lv->cap_c) {
@@ -124,8 +93,6 @@ getme_status getme__levels_build(getme_levels *lv, const getme_ws *ws,
             return GETME_ERR_NOMEM;
         lv->order = b, lv->cap = n;
     }
-    for (uint32_t i = 0; i < lv->mcap; i++)
-        lv->key[i] = -1;
     lv->used = 0;
     int32_t num = 0;
     for (int32_t i = 0; i < n; i++) {
@@ -135,22 +102,29 @@ getme_status getme__levels_build(getme_levels *lv, const getme_ws *ws,
         for (int j = 0; j < getme__nv[t]; j++)
             if (!ws->fixed[c[j]])
                 w[k++] = c[j];
-        int64_t m = patch_slots(lv, ws, e, w, k);
-        if (m < 0)
+        int64_t m = patch_elems(lv, ws, e, w, k);
+        if (m < 0) {
+            clear_marks(lv, mark);
             return GETME_ERR_NOMEM;
+        }
         if (i % chunk == 0) /* a chunk starts above every earlier level */
             lv->cfirst[i / chunk] = num;
         /* marks are 1 + a level: L is the new level (earlier chunks'
            marks are at most num, their chunk's start) */
         int32_t L = lv->cfirst[i / chunk];
+        const int32_t *sl = lv->slot;
         for (int64_t r = 0; r < m; r++)
-            L = lv->mark[lv->slot[r]] > L ? lv->mark[lv->slot[r]] : L;
-        for (int64_t r = 0; r < m; r++)
-            lv->mark[lv->slot[r]] = L + 1;
+            L = mark[sl[r]] > L ? mark[sl[r]] : L;
+        for (int64_t r = 0; r < m; r++) {
+            if (!mark[sl[r]]) /* first touched: cleared at the end */
+                lv->touched[lv->used++] = sl[r];
+            mark[sl[r]] = L + 1;
+        }
         lv->level[i] = L;
         num = L + 1 > num ? L + 1 : num;
     }
     lv->cfirst[nc] = num;
+    clear_marks(lv, mark);
     if (num + 1 > lv->cap_ptr) {
         int32_t *p = getme__realloc(lv->ptr, (size_t)(num + 1) * sizeof *p);
         if (!p)
