@@ -18,7 +18,6 @@
 
 #include <string.h>
 
-#define MAX_PIECES LINEPAR_MAX_PIECES
 #define NMARK 256 /* line starts noted per run, where pieces may start */
 /* Below this many bytes a run is parsed by the calling thread: starting a
    team costs a few microseconds, parsing 256 KiB about a millisecond. */
@@ -28,7 +27,7 @@ int linepar_threads(int threads, size_t len)
 {
     if (threads < 1 || len < MIN_PARALLEL_BYTES)
         return 1;
-    return threads > MAX_PIECES ? MAX_PIECES : threads;
+    return threads > LINEPAR_MAX_PIECES ? LINEPAR_MAX_PIECES : threads;
 }
 
 size_t linepar_count(const char *p, const char *end)
@@ -116,9 +115,10 @@ size_t linepar_run(const char *text, size_t len, size_t max, int threads,
        loaded machine a thread that is not running does not hold up the
        others for its whole share. */
     int t = linepar_threads(threads, len);
-    int want = 4 * t > MAX_PIECES ? MAX_PIECES : 4 * t, np;
-    const char *cut[MAX_PIECES + 1], *stop_at[MAX_PIECES];
-    size_t first[MAX_PIECES + 1], stop[MAX_PIECES];
+    int want = 4 * t > LINEPAR_MAX_PIECES ? LINEPAR_MAX_PIECES : 4 * t;
+    int np;
+    const char *cut[LINEPAR_MAX_PIECES + 1], *stop_at[LINEPAR_MAX_PIECES];
+    size_t first[LINEPAR_MAX_PIECES + 1], stop[LINEPAR_MAX_PIECES];
     size_t nrun = linepar_pieces(text, len, max, want, cut, first, &np);
     const char *run_end = cut[np];
     if (linepar_threads(threads, (size_t)(run_end - text)) == 1) {

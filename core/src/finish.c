@@ -1172,7 +1172,8 @@ static getme_status pass_sweeps(sweep_ctx *c, double *budget)
         /* the run's element list is free after the iterations: zeroed
            once here, and levels_build leaves it zeroed */
         if (!c->marks_zero) {
-            memset(c->run->elems, 0, (size_t)c->run->ws->ne * sizeof *c->run->elems);
+            memset(c->run->elems, 0,
+                   (size_t)c->run->ws->ne * sizeof *c->run->elems);
             c->marks_zero = 1;
         }
         getme_status st = getme__levels_build(&c->lv, c->run->ws, c->list,

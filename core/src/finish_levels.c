@@ -12,20 +12,20 @@ void getme__levels_free(getme_levels *lv)
     free(lv->order);
     free(lv->ptr);
     free(lv->touched);
-    free(lv->slot);
+    free(lv->patch);
     free(lv->cfirst);
     memset(lv, 0, sizeof *lv);
 }
 
-/* Room in lv->slot for one patch of refs entries, and in lv->touched for
+/* Room in lv->patch for one patch of refs entries, and in lv->touched for
    as many elements more; 0 or -1 (then lv is as it was). */
 static int reserve(getme_levels *lv, int64_t refs)
 {
-    if (refs > lv->cap_s) {
-        int32_t *s = getme__realloc(lv->slot, (size_t)refs * sizeof *s);
-        if (!s)
+    if (refs > lv->cap_p) {
+        int32_t *p = getme__realloc(lv->patch, (size_t)refs * sizeof *p);
+        if (!p)
             return -1;
-        lv->slot = s, lv->cap_s = refs;
+        lv->patch = p, lv->cap_p = refs;
     }
     if (lv->used + refs > lv->cap_t) {
         int64_t cap = lv->used + refs > 2 * lv->cap_t ? lv->used + refs
@@ -38,7 +38,7 @@ static int reserve(getme_levels *lv, int64_t refs)
     return 0;
 }
 
-/* Element e's patch (free nodes w[0..k)) into lv->slot, repeats allowed;
+/* Element e's patch (free nodes w[0..k)) into lv->patch, repeats allowed;
    its length, or -1 without memory. */
 static int64_t patch_elems(getme_levels *lv, const getme_ws *ws, int32_t e,
                            const int32_t *w, int k)
@@ -50,7 +50,7 @@ static int64_t patch_elems(getme_levels *lv, const getme_ws *ws, int32_t e,
         return -1;
     int64_t m = 0;
     if (k == 0) /* it only reads its own quality */
-        lv->slot[m++] = e;
+        lv->patch[m++] = e;
     for (int j = 0; j < k; j++)
 #ifdef GETME_FINISH_MUTANT /* test builds: a broken rule must be caught */
         if (j == 0)
@@ -58,7 +58,7 @@ static int64_t patch_elems(getme_levels *lv, const getme_ws *ws, int32_t e,
         {
             getme_star_it it = getme__star_open(ws, w[j]);
             for (int32_t a; getme__star_next(&it, &a);)
-                lv->slot[m++] = a;
+                lv->patch[m++] = a;
         }
     return m;
 }
@@ -112,7 +112,7 @@ getme_status getme__levels_build(getme_levels *lv, const getme_ws *ws,
         /* marks are 1 + a level: L is the new level (earlier chunks'
            marks are at most num, their chunk's start) */
         int32_t L = lv->cfirst[i / chunk];
-        const int32_t *sl = lv->slot;
+        const int32_t *sl = lv->patch;
         for (int64_t r = 0; r < m; r++)
             L = mark[sl[r]] > L ? mark[sl[r]] : L;
         for (int64_t r = 0; r < m; r++) {

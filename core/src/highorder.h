@@ -79,7 +79,9 @@ typedef struct getme_ho_ws {
 } getme_ho_ws;
 
 /* The node det J ratio (min / max of det J at the nodes) smoothing keeps
-   an element at: it never goes below min(this, its ratio at the start). */
+   an element at: it never goes below min(this, its ratio at the start).
+   Also the ratio the repair pulls an element invalid at a node up to
+   (getme__ho_repair), so that smoothing keeps what the repair made. */
 #define GETME_HO_RATIO_FLOOR 0.1
 
 /* Attach the mesh's second-order elements to a freshly built workspace

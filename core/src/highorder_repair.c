@@ -12,8 +12,9 @@
  * from its straight position, until no such element is left or 64 rounds
  * (2^-64 of the offset: straight to rounding) are done.  An element found
  * invalid is pulled on until the ratio of its smallest to its largest
- * det J at the nodes is REPAIR_RATIO (Gmsh's default target for its own
- * high-order optimizer, Mesh.HighOrderThresholdMin) or its free nodes are
+ * det J at the nodes is GETME_HO_RATIO_FLOOR, 0.1 (Gmsh's default target
+ * for its own high-order optimizer, Mesh.HighOrderThresholdMin, and the
+ * floor smoothing then keeps, highorder.h) or its free nodes are
  * straight: stopping as soon as it is valid left elements valid by a
  * rounding (ratio 0.0000 on a sphere whose mid-nodes were displaced, five
  * of them below 1e-6 by Gmsh's measure), which no solver accepts.
@@ -30,7 +31,6 @@
 #include <string.h>
 
 #define REPAIR_ROUNDS 64
-#define REPAIR_RATIO 0.1
 
 static int corners_valid(const getme_ws *ws, int32_t e)
 {
@@ -65,11 +65,11 @@ static double rel_offset(const getme_ho_ws *ho, int32_t h)
 }
 
 /* Invalid at a node with valid corners; or found so before (was_bad) and
-   not yet REPAIR_RATIO. */
+   not yet GETME_HO_RATIO_FLOOR. */
 static int needs_repair(const getme_ws *ws, int32_t e, int was_bad)
 {
     return ws->ho->etype[e] >= 0 && corners_valid(ws, e) &&
-           (was_bad ? getme__ho_ratio(ws, ws->x, e) < REPAIR_RATIO
+           (was_bad ? getme__ho_ratio(ws, ws->x, e) < GETME_HO_RATIO_FLOOR
                     : !getme__ho_valid(ws, ws->x, e));
 }
 

@@ -433,7 +433,8 @@ getme_status getme__ho_floor_start(getme_ws *ws)
     if (!ho)
         return GETME_OK;
     free(ho->floor);
-    ho->floor = getme__malloc((size_t)(ws->ne ? ws->ne : 1) * sizeof *ho->floor);
+    ho->floor =
+        getme__malloc((size_t)(ws->ne ? ws->ne : 1) * sizeof *ho->floor);
     if (!ho->floor)
         return GETME_ERR_NOMEM;
 #pragma omp parallel for schedule(static) num_threads(ws->nt)
@@ -449,9 +450,7 @@ int getme__ho_accept(const getme_ws *ws, const double *coords, int32_t e)
     const getme_ho_ws *ho = ws->ho;
     if (!ho->floor)
         return getme__ho_valid(ws, coords, e);
-    if (ho->etype[e] < 0)
-        return 1;
-    double r = getme__ho_ratio(ws, coords, e);
+    double r = getme__ho_ratio(ws, coords, e); /* 1: checked at corners */
     return r > 0.0 && r >= ho->floor[e];
 }
 
