@@ -1,7 +1,7 @@
 #!/usr/bin/python3
-"""big_meshes.py KIND SIZE OUT -- inputs for size tests beyond the benchmark's
-own meshes (docs/bench.md, "Session 26"): meshes nobody tuned getme on, at
-sizes the benchmark does not reach.
+"""big_meshes.py KIND SIZE OUT [BINARY_OUT] -- inputs for size tests
+beyond the benchmark's own meshes (docs/bench.md, "Session 26"): meshes
+nobody tuned getme on, at sizes the benchmark does not reach.
 
   part SIZE   a real CAD part as a user meshes it: an OpenCASCADE block
               with eight through holes, fragmented with a sphere and a box
@@ -10,7 +10,8 @@ sizes the benchmark does not reach.
               Mesh.Optimize = 0 (raw Delaunay tets, slivers included).
               SIZE is the largest mesh size: 0.066 gives ~3.0M tets,
               0.042 ~11.2M (about 90 s and 5 GB in Gmsh on 2 cores).
-              Writes OUT as MSH 4.1 ASCII and OUT-bin.msh as binary.
+              Writes OUT as MSH 4.1 ASCII, and BINARY_OUT, if given, as
+              binary (no other file is written).
   kuhn N      an N x N x N box of cubes, each split into 6 tets along its
               diagonal (6 N^3 tets, (N + 1)^3 nodes), written straight as
               MSH 4.1 binary without Gmsh (N = 171: 30.0M tets, 1.36 GB,
@@ -18,7 +19,8 @@ sizes the benchmark does not reach.
               (0.7560): distort it first (getme distort --seed 1), and the
               smoother should bring it back near that value.
 
-  /usr/bin/python3 bench/big_meshes.py part 0.066 /work/cache/cad3.msh
+  /usr/bin/python3 bench/big_meshes.py part 0.066 /work/cache/cad3.msh \\
+      /work/cache/cad3-bin.msh
   /usr/bin/python3 bench/big_meshes.py kuhn 171 /work/cache/kuhn30.msh
 """
 import sys
@@ -26,7 +28,7 @@ import sys
 import numpy as np
 
 
-def part(h, out):
+def part(h, out, binary_out):
     import gmsh
     gmsh.initialize()
     gmsh.option.setNumber("General.Terminal", 1)
@@ -53,8 +55,9 @@ def part(h, out):
     gmsh.model.mesh.generate(3)
     gmsh.option.setNumber("Mesh.Binary", 0)
     gmsh.write(out)
-    gmsh.option.setNumber("Mesh.Binary", 1)
-    gmsh.write(out[:-4] + "-bin.msh" if out.endswith(".msh") else out + "-bin")
+    if binary_out:
+        gmsh.option.setNumber("Mesh.Binary", 1)
+        gmsh.write(binary_out)
     gmsh.finalize()
 
 
@@ -108,10 +111,11 @@ def kuhn(n, out):
 
 
 def main(argv):
-    if len(argv) != 4 or argv[1] not in ("part", "kuhn"):
+    if not (len(argv) == 4 or (len(argv) == 5 and argv[1] == "part")) or \
+            argv[1] not in ("part", "kuhn"):
         sys.exit(__doc__)
     if argv[1] == "part":
-        part(float(argv[2]), argv[3])
+        part(float(argv[2]), argv[3], argv[4] if len(argv) == 5 else None)
     else:
         kuhn(int(argv[2]), argv[3])
 
