@@ -9,10 +9,12 @@
       awk '/^TT/ {t[substr($0, 13)] += $2} END {for (k in t) printf "%8.4f %s\n", t[k], k}'
 
 Inserts `TT(name)` calls that print "TT <seconds since the last mark>
-<name>" to stderr at the steps of the set-up (getme__adj_build, the run's
-arrays, the first qualities, the blocks' edge lists, the Eq. 9 sums),
-of every iteration (scatter, new nodes, relaxation, update of the sums)
-and of the q*min stage's cycles and finishing step.  Nothing else
+<name>" to stderr at the steps of the reader's workspace and boundary
+search (since session 27), of each sweep of the quality measures, of
+the set-up (getme__adj_build, the run's arrays, the first qualities,
+the blocks' edge lists, the Eq. 9 sums), of every iteration (scatter,
+new nodes, relaxation, update of the sums) and of the q*min stage's
+cycles and finishing step.  Nothing else
 changes: the output file is the same bits (cmp it against the
 uninstrumented build).
 
@@ -37,6 +39,37 @@ MACROS = (
 
 # file -> [(anchor, replacement)]: each anchor's first occurrence
 PATCHES = {
+    "core/src/workspace.c": [
+        ("    if (mesh->mirror < 0)\n        getme__detect_orientation(mesh);\n    ws->dim",
+         "    TT0();\n    if (mesh->mirror < 0)\n        getme__detect_orientation(mesh);\n"
+         "    ws->dim"),
+        ("    if ((st = number_nodes(ws, mesh, renumber)) != GETME_OK)\n        goto fail;",
+         "    TT(\"ws: order_elements\");\n"
+         "    if ((st = number_nodes(ws, mesh, renumber)) != GETME_OK)\n        goto fail;\n"
+         "    TT(\"ws: number_nodes\");"),
+        ("    if ((st = build_stars(ws)) != GETME_OK)\n        goto fail;\n    read_fixed(ws, mesh);",
+         "    TT(\"ws: coordinates\");\n    if ((st = build_stars(ws)) != GETME_OK)\n"
+         "        goto fail;\n    TT(\"ws: build_stars\");\n    read_fixed(ws, mesh);"),
+        ("    if ((st = colour_blocks(ws)) != GETME_OK)\n        goto fail;\n    return GETME_OK;",
+         "    TT(\"ws: read_fixed\");\n    if ((st = colour_blocks(ws)) != GETME_OK)\n"
+         "        goto fail;\n    TT(\"ws: colour_blocks\");\n    return GETME_OK;"),
+    ],
+    "core/src/topology.c": [
+        ("    int64_t foff[GETME_NUM_TYPES];\n    int64_t total = getme__ws_face_offsets(&ws, foff);",
+         "    TT0();\n    int64_t foff[GETME_NUM_TYPES];\n"
+         "    int64_t total = getme__ws_face_offsets(&ws, foff);"),
+        ("    const getme_facenb *fnb = &ws.faces;",
+         "    TT(\"boundary: faces, pack\");\n    const getme_facenb *fnb = &ws.faces;"),
+        ("    free(touch);\n",
+         "    free(touch);\n    TT(\"boundary: touch, mark\");\n"),
+    ],
+    "core/src/measures.c": [
+        ("    int nt = omp_get_max_threads();\n    double *v =",
+         "    TT0();\n    int nt = omp_get_max_threads();\n    double *v ="),
+        ("    free(v);\n    free(part);\n    return GETME_OK;\n}",
+         "    TT(\"measures: one sweep\");\n    free(v);\n    free(part);\n"
+         "    return GETME_OK;\n}"),
+    ],
     "core/src/smooth.c": [
         ("    getme__ws_lend_conn(&ws, mesh); /* back at done: */",
          "    TT0();\n    getme__ws_lend_conn(&ws, mesh); /* back at done: */"),
