@@ -156,7 +156,7 @@ def main():
                 for name, _ in runs:
                     a1, a2 = med[(name, threads[0])], med[(name, threads[-1])]
                     lines.append(f"| {short} | {threads[0]}→{threads[-1]} | speedup {name} | "
-                                 f"| | | {a1['ns1'] / a2['ns1']:.2f} | | | | "
+                                 f"| | | | {a1['ns1'] / a2['ns1']:.2f} | | | | "
                                  f"{a1['total'] / a2['total']:.2f} | | | | | |")
     text = "\n".join(lines)
     print(text)
