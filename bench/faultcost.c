@@ -31,29 +31,46 @@ static double now(void)
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-static void round_of(size_t n, int huge, int populate)
+enum { ALIGN = 2 << 20 }; /* one huge page */
+
+/* n bytes of fresh anonymous memory from a 2 MiB boundary, advised as
+   wanting huge pages or not; *base is the mapping to unmap (n + ALIGN
+   bytes).  Exits on failure: a measuring aid. */
+static char *map_aligned(size_t n, int huge, char **base)
 {
-    const size_t align = (size_t)2 << 20;
-    double t0 = now();
-    char *m = mmap(NULL, n + align, PROT_READ | PROT_WRITE,
+    char *m = mmap(NULL, n + ALIGN, PROT_READ | PROT_WRITE,
                    MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     if (m == MAP_FAILED) {
         perror("mmap");
         exit(1);
     }
-    char *a = (char *)(((uintptr_t)m + align - 1) & ~(uintptr_t)(align - 1));
+    char *a = (char *)(((uintptr_t)m + ALIGN - 1) & ~(uintptr_t)(ALIGN - 1));
     (void)madvise(a, n, huge ? MADV_HUGEPAGE : MADV_NOHUGEPAGE);
+    *base = m;
+    return a;
+}
+
+/* One byte per cache line of [a, a + n). */
+static void touch(char *a, size_t n)
+{
+    for (size_t i = 0; i < n; i += 64)
+        a[i] = 1;
+}
+
+static void round_of(size_t n, int huge, int populate)
+{
+    double t0 = now();
+    char *m, *a = map_aligned(n, huge, &m);
     if (populate && madvise(a, n, MADV_POPULATE_WRITE) != 0)
         perror("MADV_POPULATE_WRITE");
     double t1 = now();
-    for (size_t i = 0; i < n; i += 64)
-        a[i] = 1;
+    touch(a, n);
     double t2 = now();
     printf("%-9s %-9s %6zu MiB: map%s %.3f s, first writes %.3f s, "
            "total %.3f s\n",
            huge ? "huge" : "4 KiB", populate ? "populate" : "", n >> 20,
            populate ? "+populate" : "", t1 - t0, t2 - t1, t2 - t0);
-    munmap(m, n + align);
+    munmap(m, n + ALIGN);
 }
 
 /* Growth past what was just freed (session 27): huge pages, n bytes
@@ -65,37 +82,18 @@ static void round_of(size_t n, int huge, int populate)
    allocates below it. */
 static void growth(size_t n)
 {
-    const size_t align = (size_t)2 << 20;
-    size_t total = 2 * n + align;
-    char *m = mmap(NULL, total, PROT_READ | PROT_WRITE,
-                   MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-    if (m == MAP_FAILED) {
-        perror("mmap");
-        exit(1);
-    }
-    char *a = (char *)(((uintptr_t)m + align - 1) & ~(uintptr_t)(align - 1));
-    (void)madvise(a, n, MADV_HUGEPAGE);
-    for (size_t i = 0; i < n; i += 64)
-        a[i] = 1;
-    munmap(m, total);
-    m = mmap(NULL, total, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS,
-             -1, 0);
-    if (m == MAP_FAILED) {
-        perror("mmap");
-        exit(1);
-    }
-    a = (char *)(((uintptr_t)m + align - 1) & ~(uintptr_t)(align - 1));
-    (void)madvise(a, 2 * n, MADV_HUGEPAGE);
+    char *m, *a = map_aligned(n, 1, &m);
+    touch(a, n);
+    munmap(m, n + ALIGN);
+    a = map_aligned(2 * n, 1, &m);
     double t0 = now();
-    for (size_t i = 0; i < n; i += 64)
-        a[i] = 1;
+    touch(a, n);
     double t1 = now();
-    for (size_t i = n; i < 2 * n; i += 64)
-        a[i] = 1;
+    touch(a + n, n);
     double t2 = now();
     printf("growth    huge      %6zu MiB after freeing %zu: first half %.3f s, "
            "second half %.3f s\n", (2 * n) >> 20, n >> 20, t1 - t0, t2 - t1);
-    munmap(m, total);
+    munmap(m, 2 * n + ALIGN);
 }
 
 int main(int argc, char **argv)
