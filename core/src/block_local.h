@@ -35,7 +35,8 @@
  * thread runs its part's interior blocks in element order (no two parts'
  * interior blocks share a node).  The blocks left (the parts' interfaces:
  * ~30 % of the 1M tets' blocks with 2 parts) are dealt into parts again
- * by position across the interfaces, twice, and the few left after that run colour by
+ * by position across the interfaces (block_local.c, deal_next), twice,
+ * and the few left after that run colour by
  * colour as before.  Any race-free order gives the same bits: the sums are
  * exact integers (exact.h) and every other result is per element.
  */
