@@ -14,7 +14,9 @@ search (since session 27), of each sweep of the quality measures, of
 the set-up (getme__adj_build, the run's arrays, the first qualities,
 the blocks' edge lists, the Eq. 9 sums), of every iteration (scatter,
 new nodes, relaxation, update of the sums) and of the q*min stage's
-cycles and finishing step.  Nothing else
+cycles and finishing step, and (since session 28) of the block sweeps'
+phases (getme__blocks_run: each level of the parts, then the colours,
+summed over all sweeps, on block_local.c's own clock).  Nothing else
 changes: the output file is the same bits (cmp it against the
 uninstrumented build).
 
@@ -62,6 +64,22 @@ PATCHES = {
          "    TT(\"boundary: faces, pack\");\n    const getme_facenb *fnb = &ws.faces;"),
         ("    free(touch);\n",
          "    free(touch);\n    TT(\"boundary: touch, mark\");\n"),
+    ],
+    "core/src/block_local.c": [
+        # getme__blocks_run's phases (session 28): the parts' levels and
+        # the colours, summed over every block sweep (scatter, first trial
+        # pass, Eq. 9 sums); this file's own clock, so the other files'
+        # timers keep their meaning
+        ("    int64_t total = 0;\n    int np = blk->num_parts;\n",
+         "    int64_t total = 0;\n    int np = blk->num_parts;\n    TT0();\n"),
+        ("                total += f(ctx, blk->order[k]);\n    }\n",
+         "                total += f(ctx, blk->order[k]);\n"
+         "        if (l == 0)\n            TT(\"blocks: level 0\");\n"
+         "        else if (l == 1)\n            TT(\"blocks: level 1\");\n"
+         "        else\n            TT(\"blocks: level 2+\");\n    }\n"),
+        ("            total += f(ctx, blk->order[k]);\n    }\n    return total;",
+         "            total += f(ctx, blk->order[k]);\n    }\n"
+         "    TT(\"blocks: colours\");\n    return total;"),
     ],
     "core/src/measures.c": [
         ("    int nt = omp_get_max_threads();\n    double *v =",
