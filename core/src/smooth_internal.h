@@ -73,6 +73,8 @@ typedef struct getme_run {
                            element, which it then does not hold (relax.c) */
     int32_t num_nodes, num_elems;
     int32_t *list;      /* nn: scratch node list (relaxation, sum updates)  */
+    int32_t first_steps; /* nodes the relaxation stepped down the table
+                            for the first time (getme__relax's count)    */
     /* GETMe adaptive only (getme_adaptive.c): */
     struct getme_adj *adj; /* Eq. 9 sums (adjacency.h)                      */
     /* Set (to adj) in the q_mean stage, where run->elems is every free
@@ -255,7 +257,8 @@ static inline void getme__place_first(double *x, unsigned char *xold,
  * nodes of invalid elements down the table until no element is invalid.
  * R's last entry is 0, so a node can always go back to where it was and the
  * mesh stays valid.  Updates ws->x and run->q; returns how many nodes
- * ended beyond the table's first entry.
+ * ended beyond the table's first entry (GETME_CHECK_SUMS builds: -1 if
+ * the count kept while stepping differs from a count over I_T).
  */
 int32_t getme__relax(getme_run *run, const double *R, int nR);
 
