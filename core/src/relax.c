@@ -439,13 +439,13 @@ static void step_nodes(getme_run *run, const double *R, int nR, int32_t m,
     const getme_ws *ws = run->ws;
     for (int32_t j = 0; j < m; j++) {
         int32_t i = run->list[j];
+        /* the count getme__relax returns: every node of I_T starts the
+           relaxation at index 0 (getme__place_first) */
+        run->first_steps += run->ridx[i] == 0;
         /* The q_mean stage with a slot map: the p-hat is the position at
            R[0] = 1 until the first step keeps it.  If the pool cannot
            grow for it, the node goes straight back to its old position
            (R's last entry, 0, needs no p-hat): still a valid mesh. */
-        /* the count getme__relax returns: every node of I_T starts the
-           relaxation at index 0 (getme__place_first) */
-        run->first_steps += run->ridx[i] == 0;
         if (run->save_phat && run->ridx[i] == 0 &&
             getme__save_phat(run, i) != GETME_OK)
             run->ridx[i] = (uint8_t)(nR - 2);
