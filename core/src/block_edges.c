@@ -141,11 +141,16 @@ void getme__blocks_edges(getme_blocks *blk, const getme_adj *adj,
         /* room for ~2.25 entries per tet (2.1 on the benchmark tets) */
         int64_t room = (int64_t)(ws->block_start[b1] - ws->block_start[b0]) *
                        9 / 4 + most;
-        bufs[th] = getme__malloc((size_t)room * sizeof **bufs);
-        ok = bufs[th] != NULL;
+        /* the buffer and its length on the thread's stack while it
+           works: adjacent in bufs[] and lens[], the threads' entries
+           share a cache line */
+        int32_t *buf = getme__malloc((size_t)room * sizeof *buf);
+        int64_t len = 0;
+        ok = buf != NULL;
         ok = ok && number_range(blk, adj, ws, b0, b1,
-                                tables + per * (size_t)th, cap, most,
-                                &bufs[th], &room, &lens[th]) == 0;
+                                tables + per * (size_t)th, cap, most, &buf,
+                                &room, &len) == 0;
+        bufs[th] = buf, lens[th] = len;
     }
     if (!ok)
         goto done;
@@ -168,8 +173,8 @@ void getme__blocks_edges(getme_blocks *blk, const getme_adj *adj,
     bufs[0] = NULL;
     for (int th = 1; th < team; th++) {
         int32_t b0 = (int32_t)((int64_t)nb * th / team);
-        memcpy(blk->edges + blk->eptr[b0], bufs[th],
-               (size_t)lens[th] * sizeof *blk->edges);
+        getme__copy(blk->edges + blk->eptr[b0], bufs[th],
+                    (size_t)lens[th] * sizeof *blk->edges, team);
     }
 done:
     for (int th = 0; bufs && th < nt; th++)

@@ -20,10 +20,14 @@
    Results do not depend on it: every loop is deterministic. */
 #define GETME_PAR_MIN 8192
 
-/* Per-thread dedupe marks for the Eq. 9 neighbour sums (weights.c). */
+/* Per-thread dedupe marks for the Eq. 9 neighbour sums (weights.c).  now
+   changes once per element walked, so each thread's is padded apart from
+   the others' (two threads writing one cache line slow each other down:
+   false sharing). */
 typedef struct getme_stamp {
     uint32_t *mark; /* ne entries */
     uint32_t now;
+    char pad[128 - sizeof(uint32_t *) - sizeof(uint32_t)];
 } getme_stamp;
 
 /* Scratch arrays of one smoothing run, allocated once. */
