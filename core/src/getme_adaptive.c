@@ -1643,6 +1643,9 @@ static getme_status alloc_adaptive(getme_run *run)
     size_t ne = (size_t)(ws->ne ? ws->ne : 1);
     run->tflag = getme__calloc(ne, 1);
     size_t nn = (size_t)(ws->nn ? ws->nn : 1);
+    /* without it the relaxation scans every element instead */
+    run->block_bad = getme__calloc((size_t)(ws->num_blocks ? ws->num_blocks : 1),
+                                   sizeof *run->block_bad);
     /* A pool of sums with a slot map (getme_run.facc, assign_slots), on
        one process (a distributed run sums every node's entry over the
        processes) and with a q_mean table from 1 (the p-hat is then the
@@ -1686,6 +1689,8 @@ static getme_status alloc_adaptive(getme_run *run)
 
 static void free_adaptive(getme_run *run)
 {
+    free(run->block_bad);
+    run->block_bad = NULL;
     free(run->tlist);
     free(run->tflag);
     free(run->qold);

@@ -76,6 +76,11 @@ typedef struct getme_run {
                            GETMe adaptive's q_mean stage (live) every free
                            element, which it then does not hold (relax.c) */
     int32_t num_nodes, num_elems;
+    /* GETMe adaptive's q_mean stage: how many of each block's free
+       elements the relaxation's first pass found invalid (relax.c), so the
+       list of them is made from those blocks alone; num_blocks entries,
+       or NULL (a scan over every element instead) */
+    int32_t *block_bad;
     int32_t *list;      /* nn: scratch node list (relaxation, sum updates)  */
     int32_t first_steps; /* nodes the relaxation stepped down the table
                             for the first time (getme__relax's count)    */
