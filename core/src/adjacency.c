@@ -354,8 +354,9 @@ static void counts_and_flags(getme_adj *adj, const getme_ws *ws,
 
 /* One thread's state of check_all's walk, on that thread's stack: now
    changes once per element, and in an array of them the threads' fields
-   shared a cache line (false sharing: the check of the full hexes ran
-   1.3x faster on two threads than on one). */
+   shared a cache line (false sharing, as build_edges' lengths did; the
+   check's own two-thread time did not move with it, docs/bench.md
+   session 29). */
 typedef struct union_scratch {
     uint32_t *stamp; /* ne: element last seen at this stamp value */
     const uint64_t *cv; /* ne: check_value of every element (shared) */
