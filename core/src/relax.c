@@ -268,11 +268,13 @@ static int32_t list_invalid(const getme_run *run, int32_t **bad, int64_t *cap,
        thread at any thread count. */
     const getme_ws *ws = run->ws;
     if (run->live && run->block_bad) {
-        for (int32_t b = 0; m < n && b < ws->num_blocks; b++)
-            for (int32_t e = ws->block_start[b];
-                 run->block_bad[b] > 0 && e < ws->block_start[b + 1]; e++)
+        for (int32_t b = 0; m < n && b < ws->num_blocks; b++) {
+            if (run->block_bad[b] == 0)
+                continue;
+            for (int32_t e = ws->block_start[b]; e < ws->block_start[b + 1]; e++)
                 if (is_invalid(run, list_elem(run, e)))
                     (*bad)[m++] = e;
+        }
         if (m == n)
             return m;
         m = 0; /* unreachable: the counts are the same elements' */
