@@ -167,6 +167,12 @@ typedef struct cli_guard {
 } cli_guard;
 void cli_write_guard(cli_guard *g, int on);
 
+/* Before the getme command re-executes itself (main.c): widen the
+   initial thread's CPU mask, which libgomp bound to its first place when
+   OMP_PROC_BIND or OMP_PLACES asked for binding, back to the union of its
+   places (affinity.c).  Nothing happens without binding. */
+void cli_affinity_unbind(void);
+
 int cli_smooth(int argc, char **argv);
 int cli_quality(int argc, char **argv);
 int cli_distort(int argc, char **argv);

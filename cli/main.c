@@ -58,13 +58,21 @@ static int list_formats(void)
    2 threads many times slower than 1: measured on 191k tets at load 5,
    1.85 s with 1 thread, 23.4 s with 2 spinning, 2.2 s with 2 waiting
    passively.  So unless the user chose a policy, restart once with
-   passive waiting; if the restart fails, carry on as we are. */
+   passive waiting; if the restart fails, carry on as we are.
+   With thread binding asked for (OMP_PROC_BIND, OMP_PLACES), libgomp has
+   already bound this, the initial thread, to the first place before
+   main() runs, and execv keeps that mask: the restarted process saw one
+   CPU and ran every thread on it (OMP_PROC_BIND=true, 2 threads: twice
+   as slow as without binding).  So the restart first widens the mask to
+   the union of libgomp's places, which it built from the mask the
+   process started with. */
 static void prefer_passive_waiting(char **argv)
 {
     if (getenv("OMP_WAIT_POLICY"))
         return;
     if (setenv("OMP_WAIT_POLICY", "passive", 1) != 0)
         return;
+    cli_affinity_unbind();
     execv("/proc/self/exe", argv);
 }
 
