@@ -20,8 +20,10 @@ Needs 2 CPUs; skipped (exit 77) with fewer.
 """
 import os
 import re
-import subprocess
 import sys
+
+# tests/support is on PYTHONPATH (set by ctest)
+from checks import Checks
 
 GETME = sys.argv[1]
 CPUS = sorted(os.sched_getaffinity(0))
@@ -29,13 +31,8 @@ if len(CPUS) < 2:
     print("skipped: needs 2 CPUs, this process may use", len(CPUS))
     sys.exit(77)
 
-failures = 0
-
-
-def check(ok, what):
-    global failures
-    print(("ok   " if ok else "FAIL ") + what)
-    failures += 0 if ok else 1
+T = Checks(GETME)
+check = T.check
 
 
 def places(env, cpus=None):
@@ -44,9 +41,7 @@ def places(env, cpus=None):
          if not k.startswith(("OMP_", "GOMP_"))}
     e.update(env, OMP_DISPLAY_ENV="true")
     pre = (lambda: os.sched_setaffinity(0, cpus)) if cpus else None
-    r = subprocess.run([GETME, "version"], env=e, capture_output=True,
-                       text=True, preexec_fn=pre)
-    check(r.returncode == 0, "getme version exits 0 with %s" % env)
+    r = T.run("version", env=e, preexec_fn=pre)
     return re.findall(r"OMP_PLACES = '([^']*)'", r.stderr + r.stdout)
 
 
@@ -75,5 +70,4 @@ got = places({"OMP_WAIT_POLICY": "active", "OMP_PROC_BIND": "true"})
 check(len(got) == 1, "OMP_WAIT_POLICY set: no restart (%d settings blocks)"
       % len(got))
 
-print("%d failure(s)" % failures)
-sys.exit(1 if failures else 0)
+sys.exit(T.summary())
