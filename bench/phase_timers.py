@@ -52,9 +52,9 @@ PATCHES = {
         ("    if ((st = build_stars(ws)) != GETME_OK)\n        goto fail;\n    read_fixed(ws, mesh);",
          "    TT(\"ws: coordinates\");\n    if ((st = build_stars(ws)) != GETME_OK)\n"
          "        goto fail;\n    TT(\"ws: build_stars\");\n    read_fixed(ws, mesh);"),
-        ("    if ((st = colour_blocks(ws)) != GETME_OK)\n        goto fail;\n    return GETME_OK;",
-         "    TT(\"ws: read_fixed\");\n    if ((st = colour_blocks(ws)) != GETME_OK)\n"
-         "        goto fail;\n    TT(\"ws: colour_blocks\");\n    return GETME_OK;"),
+        ("    if ((st = cut_blocks(ws)) != GETME_OK)\n        goto fail;\n    return GETME_OK;",
+         "    TT(\"ws: read_fixed\");\n    if ((st = cut_blocks(ws)) != GETME_OK)\n"
+         "        goto fail;\n    TT(\"ws: cut_blocks\");\n    return GETME_OK;"),
     ],
     "core/src/topology.c": [
         ("    int64_t foff[GETME_NUM_TYPES];\n    int64_t total = getme__ws_face_offsets(&ws, foff);",

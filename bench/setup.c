@@ -113,9 +113,6 @@ static uint64_t ws_hash(const getme_ws *ws)
     h = fnv(h, ws->star, (size_t)nc * 4);
     h = fnv(h, &ws->max_star, 4);
     h = fnv(h, ws->block_start, ((size_t)ws->num_blocks + 1) * 4);
-    h = fnv(h, ws->colour_ptr, ((size_t)ws->num_colours + 1) * 4);
-    h = fnv(h, ws->colour_blocks, (size_t)ws->num_blocks * 4);
-    h = fnv(h, &ws->serial_colour, sizeof ws->serial_colour);
     return h;
 }
 

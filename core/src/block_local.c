@@ -220,6 +220,61 @@ static void deal_next(const getme_blocks *blk, const getme_ws *ws,
     deal_across(blk, ws, cur, n, np, bpart, keys, best);
 }
 
+/* The most colours the blocks left after the levels get (a bit each in
+   a 32-bit mask per node); a block that finds them all taken runs in
+   the serial colour. */
+#define LEFT_COLOURS 32
+
+/* The blocks left after the levels, cur[0..n) in ascending order, into
+   order[m..], colour by colour (ascending within a colour): coloured
+   greedily in that order, among themselves only, so that no two blocks
+   of a colour share a node.  They are a few percent of the blocks,
+   spread along the parts' interfaces: coloured with all the blocks (the
+   workspace did that until session 31) they took 18 colours of ~20
+   blocks each on the full tets, each colour a parallel loop of its own
+   per sweep; among themselves they need a handful.  mask: room for
+   ws->nn entries, colour: for n (scratch).  GETME_OK or GETME_ERR_NOMEM. */
+static getme_status colour_left(getme_blocks *blk, const int32_t *cur,
+                                int32_t n, uint32_t *mask, int32_t *colour,
+                                int32_t m)
+{
+    for (int32_t k = 0; k < n; k++)
+        for (int64_t j = blk->nptr[cur[k]]; j < blk->nptr[cur[k] + 1]; j++)
+            mask[blk->nodes[j]] = 0;
+    int ncol = 0, serial = 0;
+    for (int32_t k = 0; k < n; k++) {
+        int64_t j0 = blk->nptr[cur[k]], j1 = blk->nptr[cur[k] + 1];
+        uint32_t taken = 0;
+        for (int64_t j = j0; j < j1; j++)
+            taken |= mask[blk->nodes[j]];
+        if (taken == UINT32_MAX) {
+            colour[k] = -1; /* the serial colour */
+            serial = 1;
+            continue;
+        }
+        int c = __builtin_ctz(~taken);
+        colour[k] = c;
+        ncol = c + 1 > ncol ? c + 1 : ncol;
+        for (int64_t j = j0; j < j1; j++)
+            mask[blk->nodes[j]] |= (uint32_t)1 << c;
+    }
+    blk->num_colours = ncol + serial;
+    blk->serial_colour = serial ? ncol : -1;
+    blk->col_ptr =
+        getme__malloc(((size_t)blk->num_colours + 1) * sizeof *blk->col_ptr);
+    if (!blk->col_ptr)
+        return GETME_ERR_NOMEM;
+    for (int c = 0; c < blk->num_colours; c++) {
+        int want = c == blk->serial_colour ? -1 : c;
+        blk->col_ptr[c] = m;
+        for (int32_t k = 0; k < n; k++)
+            if (colour[k] == want)
+                blk->order[m++] = cur[k];
+    }
+    blk->col_ptr[blk->num_colours] = m;
+    return GETME_OK;
+}
+
 /* The visiting order (block_local.h), from the blocks' node lists; part[]
    has room for ws->nn entries (scratch).  Level 0: block b is in part
    b * num_parts / num_blocks; the blocks left after a level are dealt
@@ -234,15 +289,13 @@ static getme_status build_order(getme_blocks *blk, const getme_ws *ws,
     blk->order = getme__malloc(nbs * sizeof *blk->order);
     blk->part_ptr = getme__calloc((size_t)GETME_ORDER_LEVELS * np + 1,
                                   sizeof *blk->part_ptr);
-    blk->col_ptr =
-        getme__calloc((size_t)ws->num_colours + 1, sizeof *blk->col_ptr);
     int32_t *cur = getme__malloc(nbs * sizeof *cur);
     int32_t *bpart = getme__malloc(nbs * sizeof *bpart);
     getme_ranked *keys = getme__malloc(nbs * sizeof *keys);
     uint8_t *left = getme__malloc(nbs);
     int32_t *count = getme__malloc((size_t)np * sizeof *count);
     getme_status st = GETME_ERR_NOMEM;
-    if (!blk->order || !blk->part_ptr || !blk->col_ptr || !cur || !bpart ||
+    if (!blk->order || !blk->part_ptr || !cur || !bpart ||
         !keys || !left || !count)
         goto done;
     for (int32_t b = 0; b < nb; b++) {
@@ -286,14 +339,8 @@ static getme_status build_order(getme_blocks *blk, const getme_ws *ws,
         if (l + 1 < GETME_ORDER_LEVELS)
             deal_next(blk, ws, cur, ncur, np, bpart, keys, part, count);
     }
-    for (int c = 0; c < ws->num_colours; c++) {
-        blk->col_ptr[c] = m;
-        for (int32_t k = ws->colour_ptr[c]; k < ws->colour_ptr[c + 1]; k++)
-            if (left[ws->colour_blocks[k]])
-                blk->order[m++] = ws->colour_blocks[k];
-    }
-    blk->col_ptr[ws->num_colours] = m;
-    st = GETME_OK;
+    /* bpart is free now: the last level deals no further */
+    st = colour_left(blk, cur, ncur, (uint32_t *)part, bpart, m);
 done:
     free(cur), free(bpart), free(keys), free(left), free(count);
     return st;
@@ -312,9 +359,9 @@ int64_t getme__blocks_run(const getme_blocks *blk, const getme_ws *ws,
             for (int32_t k = ptr[p]; k < ptr[p + 1]; k++)
                 total += f(ctx, blk->order[k]);
     }
-    for (int c = 0; c < ws->num_colours; c++) {
+    for (int c = 0; c < blk->num_colours; c++) {
         int32_t k0 = blk->col_ptr[c], k1 = blk->col_ptr[c + 1];
-        int nt = c == ws->serial_colour ? 1 : ws->nt;
+        int nt = c == blk->serial_colour ? 1 : ws->nt;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nt) \
     reduction(+ : total) if (k1 - k0 > 1)
         for (int32_t k = k0; k < k1; k++)

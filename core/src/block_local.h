@@ -98,6 +98,9 @@ typedef struct getme_blocks {
     int32_t *order;     /* num_blocks                                     */
     int32_t *part_ptr;  /* GETME_ORDER_LEVELS np + 1                      */
     int32_t *col_ptr;   /* num_colours + 1                                */
+    int num_colours;    /* of the blocks left after the levels            */
+    int serial_colour;  /* the colour whose blocks run one by one (no free
+                           colour was left for them), or -1              */
     /* Element e of type t is in block tblock[t] + (e - ws->tstart[t]) /
        bsize (getme__blocks_of): the workspace cuts each type's range into
        blocks of one size, and bsize, the largest block's element count,

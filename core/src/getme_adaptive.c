@@ -648,7 +648,7 @@ static getme_status assign_slots(getme_run *run)
             run->slot[g] = -1;
         }
     int32_t navail = 0, made = 0;
-    int np = blk->num_parts, nph = GETME_ORDER_LEVELS + ws->num_colours;
+    int np = blk->num_parts, nph = GETME_ORDER_LEVELS + blk->num_colours;
     for (int ph = 0; ph < nph; ph++) {
         int32_t nback = 0;
         int c = ph - GETME_ORDER_LEVELS;
@@ -662,7 +662,7 @@ static getme_status assign_slots(getme_run *run)
                 lane_end = blk->part_ptr[ph * np + p + 1];
                 p++;
             } else {
-                lane_end = c == ws->serial_colour ? k1 : k + 1;
+                lane_end = c == blk->serial_colour ? k1 : k + 1;
             }
             int32_t base = nback; /* this lane's free slots: back[base..) */
             for (; k < lane_end; k++) {

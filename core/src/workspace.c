@@ -1,6 +1,6 @@
 /*
  * workspace.c -- build the smoother's working copy of a mesh: locality
- * order, node stars, colour-blocks (see workspace.h for why).
+ * order, node stars, blocks (see workspace.h for why).
  */
 #include "exact.h"
 #include "workspace.h"
@@ -13,14 +13,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Elements per colour-block.  Small enough that a block's nodes stay in
-   cache and there are many blocks per colour; large enough that the
-   per-block overhead vanishes.  Fixed: results must not depend on it
-   changing with the thread count. */
+/* Elements per block.  Small enough that a block's nodes stay in cache
+   and there are many blocks per thread; large enough that the per-block
+   overhead vanishes.  Fixed: results must not depend on it changing with
+   the thread count. */
 #define BLOCK_SIZE 512
-/* Colours available in the per-node bit masks; blocks that find all of
-   them taken go to one extra colour processed serially. */
-#define MAX_COLOURS 64
 /* How far ahead the scattered gathers of the build fetch (rows, keys). */
 #define ROW_AHEAD 16
 
@@ -38,8 +35,6 @@ void getme__ws_free(getme_ws *ws)
     getme__offs_free(&ws->star_offs);
     free(ws->star);
     free(ws->block_start);
-    free(ws->colour_ptr);
-    free(ws->colour_blocks);
     getme__facenb_free(&ws->faces);
     getme__packed_free(&ws->elem_packed);
     getme__packed_free(&ws->node_packed);
@@ -469,8 +464,10 @@ static getme_status build_stars(getme_ws *ws)
     return GETME_OK;
 }
 
-/* Cut each type range into blocks and colour them greedily in order. */
-static getme_status colour_blocks(getme_ws *ws)
+/* Cut each type range into blocks.  Which blocks may run at the same
+   time is the blocks' business (block_local.c: the parts of each level,
+   then the blocks left, coloured among themselves). */
+static getme_status cut_blocks(getme_ws *ws)
 {
     int32_t nb = 0;
     for (int t = 0; t < GETME_NUM_TYPES; t++) {
@@ -479,63 +476,13 @@ static getme_status colour_blocks(getme_ws *ws)
     }
     ws->num_blocks = nb;
     ws->block_start = getme__malloc(((size_t)nb + 1) * sizeof *ws->block_start);
-    int32_t *colour = getme__malloc((size_t)(nb ? nb : 1) * sizeof *colour);
-    uint64_t *mask = getme__calloc((size_t)(ws->nn ? ws->nn : 1), sizeof *mask);
-    ws->colour_ptr = getme__calloc(MAX_COLOURS + 2, sizeof *ws->colour_ptr);
-    ws->colour_blocks = getme__malloc((size_t)(nb ? nb : 1) * sizeof(int32_t));
-    if (!ws->block_start || !colour || !mask || !ws->colour_ptr ||
-        !ws->colour_blocks) {
-        free(colour), free(mask);
+    if (!ws->block_start)
         return GETME_ERR_NOMEM;
-    }
     int32_t b = 0;
     for (int t = 0; t < GETME_NUM_TYPES; t++)
         for (int32_t e = ws->tstart[t]; e < ws->tstart[t + 1]; e += BLOCK_SIZE)
             ws->block_start[b++] = e;
     ws->block_start[nb] = ws->ne;
-
-    int used_serial = 0, max_colour = -1;
-    for (b = 0; b < nb; b++) {
-        uint64_t forbidden = 0;
-        int32_t e0 = ws->block_start[b], e1 = ws->block_start[b + 1];
-        int t = getme__ws_type(ws, e0);
-        int nv = getme__nv[t];
-        for (int32_t e = e0; e < e1; e++) {
-            const int32_t *c = getme__ws_nodes(ws, t, e);
-            for (int i = 0; i < nv; i++)
-                forbidden |= mask[c[i]];
-        }
-        int col = MAX_COLOURS;
-        if (~forbidden)
-            col = __builtin_ctzll(~forbidden);
-        colour[b] = col;
-        if (col == MAX_COLOURS) {
-            used_serial = 1;
-            continue; /* serial blocks run alone: no mask bit needed */
-        }
-        if (col > max_colour)
-            max_colour = col;
-        uint64_t bit = (uint64_t)1 << col;
-        for (int32_t e = e0; e < e1; e++) {
-            const int32_t *c = getme__ws_nodes(ws, t, e);
-            for (int i = 0; i < nv; i++)
-                mask[c[i]] |= bit;
-        }
-    }
-    free(mask);
-    ws->num_colours = used_serial ? MAX_COLOURS + 1 : max_colour + 1;
-    ws->serial_colour = used_serial ? MAX_COLOURS : -1;
-    /* Bucket blocks by colour (counting sort keeps block order). */
-    for (b = 0; b < nb; b++)
-        ws->colour_ptr[colour[b] + 1]++;
-    for (int c = 0; c < ws->num_colours; c++)
-        ws->colour_ptr[c + 1] += ws->colour_ptr[c];
-    int32_t fill[MAX_COLOURS + 1];
-    for (int c = 0; c < ws->num_colours; c++)
-        fill[c] = ws->colour_ptr[c];
-    for (b = 0; b < nb; b++)
-        ws->colour_blocks[fill[colour[b]]++] = b;
-    free(colour);
     return GETME_OK;
 }
 
@@ -615,7 +562,7 @@ getme_status getme__ws_build(getme_ws *ws, getme_mesh *mesh, int renumber,
     if ((st = build_stars(ws)) != GETME_OK)
         goto fail;
     read_fixed(ws, mesh);
-    if ((st = colour_blocks(ws)) != GETME_OK)
+    if ((st = cut_blocks(ws)) != GETME_OK)
         goto fail;
     return GETME_OK;
 fail:

@@ -8,11 +8,11 @@
  *    numbered in first-touch order of that element order, so neighbouring
  *    elements and nodes are close in memory (renumber = 1);
  *  - a node -> element CSR ("stars"), each star sorted by element index;
- *  - blocks of consecutive elements, coloured so that no two blocks of one
- *    colour share a node.  Scattering element contributions block by block,
- *    colour after colour, needs no atomics and adds the contributions to a
- *    node in an order that does not depend on the thread count, which is
- *    what makes results bit-identical for any number of threads.
+ *  - blocks of 512 consecutive elements (one type each), the unit of the
+ *    stage-1 sweeps.  Which blocks run at the same time (none sharing a
+ *    node, so the scatter needs no atomics) is block_local.h's visiting
+ *    order; the sums are exact integers, so any such order gives the
+ *    same bits for any number of threads.
  */
 #ifndef GETME_WORKSPACE_H
 #define GETME_WORKSPACE_H
@@ -59,14 +59,9 @@ typedef struct getme_ws {
                                 (offsets.h), star_ptr then NULL; read
                                 both through getme__ws_star_at         */
     int32_t max_star;    /* largest star                                     */
-    /* colour-blocks */
+    /* blocks */
     int32_t num_blocks;
     int32_t *block_start; /* num_blocks + 1, element ranges (one type each)  */
-    int32_t num_colours;
-    int32_t *colour_ptr;  /* num_colours + 1, into colour_blocks             */
-    int32_t *colour_blocks;
-    int serial_colour;    /* colour index whose blocks must run one by one
-                             (colour overflow), or -1                        */
     getme_ho_ws *ho;      /* second-order elements' dependent nodes, or NULL */
     int conn_lent;        /* the mesh's block lent its connectivity
                              (getme__ws_lend_conn)                          */
