@@ -4,12 +4,13 @@
  */
 #include "cli.h"
 
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
 static const char QUALITY_HELP[] =
     "usage: getme quality IN [--fix NAME]... [--free NAME]... [--free-interfaces]\n"
-    "                        [--worst N] [-q]\n"
+    "                        [--worst N] [--threads N] [-q]\n"
     "\n"
     "Print the mean ratio quality of the mesh in IN per element type: q*min\n"
     "(worst element with a free node), qmin, qmean, and a histogram like\n"
@@ -19,6 +20,8 @@ static const char QUALITY_HELP[] =
     "With --worst N, the N worst elements, and the N worst with a free node,\n"
     "each with why it cannot get better by moving nodes (all nodes fixed, on\n"
     "a fixed interface, free nodes at a local optimum, or still improvable).\n"
+    "--threads N: OpenMP threads for reading and measuring (default: all\n"
+    "cores, or OMP_NUM_THREADS); the report is the same for any number.\n"
     "Exit code 6 if the mesh has invalid (inverted) elements.\n";
 
 /* q: every element's quality (from the measures' sweep) */
@@ -71,6 +74,14 @@ int cli_quality(int argc, char **argv)
         } else if (!strcmp(o, "--worst") && i + 1 < argc) {
             if (cli_parse_int(o, argv[++i], 0, 1000000, &worst) != 0)
                 return EXIT_USAGE;
+        } else if (!strcmp(o, "--threads") && i + 1 < argc) {
+            long n;
+            if (cli_parse_int(o, argv[++i], 1, 4096, &n) != 0)
+                return EXIT_USAGE;
+            /* the readers' team and the measures' sweeps (OpenMP's
+               default team), as smooth's --threads */
+            opts.num_threads = (int)n;
+            omp_set_num_threads((int)n);
         } else if (!strcmp(o, "-q") || !strcmp(o, "--quiet")) {
             log.quiet = 1;
         } else if (o[0] == '-' && o[1]) {

@@ -186,6 +186,12 @@ def mesh_case(case):
     for k in kinds:
         check(f"{k} SICN: min" in p.stdout and f"{k} scaled Jacobian: min" in p.stdout,
               f"getme quality prints the {k} measures")
+    # --threads as smooth's: the report is the same for any number
+    r1 = run("quality", dist, "--threads", "1", "--worst", "5")
+    r2 = run("quality", dist, "--threads", "2", "--worst", "5")
+    check(r1.stdout == r2.stdout and r1.stderr == r2.stderr and "Worst 5" in r1.stdout,
+          "getme quality --threads 1 and 2 print the same report")
+    run("quality", dist, "--threads", "0", expect=2)
     print(f"{case}: {', '.join(f'{k} {len(q0[k])}' for k in kinds)}; q*min {mn0:.4f} -> "
           f"getme {mn1:.4f} (laplace {mnl:.4f}); qmean {mean0:.4f} -> {mean1:.4f} "
           f"(laplace {meanl:.4f}); iterations {rep['iterations']['mean_stage']}/"
