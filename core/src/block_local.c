@@ -220,20 +220,17 @@ static void deal_next(const getme_blocks *blk, const getme_ws *ws,
     deal_across(blk, ws, cur, n, np, bpart, keys, best);
 }
 
-/* The most colours the blocks left after the levels get (a bit each in
-   a 32-bit mask per node); a block that finds them all taken runs in
-   the serial colour. */
-#define LEFT_COLOURS 32
-
 /* The blocks left after the levels, cur[0..n) in ascending order, into
    order[m..], colour by colour (ascending within a colour): coloured
    greedily in that order, among themselves only, so that no two blocks
-   of a colour share a node.  They are a few percent of the blocks,
-   spread along the parts' interfaces: coloured with all the blocks (the
-   workspace did that until session 31) they took 18 colours of ~20
-   blocks each on the full tets, each colour a parallel loop of its own
-   per sweep; among themselves they need a handful.  mask: room for
-   ws->nn entries, colour: for n (scratch).  GETME_OK or GETME_ERR_NOMEM. */
+   of a colour share a node; at most 32 colours (a bit each in a 32-bit
+   mask per node), and a block that finds them all taken runs in the
+   serial colour, last.  They are a few percent of the blocks, along the
+   parts' interfaces.  The workspace used to colour all blocks, serially,
+   for these few; among themselves they form one connected sheet and
+   still take 16 colours on the full tets (18 before, docs/bench.md
+   session 31).  mask: room for ws->nn entries, colour: for n (scratch).
+   GETME_OK or GETME_ERR_NOMEM. */
 static getme_status colour_left(getme_blocks *blk, const int32_t *cur,
                                 int32_t n, uint32_t *mask, int32_t *colour,
                                 int32_t m)
