@@ -1,8 +1,7 @@
 /*
- * getme_alloc.c -- allocation with a huge-page hint for large blocks
- * (getme_alloc.h).
+ * getme_alloc.c -- allocation placed for huge pages (getme_alloc.h).
  */
-#define _DEFAULT_SOURCE /* madvise and MADV_HUGEPAGE under -std=c11 */
+#define _DEFAULT_SOURCE /* madvise, MADV_HUGEPAGE, posix_memalign, c11 */
 #include "getme_alloc.h"
 
 #include <stdint.h>
@@ -14,6 +13,12 @@
 #if defined(__linux__) && !defined(GETME_NO_HUGE_PAGES)
 #include <sys/mman.h>
 #include <unistd.h>
+#endif
+
+#if defined(__linux__) && defined(MADV_HUGEPAGE) && !defined(GETME_NO_HUGE_PAGES)
+#define HUGE_PAGES 1
+#else
+#define HUGE_PAGES 0
 #endif
 
 /* Advise the pages that [p, p + n) touches as wanting huge pages: the
@@ -32,8 +37,8 @@
    of the heap; the hint does not change their contents. */
 static void *advise(void *p, size_t n)
 {
-#if defined(__linux__) && defined(MADV_HUGEPAGE) && !defined(GETME_NO_HUGE_PAGES)
-    if (p && n >= GETME_HUGE_MIN) {
+#if HUGE_PAGES
+    if (p) {
         long ps = sysconf(_SC_PAGESIZE);
         uintptr_t page = ps > 0 ? (uintptr_t)ps : 4096;
         uintptr_t a = (uintptr_t)p & ~(page - 1);
@@ -47,28 +52,69 @@ static void *advise(void *p, size_t n)
     return p;
 }
 
-void *getme__malloc(size_t n) { return advise(malloc(n), n); }
-
-void *getme__calloc(size_t k, size_t n)
+#if HUGE_PAGES
+/* A large block that starts on a huge-page boundary, advised.
+   Why aligned: glibc maps a large block from any 4 KiB boundary, and the
+   kernel can give a huge page only to a whole aligned 2 MiB stretch of a
+   mapping; the stretch a block starts in (on average 1 MiB of it) was
+   4 KiB pages, each a page fault at its first touch, and so was every
+   block of 2-4 MiB, which held no whole stretch at all.  On the
+   benchmark's VM such a fault costs 6-15 us even on memory just freed
+   (docs/design.md §6): the full tets took ~38,000 faults a run, 23,000
+   with this (bench.md, session 32).
+   The end stays on 4 KiB pages: rounding the size up to a whole huge page
+   would make the rest of the block's last stretch resident too (a huge
+   page is resident in full), up to 2 MiB a block, 37 MiB more at the full
+   hexes' peak. */
+static void *huge_block(size_t n)
 {
-    /* an overflowing k * n fails in calloc: NULL, nothing advised */
-    return advise(calloc(k, n), k && n <= SIZE_MAX / k ? k * n : 0);
+    void *p = NULL;
+    if (posix_memalign(&p, GETME_HUGE_PAGE, n) != 0)
+        return NULL;
+    return advise(p, n);
+}
+#endif
+
+void *getme__malloc(size_t n)
+{
+#if HUGE_PAGES
+    if (n >= GETME_HUGE_MIN)
+        return huge_block(n);
+#endif
+    return malloc(n);
 }
 
-/* Growing into a large block: realloc copies the old contents into the
-   new block before it could be advised, so each of the new block's pages
-   was first touched as a 4 KiB page fault (perf -e page-faults: a sixth
-   of all faults on the full tets, build_edges' count arrays growing from
-   the heap into a mapping).  So a new, advised block, then the copy.
-   Shrinking, or growing a block that is already large (glibc moves its
-   pages with mremap, no copy), stays realloc's. */
+/* calloc's block is neither aligned nor advised below 4 MiB.  A large
+   calloc'd block is a fresh mapping whose pages stay the kernel's shared
+   zero page until written, and many calloc'd arrays are marks written at
+   a few places: on 4 KiB pages only the pages written become resident,
+   on huge pages every 2 MiB stretch written once (advising calloc'd
+   blocks from 1 MiB on put the full hexes' peak 6 MiB higher).  An
+   aligned block would also have to be zeroed here, touching every page:
+   posix_memalign may take it from the heap's freed memory. */
+void *getme__calloc(size_t k, size_t n)
+{
+    void *p = calloc(k, n); /* an overflowing k * n fails here: NULL */
+    size_t t = k && n <= SIZE_MAX / k ? k * n : 0;
+    return t >= GETME_HUGE_CALLOC_MIN ? advise(p, t) : p;
+}
+
+/* Growing into a large block: a new, aligned block, then the copy.  The C
+   library's realloc would copy the old contents into a block that is not
+   advised yet (every page a 4 KiB fault: a sixth of all faults on the full
+   tets, build_edges' count arrays growing from the heap into a mapping),
+   or move an already large block's pages with mremap to an address that
+   is not aligned.  The copy costs ~1 ms per 10 MiB.  Shrinking stays
+   realloc's, in place. */
 void *getme__realloc(void *p, size_t n)
 {
-#if defined(__GLIBC__) && defined(MADV_HUGEPAGE) && !defined(GETME_NO_HUGE_PAGES)
-    if (p && n >= GETME_HUGE_MIN) {
+#if HUGE_PAGES && defined(__GLIBC__)
+    if (!p)
+        return getme__malloc(n);
+    if (n >= GETME_HUGE_MIN) {
         size_t old = malloc_usable_size(p);
-        if (old < GETME_HUGE_MIN) { /* n > old */
-            void *q = getme__malloc(n);
+        if (old < n) {
+            void *q = huge_block(n);
             if (!q)
                 return NULL; /* p stays valid, as after realloc */
             memcpy(q, p, old);
@@ -77,10 +123,14 @@ void *getme__realloc(void *p, size_t n)
         }
     }
 #endif
-    return advise(realloc(p, n), n);
+    return n >= GETME_HUGE_MIN ? advise(realloc(p, n), n) : realloc(p, n);
 }
 
 void *getme__aligned_alloc(size_t align, size_t n)
 {
-    return advise(aligned_alloc(align, n), n);
+#if HUGE_PAGES
+    if (n >= GETME_HUGE_MIN && align <= GETME_HUGE_PAGE)
+        return huge_block(n); /* a huge page's boundary is any smaller one */
+#endif
+    return aligned_alloc(align, n);
 }

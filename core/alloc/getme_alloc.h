@@ -1,9 +1,16 @@
 /*
  * getme_alloc.h -- the libraries' allocation functions: malloc, calloc, realloc
- * and aligned_alloc as the C library has them, except that a block of at
- * least GETME_HUGE_MIN bytes is advised to the kernel as wanting
- * transparent huge pages (Linux madvise(MADV_HUGEPAGE); elsewhere, or
- * where the kernel refuses, nothing changes).  Free with free().
+ * and aligned_alloc as the C library has them, except that large blocks are
+ * placed for transparent huge pages (Linux madvise(MADV_HUGEPAGE);
+ * elsewhere, or where the kernel refuses, nothing changes):
+ *   - a block of at least GETME_HUGE_MIN bytes from getme__malloc,
+ *     getme__realloc or getme__aligned_alloc starts on a GETME_HUGE_PAGE
+ *     boundary and is advised, so that every whole 2 MiB stretch of it,
+ *     its first one included, can be one huge page;
+ *   - a block of at least GETME_HUGE_CALLOC_MIN bytes from getme__calloc
+ *     is advised where the C library puts it (see getme_alloc.c for why
+ *     not aligned and why from a larger size).
+ * Free with free().
  *
  * Why: a multi-million-element mesh lives in a few hundred MiB of arrays
  * that the read, the set-up and the q*_min stage walk in scattered order,
@@ -17,8 +24,13 @@
 
 #include <stddef.h>
 
-/* Blocks from this size on are advised: below 2 MiB no huge page fits. */
-#define GETME_HUGE_MIN ((size_t)4 << 20)
+/* The huge page's size on x86-64 and arm64 (4 KiB base pages). */
+#define GETME_HUGE_PAGE ((size_t)2 << 20)
+/* Blocks from this size on are aligned and advised: below one huge page
+   none fits. */
+#define GETME_HUGE_MIN GETME_HUGE_PAGE
+/* calloc'd blocks from this size on are advised. */
+#define GETME_HUGE_CALLOC_MIN ((size_t)4 << 20)
 
 void *getme__malloc(size_t n);
 void *getme__calloc(size_t k, size_t n);

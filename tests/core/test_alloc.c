@@ -1,10 +1,12 @@
 /*
  * test_alloc.c -- the allocation functions of core/alloc/getme_alloc.h:
  * each gives a block that works as the C library's does (zeroed by calloc,
- * kept by realloc), and a block of GETME_HUGE_MIN bytes or more lies in
- * memory advised for huge pages (the "hg" flag in /proc/self/smaps, which
- * madvise(MADV_HUGEPAGE) sets), while a smaller one and a plain malloc of
- * the same size do not (so the check itself can fail).  Built with
+ * kept by realloc), and a block of GETME_HUGE_MIN bytes or more starts on
+ * a huge-page boundary and lies in memory advised for huge pages (the "hg"
+ * flag in /proc/self/smaps, which madvise(MADV_HUGEPAGE) sets), while a
+ * smaller one and a plain malloc of the same size do not (so the check
+ * itself can fail); calloc'd blocks only from GETME_HUGE_CALLOC_MIN on,
+ * where the C library puts them.  Built with
  * -DGETME_HUGE_PAGES=OFF, no block is advised.  Skipped (exit 77) where
  * the kernel has no transparent huge pages.
  */
@@ -51,6 +53,11 @@ static int advised(const void *p, size_t n)
     return vma_has_flag((const char *)p + n / 2, "hg") == 1;
 }
 
+static int huge_aligned(const void *p)
+{
+    return (uintptr_t)p % GETME_HUGE_PAGE == 0;
+}
+
 int main(void)
 {
     FILE *thp = fopen("/sys/kernel/mm/transparent_hugepage/enabled", "r");
@@ -86,6 +93,21 @@ int main(void)
        could then no longer grow it in place (mremap failed, EFAULT) */
     CHECK(vma_has_flag(m, "hg") == want);
     CHECK(vma_has_flag(m + big - 1, "hg") == want);
+    CHECK(huge_aligned(m) == want);
+
+    /* between one huge page and the calloc threshold: a malloc'd block is
+       aligned and advised (it holds one whole huge page), a calloc'd one
+       neither (its untouched pages stay the kernel's zero page) */
+    const size_t mid = GETME_HUGE_MIN + GETME_HUGE_MIN / 2;
+    CHECK(mid < GETME_HUGE_CALLOC_MIN);
+    unsigned char *mm = getme__malloc(mid);
+    CHECK(mm != NULL);
+    CHECK(huge_aligned(mm) == want && advised(mm, mid) == want);
+    memset(mm, 0x3c, mid);
+    CHECK(mm[mid - 1] == 0x3c);
+    unsigned char *mc = getme__calloc(mid, 1);
+    CHECK(mc != NULL);
+    CHECK(!advised(mc, mid) && mc[0] == 0 && mc[mid - 1] == 0);
 
     size_t k = big / sizeof(double);
     double *c = getme__calloc(k, sizeof *c);
@@ -98,21 +120,28 @@ int main(void)
 
     void *al = getme__aligned_alloc(64, big);
     CHECK(al != NULL && (uintptr_t)al % 64 == 0);
-    CHECK(advised(al, big) == want);
+    CHECK(advised(al, big) == want && huge_aligned(al) == want);
 
     /* grown from the small block: its bytes kept, the new block advised */
     unsigned char *r = getme__realloc(s, big);
     CHECK(r != NULL);
     CHECK(r[0] == 0x5a && r[small - 1] == 0x5a);
-    CHECK(advised(r, big) == want);
+    CHECK(advised(r, big) == want && huge_aligned(r) == want);
 
     /* a large block grown: its bytes kept, the whole block advised */
     m = getme__realloc(m, 2 * big);
     CHECK(m != NULL);
     CHECK(m[0] == 0xa5 && m[big - 1] == 0xa5);
     CHECK(vma_has_flag(m, "hg") == want && advised(m, 2 * big) == want);
+    CHECK(huge_aligned(m) == want);
+    /* shrunk: its bytes kept */
+    unsigned char *m2 = getme__realloc(m, big / 2);
+    CHECK(m2 != NULL && m2[0] == 0xa5 && m2[big / 2 - 1] == 0xa5);
+    m = m2;
 
     free(plain);
+    free(mm);
+    free(mc);
     free(m);
     free(c);
     free(al);
