@@ -59,7 +59,7 @@ static void *advise(void *p, size_t n)
    mapping; the stretch a block starts in (on average 1 MiB of it) was
    4 KiB pages, each a page fault at its first touch, and so was every
    block of 2-4 MiB, which held no whole stretch at all.  On the
-   benchmark's VM such a fault costs 6-15 us even on memory just freed
+   benchmark's VM such a fault costs 6-17 us even on memory just freed
    (docs/design.md §6): the full tets took ~38,000 faults a run, 23,000
    with this (bench.md, session 32).
    The end stays on 4 KiB pages: rounding the size up to a whole huge page
