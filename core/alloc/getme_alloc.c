@@ -108,9 +108,9 @@ void *getme__calloc(size_t k, size_t n)
    realloc's, in place. */
 void *getme__realloc(void *p, size_t n)
 {
-#if HUGE_PAGES && defined(__GLIBC__)
     if (!p)
-        return getme__malloc(n);
+        return getme__malloc(n); /* aligned where it is large */
+#if HUGE_PAGES && defined(__GLIBC__)
     if (n >= GETME_HUGE_MIN) {
         size_t old = malloc_usable_size(p);
         if (old < n) {
