@@ -72,8 +72,8 @@ PATCHES = {
         # timers keep their meaning
         ("    int64_t total = 0;\n    int np = blk->num_parts;\n",
          "    int64_t total = 0;\n    int np = blk->num_parts;\n    TT0();\n"),
-        ("                total += f(ctx, blk->order[k]);\n    }\n",
-         "                total += f(ctx, blk->order[k]);\n"
+        ("            feed_level(fb, ptr, np);\n    }\n",
+         "            feed_level(fb, ptr, np);\n"
          "        if (l == 0)\n            TT(\"blocks: level 0\");\n"
          "        else if (l == 1)\n            TT(\"blocks: level 1\");\n"
          "        else\n            TT(\"blocks: level 2+\");\n    }\n"),

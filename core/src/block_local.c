@@ -33,6 +33,9 @@ void getme__blocks_free(getme_blocks *blk)
     free(blk->group.ptr);
     free(blk->group.cnt);
     free(blk->group.pos);
+    if (blk->fb)
+        free(blk->fb->weight); /* one allocation for the arrays */
+    free(blk->fb);
     getme__blocks_free_edges(blk);
     memset(blk, 0, sizeof *blk);
 }
@@ -113,14 +116,83 @@ static getme_status alloc_scratch(getme_blocks *blk, int nt)
     return GETME_OK;
 }
 
+/* Entry j of the blocks' node lists as a node index: a GETMe adaptive
+   run marks entries with the sign bit (mark_last) before
+   getme__blocks_reorder deals the blocks again. */
+static inline int32_t list_node(const getme_blocks *blk, int64_t j)
+{
+    return blk->nodes[j] & INT32_MAX;
+}
+
+/* The balance's shares and feedback for np parts (equal weights). */
+static getme_status alloc_feedback(getme_blocks *blk, int np)
+{
+    blk->fb = getme__calloc(1, sizeof *blk->fb);
+    /* weight, prev_weight, busy, work and last (8 bytes each), then perm
+       and prev_perm (4 each) */
+    int64_t *a = getme__calloc((size_t)np * 6, sizeof(int64_t));
+    if (!blk->fb || !a) {
+        free(a);
+        return GETME_ERR_NOMEM;
+    }
+    struct getme_block_feedback *fb = blk->fb;
+    fb->weight = a;
+    fb->prev_weight = a + np;
+    fb->busy = (double *)(void *)(a + 2 * np);
+    fb->work = fb->busy + np;
+    fb->last = fb->work + np;
+    fb->perm = (int32_t *)(void *)(a + 5 * np);
+    fb->prev_perm = fb->perm + np;
+    for (int p = 0; p < np; p++)
+        a[p] = 1, fb->perm[p] = p;
+    return GETME_OK;
+}
+
 /* Block b's nodes are all in part p's territory (build_order). */
 static int interior(const getme_blocks *blk, const int32_t *part, int32_t b,
                     int32_t p)
 {
     for (int64_t k = blk->nptr[b]; k < blk->nptr[b + 1]; k++)
-        if (part[blk->nodes[k]] != p)
+        if (part[list_node(blk, k)] != p)
             return 0;
     return 1;
+}
+
+/* The parts' weights and their sum (NULL: all 1). */
+static int64_t weight_of(const getme_blocks *blk, int p)
+{
+    return blk->fb ? blk->fb->weight[p] : 1;
+}
+
+static int64_t weight_sum(const getme_blocks *blk, int np)
+{
+    int64_t w = 0;
+    for (int p = 0; p < np; p++)
+        w += weight_of(blk, p);
+    return w;
+}
+
+/* Where part p's share of n ranked things starts when they are cut in
+   proportion to the weights: ceil(n c / W), c the weights before p, W
+   all of them.  With equal weights, rank k is in part floor(k np / n). */
+static int32_t cut_at(int64_t n, int64_t c, int64_t w)
+{
+    return (int32_t)((n * c + w - 1) / w);
+}
+
+/* Into bpart[rank[k]] for k in [0, n): the part of rank k, cutting in
+   proportion to the weights. */
+static void cut_ranks(const getme_blocks *blk, int np, const int32_t *rank,
+                      const getme_ranked *keys, int32_t n, int32_t *bpart)
+{
+    int64_t w = weight_sum(blk, np), c = 0;
+    int32_t k = 0;
+    for (int p = 0; p < np; p++) {
+        c += weight_of(blk, p);
+        int32_t end = p == np - 1 ? n : cut_at(n, c, w);
+        for (; k < end; k++)
+            bpart[rank ? rank[k] : keys[k].e] = p;
+    }
 }
 
 /* The axis along which the blocks cur[0..n) spread most (a block's
@@ -131,7 +203,7 @@ static int spread_axis(const getme_blocks *blk, const getme_ws *ws,
     double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
     for (int32_t k = 0; k < n; k++)
         for (int d = 0; d < 3; d++) {
-            double v = ws->x[3 * (int64_t)blk->nodes[blk->nptr[cur[k]]] + d];
+            double v = ws->x[3 * (int64_t)list_node(blk, blk->nptr[cur[k]]) + d];
             lo[d] = v < lo[d] ? v : lo[d];
             hi[d] = v > hi[d] ? v : hi[d];
         }
@@ -142,21 +214,20 @@ static int spread_axis(const getme_blocks *blk, const getme_ws *ws,
     return a;
 }
 
-/* Deal the blocks cur[0..n) into np parts of equal counts by position
-   along axis a: the blocks left after a level lie along the parts'
-   interfaces, so this cuts across them, and the next level finds most of
-   them interior. */
+/* Deal the blocks cur[0..n) into np parts by position along axis a, in
+   proportion to the parts' weights: the blocks left after a level lie
+   along the parts' interfaces, so this cuts across them, and the next
+   level finds most of them interior. */
 static void deal_across(const getme_blocks *blk, const getme_ws *ws,
                         const int32_t *cur, int32_t n, int np, int32_t *bpart,
                         getme_ranked *keys, int a)
 {
     for (int32_t k = 0; k < n; k++) {
         keys[k].e = cur[k];
-        keys[k].q = ws->x[3 * (int64_t)blk->nodes[blk->nptr[cur[k]]] + a];
+        keys[k].q = ws->x[3 * (int64_t)list_node(blk, blk->nptr[cur[k]]) + a];
     }
     qsort(keys, (size_t)n, sizeof *keys, getme__cmp_ranked);
-    for (int32_t k = 0; k < n; k++)
-        bpart[keys[k].e] = (int32_t)((int64_t)k * np / n);
+    cut_ranks(blk, np, NULL, keys, n, bpart);
 }
 
 /* part[n] for every node of the blocks cur[0..n): the one part whose
@@ -166,18 +237,20 @@ static void mark_parts(const getme_blocks *blk, const int32_t *cur,
 {
     for (int32_t k = 0; k < n; k++)
         for (int64_t j = blk->nptr[cur[k]]; j < blk->nptr[cur[k] + 1]; j++)
-            part[blk->nodes[j]] = -1;
+            part[list_node(blk, j)] = -1;
     for (int32_t k = 0; k < n; k++) {
         int32_t p = bpart[cur[k]];
         for (int64_t j = blk->nptr[cur[k]]; j < blk->nptr[cur[k] + 1]; j++) {
-            int32_t v = blk->nodes[j];
+            int32_t v = list_node(blk, j);
             part[v] = part[v] == -1 || part[v] == p ? p : -2;
         }
     }
 }
 
-/* The fewest interior blocks of a part, with the blocks cur[0..n) dealt
-   as bpart says (part[] as mark_parts leaves it). */
+/* The fewest interior blocks of a part, each part's count scaled to an
+   equal weight (count W / (np w), the count itself with equal weights),
+   with the blocks cur[0..n) dealt as bpart says (part[] as mark_parts
+   leaves it). */
 static int32_t least_interior(const getme_blocks *blk, const int32_t *cur,
                               int32_t n, const int32_t *bpart,
                               const int32_t *part, int np, int32_t *count)
@@ -185,10 +258,12 @@ static int32_t least_interior(const getme_blocks *blk, const int32_t *cur,
     memset(count, 0, (size_t)np * sizeof *count);
     for (int32_t k = 0; k < n; k++)
         count[bpart[cur[k]]] += interior(blk, part, cur[k], bpart[cur[k]]);
-    int32_t least = INT32_MAX;
-    for (int p = 0; p < np; p++)
-        least = count[p] < least ? count[p] : least;
-    return least;
+    int64_t least = INT32_MAX, w = weight_sum(blk, np);
+    for (int p = 0; p < np; p++) {
+        int64_t c = count[p] * w / (np * weight_of(blk, p));
+        least = c < least ? c : least;
+    }
+    return (int32_t)least;
 }
 
 /* Deal the blocks left, cur[0..n), for the next level: across the axis
@@ -237,13 +312,13 @@ static getme_status colour_left(getme_blocks *blk, const int32_t *cur,
 {
     for (int32_t k = 0; k < n; k++)
         for (int64_t j = blk->nptr[cur[k]]; j < blk->nptr[cur[k] + 1]; j++)
-            mask[blk->nodes[j]] = 0;
+            mask[list_node(blk, j)] = 0;
     int ncol = 0, serial = 0;
     for (int32_t k = 0; k < n; k++) {
         int64_t j0 = blk->nptr[cur[k]], j1 = blk->nptr[cur[k] + 1];
         uint32_t taken = 0;
         for (int64_t j = j0; j < j1; j++)
-            taken |= mask[blk->nodes[j]];
+            taken |= mask[list_node(blk, j)];
         if (taken == UINT32_MAX) {
             colour[k] = -1; /* the serial colour */
             serial = 1;
@@ -253,7 +328,7 @@ static getme_status colour_left(getme_blocks *blk, const int32_t *cur,
         colour[k] = c;
         ncol = c + 1 > ncol ? c + 1 : ncol;
         for (int64_t j = j0; j < j1; j++)
-            mask[blk->nodes[j]] |= (uint32_t)1 << c;
+            mask[list_node(blk, j)] |= (uint32_t)1 << c;
     }
     blk->num_colours = ncol + serial;
     blk->serial_colour = serial ? ncol : -1;
@@ -273,8 +348,9 @@ static getme_status colour_left(getme_blocks *blk, const int32_t *cur,
 }
 
 /* The visiting order (block_local.h), from the blocks' node lists; part[]
-   has room for ws->nn entries (scratch).  Level 0: block b is in part
-   b * num_parts / num_blocks; the blocks left after a level are dealt
+   has room for ws->nn entries (scratch).  Level 0: the blocks in order,
+   cut into parts in proportion to the weights (equal: block b is in part
+   b * num_parts / num_blocks); the blocks left after a level are dealt
    out again across the interfaces (deal_across). */
 static getme_status build_order(getme_blocks *blk, const getme_ws *ws,
                                 int32_t *part)
@@ -297,32 +373,41 @@ static getme_status build_order(getme_blocks *blk, const getme_ws *ws,
         goto done;
     for (int32_t b = 0; b < nb; b++) {
         cur[b] = b;
-        bpart[b] = (int32_t)((int64_t)b * np / nb);
         left[b] = 1;
     }
+    cut_ranks(blk, np, cur, NULL, nb, bpart);
     int32_t ncur = nb, m = 0;
     for (int l = 0; l < GETME_ORDER_LEVELS; l++) {
         mark_parts(blk, cur, ncur, bpart, part);
         /* A level's parts run side by side and end together, so a part
-           with more interior blocks than the least one keeps its excess
+           with more interior blocks than its share of the poorest one's
+           (the least one's count with equal weights) keeps its excess
            (its last ones) for the next level, or the colours: the thread
            with the smaller part would wait for it (full tets, 2 threads:
            423 against 273 blocks at level 1). */
-        int32_t least = INT32_MAX;
+        int poor = 0;
         for (int p = 0; p < np; p++) {
             int32_t k0 = m;
             for (int32_t k = 0; k < ncur; k++)
                 if (bpart[cur[k]] == p && interior(blk, part, cur[k], p))
                     blk->order[m++] = cur[k];
-            least = m - k0 < least ? m - k0 : least;
             blk->part_ptr[l * np + p + 1] = m;
+            /* count / weight below the poorest one's so far */
+            int64_t cp = m - k0, cq = blk->part_ptr[l * np + poor + 1] -
+                                      blk->part_ptr[l * np + poor];
+            if (cp * weight_of(blk, poor) < cq * weight_of(blk, p))
+                poor = p;
         }
+        int64_t cpoor = blk->part_ptr[l * np + poor + 1] -
+                        blk->part_ptr[l * np + poor];
         int32_t next = blk->part_ptr[l * np];
         m = next;
         for (int p = 0; p < np; p++) {
             int32_t k0 = next;
             next = blk->part_ptr[l * np + p + 1];
-            for (int32_t k = k0; k < k0 + least; k++) {
+            int64_t keep = cpoor * weight_of(blk, p) / weight_of(blk, poor);
+            keep = keep < next - k0 ? keep : next - k0;
+            for (int32_t k = k0; k < k0 + keep; k++) {
                 blk->order[m++] = blk->order[k];
                 left[blk->order[k]] = 0;
             }
@@ -343,18 +428,45 @@ done:
     return st;
 }
 
+/* A level's times per thread (fb->last) into the feedback: each
+   thread's time and blocks, and how long the level waited for its
+   slowest thread beyond the threads' mean (what perfect balance would
+   have saved). */
+static void feed_level(struct getme_block_feedback *fb, const int32_t *ptr,
+                       int np)
+{
+    double most = 0.0, sum = 0.0;
+    for (int i = 0; i < np; i++) {
+        int p = fb->perm[i];
+        fb->busy[i] += fb->last[i];
+        fb->work[i] += ptr[p + 1] - ptr[p];
+        most = fb->last[i] > most ? fb->last[i] : most;
+        sum += fb->last[i];
+    }
+    fb->wait += most - sum / np;
+}
+
 int64_t getme__blocks_run(const getme_blocks *blk, const getme_ws *ws,
                           int64_t (*f)(void *ctx, int32_t b), void *ctx)
 {
     int64_t total = 0;
     int np = blk->num_parts;
+    struct getme_block_feedback *fb = np > 1 ? blk->fb : NULL;
     for (int l = 0; l < GETME_ORDER_LEVELS; l++) {
         const int32_t *ptr = blk->part_ptr + l * np;
+        int run = np > 1 && ptr[np] > ptr[0];
 #pragma omp parallel for schedule(static, 1) num_threads(np) \
-    reduction(+ : total) if (np > 1 && ptr[np] > ptr[0])
-        for (int p = 0; p < np; p++)
+    reduction(+ : total) if (run)
+        for (int i = 0; i < np; i++) { /* static, 1: thread i */
+            int p = fb ? fb->perm[i] : i;
+            double t0 = fb ? omp_get_wtime() : 0.0;
             for (int32_t k = ptr[p]; k < ptr[p + 1]; k++)
                 total += f(ctx, blk->order[k]);
+            if (fb) /* each thread its own entry */
+                fb->last[i] = omp_get_wtime() - t0;
+        }
+        if (fb && run)
+            feed_level(fb, ptr, np);
     }
     for (int c = 0; c < blk->num_colours; c++) {
         int32_t k0 = blk->col_ptr[c], k1 = blk->col_ptr[c + 1];
@@ -432,12 +544,131 @@ getme_status getme__blocks_build(getme_blocks *blk, const getme_ws *ws,
         size_t o = (size_t)omp_get_thread_num() * nn;
         block_nodes(ws, b, mark + o, blk->nodes + blk->nptr[b]);
     }
+    if (nt > 1 && alloc_feedback(blk, nt) != GETME_OK)
+        goto done;
+    double t0 = omp_get_wtime();
     st = build_order(blk, ws, mark);
+    if (blk->fb)
+        blk->fb->cost = omp_get_wtime() - t0;
 done:
     free(own);
     if (st != GETME_OK)
         getme__blocks_free(blk);
     return st;
+}
+
+/* The slowest thread's time over the mean when thread i runs part
+   perm[i], with the speeds s[] (blocks per second) and the weights. */
+static double imbalance(const getme_blocks *blk, const double *s,
+                        const int32_t *perm, int np)
+{
+    double most = 0.0, mean = 0.0;
+    for (int i = 0; i < np; i++) {
+        double t = (double)blk->fb->weight[perm[i]] / s[i];
+        most = t > most ? t : most;
+        mean += t / np;
+    }
+    return most / mean;
+}
+
+/* perm[i], the part of thread i: the k-th fastest thread takes the k-th
+   heaviest part (insertion sorts, stable: np is the thread count).
+   scratch: 2 np entries. */
+static void deal_by_speed(const getme_blocks *blk, const double *s, int np,
+                          int32_t *perm, int32_t *scratch)
+{
+    int32_t *thr = scratch, *part = scratch + np;
+    const int64_t *w = blk->fb->weight;
+    for (int i = 0; i < np; i++) {
+        int j = i;
+        for (; j > 0 && s[thr[j - 1]] < s[i]; j--)
+            thr[j] = thr[j - 1];
+        thr[j] = i;
+        for (j = i; j > 0 && w[part[j - 1]] < w[i]; j--)
+            part[j] = part[j - 1];
+        part[j] = i;
+    }
+    for (int k = 0; k < np; k++)
+        perm[thr[k]] = part[k];
+}
+
+int getme__blocks_rebalance(getme_blocks *blk)
+{
+    struct getme_block_feedback *fb = blk->fb;
+    int np = blk->num_parts;
+    if (!fb || np < 2)
+        return 0;
+    double *s = fb->last; /* scratch now: the threads' speeds */
+    for (int i = 0; i < np; i++) {
+        if (!(fb->busy[i] > 0.0 && fb->work[i] > 0.0))
+            return 0; /* not measured yet */
+        s[i] = fb->work[i] / fb->busy[i];
+    }
+    int due = 0;
+    if (imbalance(blk, s, fb->perm, np) > 1.03) {
+        /* the new deal, then deal_by_speed's scratch */
+        int32_t *perm = getme__malloc((size_t)np * 3 * sizeof *perm);
+        if (!perm)
+            return 0;
+        deal_by_speed(blk, s, np, perm, perm + np);
+        if (imbalance(blk, s, perm, np) <= 1.03) {
+            memcpy(fb->perm, perm, (size_t)np * sizeof *perm);
+        } else if (fb->wait < fb->cost) {
+            free(perm);
+            return 0; /* real, but not worth a reorder yet: keep counting */
+        } else {
+            double sum = 0.0;
+            memcpy(fb->prev_weight, fb->weight, (size_t)np * sizeof *fb->weight);
+            memcpy(fb->prev_perm, fb->perm, (size_t)np * sizeof *fb->perm);
+            for (int i = 0; i < np; i++)
+                sum += s[i];
+            for (int i = 0; i < np; i++) {
+                int64_t v = llround(s[i] / sum * 1048576.0);
+                fb->weight[i] = v > 0 ? v : 1;
+            }
+            due = 1;
+        }
+        free(perm);
+    }
+    for (int i = 0; i < np; i++)
+        fb->busy[i] = fb->work[i] = 0.0;
+    fb->wait = 0.0;
+    return due;
+}
+
+getme_status getme__blocks_reorder(getme_blocks *blk, const getme_ws *ws,
+                                   int32_t *part, getme_block_order *old)
+{
+    *old = (getme_block_order){blk->order, blk->part_ptr, blk->col_ptr,
+                               blk->num_colours, blk->serial_colour};
+    blk->order = blk->part_ptr = blk->col_ptr = NULL;
+    getme_status st = build_order(blk, ws, part);
+    if (st == GETME_OK) {
+        for (int i = 0; i < blk->num_parts; i++)
+            blk->fb->perm[i] = i;
+        return GETME_OK;
+    }
+    getme__blocks_settle(blk, old, 0);
+    return st;
+}
+
+void getme__blocks_settle(getme_blocks *blk, getme_block_order *old,
+                          int keep)
+{
+    if (keep) {
+        free(old->order), free(old->part_ptr), free(old->col_ptr);
+    } else {
+        struct getme_block_feedback *fb = blk->fb;
+        int np = blk->num_parts;
+        free(blk->order), free(blk->part_ptr), free(blk->col_ptr);
+        blk->order = old->order, blk->part_ptr = old->part_ptr;
+        blk->col_ptr = old->col_ptr;
+        blk->num_colours = old->num_colours;
+        blk->serial_colour = old->serial_colour;
+        memcpy(fb->weight, fb->prev_weight, (size_t)np * sizeof *fb->weight);
+        memcpy(fb->perm, fb->prev_perm, (size_t)np * sizeof *fb->perm);
+    }
+    memset(old, 0, sizeof *old);
 }
 
 getme_status getme__blocks_group(getme_blocks *blk, const getme_ws *ws,

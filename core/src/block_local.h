@@ -101,6 +101,25 @@ typedef struct getme_blocks {
     int num_colours;    /* of the blocks left after the levels            */
     int serial_colour;  /* the colour whose blocks run one by one (no free
                            colour was left for them), or -1              */
+    /* The parts' shares and the timing feedback of getme__blocks_rebalance
+       (see there); fb NULL: one part, or no memory for it (the shares
+       then stay equal).  Only the schedule depends on these times, never
+       a result. */
+    struct getme_block_feedback {
+        int64_t *weight; /* np: part p's share of each level's blocks is
+                            weight[p] / (the sum); all equal at the build */
+        int32_t *perm;   /* np: thread i runs part perm[i] of each level  */
+        int64_t *prev_weight; /* np: weight and perm before the last     */
+        int32_t *prev_perm;   /* rebalance that asked for a reorder      */
+        double *busy;    /* np: seconds thread i's parts ran since the
+                            last rebalance (written by getme__blocks_run) */
+        double *work;    /* np: blocks those parts hold                   */
+        double *last;    /* np: the current level's seconds per thread    */
+        double wait;     /* seconds the levels' parts spent waiting for
+                            their slowest one since the last rebalance    */
+        double cost;     /* seconds the last reorder took, with its
+                            caller's work after it (mark_last, slots)     */
+    } *fb;
     /* Element e of type t is in block tblock[t] + (e - ws->tstart[t]) /
        bsize (getme__blocks_of): the workspace cuts each type's range into
        blocks of one size, and bsize, the largest block's element count,
@@ -140,6 +159,56 @@ void getme__blocks_free_local(getme_blocks *blk);
    the sum of f's results. */
 int64_t getme__blocks_run(const getme_blocks *blk, const getme_ws *ws,
                           int64_t (*f)(void *ctx, int32_t b), void *ctx);
+
+/* Balancing the parts to the threads' speeds.  Why: each level's parts
+   run side by side and end together, so the level lasts as long as its
+   slowest part.  The parts hold equal work, but the threads do not run
+   at equal speed: on the 2-vCPU VMs measured one vCPU ran the same loop
+   20-40 % slower than the other for stretches of several iterations
+   (another guest on its core), and hybrid CPUs have fast and slow cores
+   by design; the fast thread then waited 15-30 % of every level.  So
+   getme__blocks_run times each part's loops, and between two q_mean
+   iterations getme__blocks_rebalance turns the threads' measured speeds
+   (blocks per second) into shares: the level-0 cut and every level's
+   trimming give each part blocks in proportion to its share.
+
+   The slow vCPU is not always the same thread's: the kernel moves
+   threads between CPUs, and then the shares fit the threads the wrong
+   way round.  So the parts are first dealt to the threads again (the
+   largest part to the fastest thread, fb->perm), which costs nothing;
+   only if that cannot balance them are the blocks dealt again, and only
+   once the time lost waiting since the last rebalance is at least what a
+   reorder costs (fb->cost; the ski-rental rule: never more than twice
+   the better choice's cost, whatever the future).
+
+   Returns 1, with the new shares in weight[] (thread i's part i), if the
+   blocks should be dealt again; 0 otherwise (the parts perhaps dealt to
+   other threads; the feedback then restarts, or keeps accumulating while
+   the imbalance is real but has not cost a reorder yet).  Balanced means
+   the slowest thread's predicted time within 3 % of the mean. */
+int getme__blocks_rebalance(getme_blocks *blk);
+
+/* A visiting order set aside by getme__blocks_reorder. */
+typedef struct getme_block_order {
+    int32_t *order, *part_ptr, *col_ptr;
+    int num_colours, serial_colour;
+} getme_block_order;
+
+/* Deal the blocks again with the shares in blk->fb->weight: a new
+   visiting order (the node lists must still be there: before
+   getme__blocks_free_local); thread i then runs part i.  The old order
+   goes to *old until getme__blocks_settle.  part: scratch of ws->nn
+   entries.  GETME_OK, or GETME_ERR_NOMEM with the order as it was (and
+   nothing to settle).  The caller redoes what depends on the order
+   (getme_adaptive.c: mark_last, the pool's slots). */
+getme_status getme__blocks_reorder(getme_blocks *blk, const getme_ws *ws,
+                                   int32_t *part, getme_block_order *old);
+
+/* After getme__blocks_reorder: keep the new order (keep 1; the old one
+   is freed), or go back to the old one, with the shares and the threads'
+   parts it had (keep 0; the new one is freed). */
+void getme__blocks_settle(getme_blocks *blk, getme_block_order *old,
+                          int keep);
 
 /* The block of element e (type t). */
 static inline int32_t getme__blocks_of(const getme_blocks *blk,

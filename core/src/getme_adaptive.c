@@ -626,15 +626,23 @@ void getme__pool_reset(getme_run *run)
    The pool's size is the number of slots made: ~3 % of the nodes on one
    thread, ~8 % on two (full-size tets and hexes), against 64 B for every
    node without it.  Which slot a node gets changes no bit: the sums are
-   exact integers.  GETME_OK or GETME_ERR_NOMEM. */
-static getme_status assign_slots(getme_run *run)
+   exact integers.
+   Again after a reorder (rebalance), between iterations, when the pool is
+   all zero: it keeps the pool if the new slots fit.  scratch: NULL, or
+   2 cap entries lent for the free lists (which hold at most as many
+   entries as slots are made).  GETME_OK, GETME_ERR_NOMEM, or
+   GETME_ERR_STATE when more than cap slots were needed (run->slot is
+   then partly new: call again with more). */
+static getme_status assign_slots(getme_run *run, int32_t *scratch, size_t cap)
 {
     const getme_blocks *blk = &run->adj->blk;
     const getme_ws *ws = run->ws;
     size_t nn = (size_t)(ws->nn ? ws->nn : 1);
+    if (!scratch)
+        cap = nn;
     /* avail: free at the phase start; back: given back in the phase */
-    int32_t *avail = getme__malloc(nn * sizeof *avail);
-    int32_t *back = getme__malloc(nn * sizeof *back);
+    int32_t *avail = scratch ? scratch : getme__malloc(nn * sizeof *avail);
+    int32_t *back = scratch ? scratch + cap : getme__malloc(nn * sizeof *back);
     uint8_t *seen = run->in_t;                   /* zero before and after */
     if (!avail || !back) {
         free(avail), free(back);
@@ -679,6 +687,10 @@ static getme_status assign_slots(getme_run *run)
                     run->slot[g] = nback > base ? back[--nback]
                                  : navail > 0   ? avail[--navail]
                                                 : made++;
+                    if ((size_t)made > cap) { /* only with lent scratch */
+                        memset(seen, 0, nn);
+                        return GETME_ERR_STATE;
+                    }
                 }
                 for (int64_t j = blk->nptr[b]; j < blk->nptr[b + 1]; j++) {
                     int32_t g = blk->nodes[j] & INT32_MAX;
@@ -691,10 +703,111 @@ static getme_status assign_slots(getme_run *run)
         navail += nback;
     }
     memset(seen, 0, nn);
-    free(avail), free(back);
-    run->pool_cap = 0;
+    if (!scratch)
+        free(avail), free(back);
     run->pool_used = 0;
+    if (run->facc && made <= run->pool_cap)
+        return GETME_OK;
+    /* a pool of exactly the slots' size (pool_reserve's doubling is for
+       getme__save_phat's growth one entry at a time) */
+    free(run->facc);
+    run->facc = NULL;
+    run->phat = NULL;
+    run->pool_cap = 0;
     return pool_reserve(run, made > 0 ? made : 1);
+}
+
+#ifdef GETME_CHECK_SUMS
+/* Test builds: with 2 threads, after every q_mean iteration either the
+   parts change threads (fb->perm) or, the iteration after, the blocks are
+   dealt again with shares that change each time (4:9, 11:3, 1:1, ...),
+   so that tests/core/test_adjacency.c's comparison of 1, 2 and 3
+   threads, bit for bit, covers both. */
+static int rebalance_due(getme_blocks *blk, int nt)
+{
+    if (nt != 2 || !blk->fb)
+        return 0;
+    struct getme_block_feedback *fb = blk->fb;
+    if (fb->perm[0] == 0) { /* a reorder sets perm back to 0, 1 */
+        fb->perm[0] = 1, fb->perm[1] = 0;
+        return 0;
+    }
+    static const int64_t share[3][2] = {{1, 3}, {3, 1}, {1, 1}};
+    memcpy(fb->prev_weight, fb->weight, 2 * sizeof *fb->weight);
+    memcpy(fb->prev_perm, fb->perm, 2 * sizeof *fb->perm);
+    int k = (int)(fb->weight[0] % 3); /* the next in the cycle */
+    fb->weight[0] = share[k][0] * 3 + (k + 1) % 3;
+    fb->weight[1] = share[k][1] * 3;
+    return 1;
+}
+#else
+static int rebalance_due(getme_blocks *blk, int nt)
+{
+    (void)nt;
+    return getme__blocks_rebalance(blk);
+}
+#endif
+
+/* Between two q_mean iterations, on one process: deal the blocks again
+   when the parts' measured speeds call for it (getme__blocks_rebalance,
+   block_local.h says why), and redo what depends on the order: the
+   last-block marks and the pool's slots.  Every sum is zero between
+   iterations (each node's last block zeroes its slot, getme__reset_nodes
+   the rest), so nothing carries over, and the order changes no bit.
+   Memory: the q_mean stage is the peak (the full hexes' 559 MiB), so
+   - the scratch is the sums' array itself, zeroed again after (8 bytes
+     per node more lifted the hexes' peak by 12 MiB); only if it is too
+     small is scratch allocated, and without memory for it nothing
+     changes;
+   - uneven parts need more slots (a 60:40 split of the full hexes 13 %
+     more, 4 MiB): an order that needs more than run->pool_limit is
+     dropped for the one before, and the blocks are not dealt again in
+     this run (the parts may still change threads).
+   Only a pool that cannot grow fails the run (GETME_ERR_NOMEM). */
+static getme_status rebalance(getme_run *run)
+{
+    getme_blocks *blk = &run->adj->blk;
+    const getme_ws *ws = run->ws;
+    if (run->comm || !blk->nodes || !rebalance_due(blk, ws->nt))
+        return GETME_OK;
+    double t0 = omp_get_wtime();
+    size_t nn = (size_t)(ws->nn ? ws->nn : 1);
+    size_t have = (size_t)run->pool_cap * 4 * sizeof *run->facc;
+    getme_fx *sums = run->facc;
+    int32_t *own = NULL, *scratch = (int32_t *)(void *)sums;
+    if (have < nn * sizeof *scratch) { /* build_order's part[] */
+        scratch = own = getme__malloc(nn * sizeof *own);
+        if (!own)
+            return GETME_OK;
+    }
+    /* the free lists' room: both in the scratch */
+    size_t room = own ? nn / 2 : have / (2 * sizeof *scratch);
+    getme_block_order old;
+    getme_status st = getme__blocks_reorder(blk, ws, scratch, &old);
+    if (st != GETME_OK) { /* no memory: the old order stays */
+        free(own);
+        return GETME_OK;
+    }
+    mark_last(run);
+    if (run->slot) {
+        size_t limit = (size_t)run->pool_limit;
+        st = assign_slots(run, scratch, room < limit ? room : limit);
+        if (st == GETME_ERR_STATE) { /* too many slots: the old order */
+            getme__blocks_settle(blk, &old, 0);
+            mark_last(run);
+            st = assign_slots(run, scratch, room);
+            if (st == GETME_ERR_STATE) /* its slots did fit the pool */
+                st = assign_slots(run, NULL, 0);
+            blk->fb->cost = HUGE_VAL; /* no more reorders */
+        }
+    }
+    getme__blocks_settle(blk, &old, 1); /* nothing left to free if reverted */
+    if (!own && run->facc == sums) /* the scratch back to zero sums */
+        memset(sums, 0, have);
+    free(own);
+    if (blk->fb->cost != HUGE_VAL)
+        blk->fb->cost = omp_get_wtime() - t0;
+    return st;
 }
 
 /* q_mean stage: every free element is transformed, block by block in the
@@ -1783,15 +1896,19 @@ getme_status getme__adaptive(getme_run *run)
     }
     lists_all(run);
     set_bounds(run);
-    if (!run->comm)
-        mark_last(run);
     /* tets: the q_mean stage's edge sums block by block (block_edges.h;
        without memory for it, the global path: the same result) */
     getme__blocks_edges(&run->adj->blk, run->adj, ws);
-    if (run->slot && assign_slots(run) != GETME_OK) {
+    double t_order = omp_get_wtime();
+    if (!run->comm)
+        mark_last(run);
+    if (run->slot && assign_slots(run, NULL, 0) != GETME_OK) {
         st = GETME_ERR_NOMEM;
         goto done;
     }
+    run->pool_limit = run->pool_cap + run->pool_cap / 32;
+    if (run->adj->blk.fb) /* a reorder's cost: the order's build and these */
+        run->adj->blk.fb->cost += omp_get_wtime() - t_order;
     /* The Eq. 9 sums at the input's qualities; from here on every change of
        run->q updates them (the relaxation, update_after). */
     getme__adj_sums_all(run->adj, ws, run->q);
@@ -1864,6 +1981,10 @@ getme_status getme__adaptive(getme_run *run)
                peak); the blocks' order stays for the later sweeps. */
             getme__blocks_free_local(&run->adj->blk);
         }
+        /* another q_mean iteration follows: the parts to the threads'
+           speeds (the blocks' node lists are gone once it ends) */
+        if (state == MEAN_RUNNING && (st = rebalance(run)) != GETME_OK)
+            break;
         if (state == MIN_RUNNING) {
             if (!(q_min > prev_min + p->min_tol))
                 counter++;

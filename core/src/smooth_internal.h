@@ -113,6 +113,10 @@ typedef struct getme_run {
        hexes, tets); in the q*_min stage node nodes[k] holds slot k. */
     getme_fx *facc;     /* 4 * pool_cap                                    */
     int64_t pool_cap;   /* entries in facc                                 */
+    int64_t pool_limit; /* the most slots a reorder of the blocks may need
+                           (getme_adaptive.c, rebalance): 1/32 more than
+                           the first order's, so that it never lifts the
+                           q_mean stage's peak of memory by more          */
     int32_t *slot;      /* nn: node i's entry in facc, or NULL (i)         */
     /* With a slot map, the old coordinates during the relaxation
        (getme__xold) are here, 3 per node, not in the node's entry, which
