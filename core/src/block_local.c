@@ -148,16 +148,6 @@ static getme_status alloc_feedback(getme_blocks *blk, int np)
     return GETME_OK;
 }
 
-/* Block b's nodes are all in part p's territory (build_order). */
-static int interior(const getme_blocks *blk, const int32_t *part, int32_t b,
-                    int32_t p)
-{
-    for (int64_t k = blk->nptr[b]; k < blk->nptr[b + 1]; k++)
-        if (part[list_node(blk, k)] != p)
-            return 0;
-    return 1;
-}
-
 /* The parts' weights and their sum (NULL: all 1). */
 static int64_t weight_of(const getme_blocks *blk, int p)
 {
@@ -230,34 +220,46 @@ static void deal_across(const getme_blocks *blk, const getme_ws *ws,
     cut_ranks(blk, np, NULL, keys, n, bpart);
 }
 
-/* part[n] for every node of the blocks cur[0..n): the one part whose
-   blocks use it, or -2. */
-static void mark_parts(const getme_blocks *blk, const int32_t *cur,
-                       int32_t n, const int32_t *bpart, int32_t *part)
+/* Which of the blocks cur[0..n), dealt as bpart says, run at this level
+   (run[k] for cur[k]) and how many of each part (count[p]): the parts in
+   order, each one's blocks in list order, a block runs unless one of its
+   nodes is used by a block of another part that runs, so the parts that
+   run side by side share no node.  Why not each part's interior blocks
+   (those whose nodes no other part uses at all): that left the blocks on
+   both sides of every interface for the next level; this leaves one side
+   (a part keeps its blocks along the interfaces with the parts after
+   it).  part: scratch over the nodes. */
+static void level_runs(const getme_blocks *blk, const int32_t *cur,
+                       int32_t n, const int32_t *bpart, int32_t *part, int np,
+                       uint8_t *run, int32_t *count)
 {
     for (int32_t k = 0; k < n; k++)
         for (int64_t j = blk->nptr[cur[k]]; j < blk->nptr[cur[k] + 1]; j++)
             part[list_node(blk, j)] = -1;
-    for (int32_t k = 0; k < n; k++) {
-        int32_t p = bpart[cur[k]];
-        for (int64_t j = blk->nptr[cur[k]]; j < blk->nptr[cur[k] + 1]; j++) {
-            int32_t v = list_node(blk, j);
-            part[v] = part[v] == -1 || part[v] == p ? p : -2;
+    memset(count, 0, (size_t)np * sizeof *count);
+    for (int p = 0; p < np; p++)
+        for (int32_t k = 0; k < n; k++) {
+            int32_t b = cur[k];
+            if (bpart[b] != p)
+                continue;
+            int ok = 1;
+            for (int64_t j = blk->nptr[b]; j < blk->nptr[b + 1] && ok; j++) {
+                int32_t v = part[list_node(blk, j)];
+                ok = v < 0 || v == p;
+            }
+            run[k] = (uint8_t)ok;
+            count[p] += ok;
+            for (int64_t j = blk->nptr[b]; ok && j < blk->nptr[b + 1]; j++)
+                part[list_node(blk, j)] = p;
         }
-    }
 }
 
-/* The fewest interior blocks of a part, each part's count scaled to an
-   equal weight (count W / (np w), the count itself with equal weights),
-   with the blocks cur[0..n) dealt as bpart says (part[] as mark_parts
-   leaves it). */
-static int32_t least_interior(const getme_blocks *blk, const int32_t *cur,
-                              int32_t n, const int32_t *bpart,
-                              const int32_t *part, int np, int32_t *count)
+/* The fewest blocks that run of a part (level_runs), each part's count
+   scaled to an equal weight (count W / (np w), the count itself with
+   equal weights). */
+static int32_t least_runs(const getme_blocks *blk, const int32_t *count,
+                          int np)
 {
-    memset(count, 0, (size_t)np * sizeof *count);
-    for (int32_t k = 0; k < n; k++)
-        count[bpart[cur[k]]] += interior(blk, part, cur[k], bpart[cur[k]]);
     int64_t least = INT32_MAX, w = weight_sum(blk, np);
     for (int p = 0; p < np; p++) {
         int64_t c = count[p] * w / (np * weight_of(blk, p));
@@ -276,15 +278,16 @@ static int32_t least_interior(const getme_blocks *blk, const int32_t *cur,
    tets' +2 % (more blocks at the second level, farther apart). */
 static void deal_next(const getme_blocks *blk, const getme_ws *ws,
                       const int32_t *cur, int32_t n, int np, int32_t *bpart,
-                      getme_ranked *keys, int32_t *part, int32_t *count)
+                      getme_ranked *keys, int32_t *part, int32_t *count,
+                      uint8_t *run)
 {
     int first = spread_axis(blk, ws, cur, n), best = first;
     int32_t base = 0, most = 0;
     for (int i = 0; i < 3 && np > 1; i++) {
         int a = (first + i) % 3;
         deal_across(blk, ws, cur, n, np, bpart, keys, a);
-        mark_parts(blk, cur, n, bpart, part);
-        int32_t least = least_interior(blk, cur, n, bpart, part, np, count);
+        level_runs(blk, cur, n, bpart, part, np, run, count);
+        int32_t least = least_runs(blk, count, np);
         if (i == 0)
             base = most = least;
         else if (least > most)
@@ -347,6 +350,36 @@ static getme_status colour_left(getme_blocks *blk, const int32_t *cur,
     return GETME_OK;
 }
 
+/* Level 0 cut again (bpart) so that the blocks that run, rather than
+   the parts, come out in proportion to the shares: each part is what it
+   lost to the first cut's interfaces (its blocks that did not run,
+   count[] the ones that did) plus its share of the rest.  Otherwise the
+   parts that keep their blocks along the interfaces would have more to
+   run, and trimming them back would leave those for the next level again
+   (lost: np entries of scratch). */
+static void recut(const getme_blocks *blk, int32_t nb, int np,
+                  int32_t *bpart, const int32_t *count, int64_t *lost)
+{
+    memset(lost, 0, (size_t)np * sizeof *lost);
+    for (int32_t b = 0; b < nb; b++)
+        lost[bpart[b]]++;
+    int64_t rest = nb;
+    for (int p = 0; p < np; p++) {
+        lost[p] -= count[p];
+        rest -= lost[p];
+    }
+    int64_t w = weight_sum(blk, np), c = 0, base = 0;
+    int32_t b = 0;
+    for (int p = 0; p < np; p++) {
+        c += weight_of(blk, p);
+        base += lost[p];
+        int64_t end = p == np - 1 ? nb : base + cut_at(rest, c, w);
+        end = end < b ? b : end > nb ? nb : end;
+        for (; b < end; b++)
+            bpart[b] = p;
+    }
+}
+
 /* The visiting order (block_local.h), from the blocks' node lists; part[]
    has room for ws->nn entries (scratch).  Level 0: the blocks in order,
    cut into parts in proportion to the weights (equal: block b is in part
@@ -365,11 +398,12 @@ static getme_status build_order(getme_blocks *blk, const getme_ws *ws,
     int32_t *cur = getme__malloc(nbs * sizeof *cur);
     int32_t *bpart = getme__malloc(nbs * sizeof *bpart);
     getme_ranked *keys = getme__malloc(nbs * sizeof *keys);
-    uint8_t *left = getme__malloc(nbs);
+    uint8_t *left = getme__malloc(nbs), *run = getme__malloc(nbs);
     int32_t *count = getme__malloc((size_t)np * sizeof *count);
+    int64_t *lost = getme__malloc((size_t)np * sizeof *lost);
     getme_status st = GETME_ERR_NOMEM;
     if (!blk->order || !blk->part_ptr || !cur || !bpart ||
-        !keys || !left || !count)
+        !keys || !left || !run || !count || !lost)
         goto done;
     for (int32_t b = 0; b < nb; b++) {
         cur[b] = b;
@@ -378,9 +412,13 @@ static getme_status build_order(getme_blocks *blk, const getme_ws *ws,
     cut_ranks(blk, np, cur, NULL, nb, bpart);
     int32_t ncur = nb, m = 0;
     for (int l = 0; l < GETME_ORDER_LEVELS; l++) {
-        mark_parts(blk, cur, ncur, bpart, part);
+        level_runs(blk, cur, ncur, bpart, part, np, run, count);
+        if (l == 0 && np > 1) {
+            recut(blk, nb, np, bpart, count, lost);
+            level_runs(blk, cur, ncur, bpart, part, np, run, count);
+        }
         /* A level's parts run side by side and end together, so a part
-           with more interior blocks than its share of the poorest one's
+           with more blocks that run than its share of the poorest one's
            (the least one's count with equal weights) keeps its excess
            (its last ones) for the next level, or the colours: the thread
            with the smaller part would wait for it (full tets, 2 threads:
@@ -389,7 +427,7 @@ static getme_status build_order(getme_blocks *blk, const getme_ws *ws,
         for (int p = 0; p < np; p++) {
             int32_t k0 = m;
             for (int32_t k = 0; k < ncur; k++)
-                if (bpart[cur[k]] == p && interior(blk, part, cur[k], p))
+                if (bpart[cur[k]] == p && run[k])
                     blk->order[m++] = cur[k];
             blk->part_ptr[l * np + p + 1] = m;
             /* count / weight below the poorest one's so far */
@@ -419,12 +457,13 @@ static getme_status build_order(getme_blocks *blk, const getme_ws *ws,
                 cur[n++] = cur[k];
         ncur = n;
         if (l + 1 < GETME_ORDER_LEVELS)
-            deal_next(blk, ws, cur, ncur, np, bpart, keys, part, count);
+            deal_next(blk, ws, cur, ncur, np, bpart, keys, part, count, run);
     }
     /* bpart is free now: the last level deals no further */
     st = colour_left(blk, cur, ncur, (uint32_t *)part, bpart, m);
 done:
-    free(cur), free(bpart), free(keys), free(left), free(count);
+    free(cur), free(bpart), free(keys), free(left), free(run), free(count);
+    free(lost);
     return st;
 }
 

@@ -30,15 +30,17 @@
  * whole mesh, so each sweep went over the mesh once per colour and every
  * block found its nodes' data (coordinates, sums, neighbours' q) out of
  * cache: element order cost ~25 % less in the scatter (perf, 1M tets, one
- * thread).  So the blocks are cut into one contiguous part per thread;
- * a block whose nodes no other part touches is "interior", and each
- * thread runs its part's interior blocks in element order (no two parts'
- * interior blocks share a node).  The blocks left (the parts' interfaces:
- * ~30 % of the 1M tets' blocks with 2 parts) are dealt into parts again
- * by position across the interfaces (block_local.c, deal_next), twice,
- * and the few left after that run colour by
- * colour as before.  Any race-free order gives the same bits: the sums are
- * exact integers (exact.h) and every other result is per element.
+ * thread).  So the blocks are cut into one contiguous part per thread,
+ * and each thread runs its part's blocks in element order, except those
+ * that share a node with another part's that run: the parts in order,
+ * each keeps its side of the interfaces with the parts after it
+ * (block_local.c, level_runs), and the cut is placed so that the parts
+ * run equal shares (recut).  The blocks left (one side of each
+ * interface) are dealt into parts again by position across the
+ * interfaces (deal_next), twice, and the few left after that run colour
+ * by colour as before.  Any race-free order gives the same bits: the
+ * sums are exact integers (exact.h) and every other result is per
+ * element.
  */
 #ifndef GETME_BLOCK_LOCAL_H
 #define GETME_BLOCK_LOCAL_H

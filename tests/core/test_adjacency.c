@@ -392,14 +392,15 @@ static void check_block_order(void)
         CHECK(getme__adj_build(&adj, &ws) == GETME_OK);
         CHECK_EQ_INT(ws.num_blocks, 162);
         int32_t in_parts = check_order(&adj.blk, &ws);
-        /* 1 thread: all in element order; more: the blocks on no part's
-           interface, over three levels (block_local.c), as many in each
-           part of a level as in its smallest; the grid is only ~5 blocks
-           wide, so the interfaces hold many of them.  2 threads: 114, 86
-           when each level dealt its blocks across the axis they spread
-           most along (here an axis that leaves one part poor: deal_next
-           takes another) */
-        static const int32_t expect[5] = {0, 162, 114, 18, 20};
+        /* 1 thread: all in element order; more: over three levels
+           (block_local.c), the blocks that share no node with another
+           part's that run (each part keeps its side of the interfaces
+           with the parts after it, level_runs), as many in each part of
+           a level as in its smallest; the grid is only ~5 blocks wide, so
+           the interfaces hold many of them.  With both sides of every
+           interface left for the next level (each part's interior
+           blocks): 114, 18 and 20 */
+        static const int32_t expect[5] = {0, 162, 130, 99, 60};
         CHECK_EQ_INT(in_parts, expect[nt]);
         int32_t *pos = check_group(&adj.blk, &ws);
         if (!gref) { /* the same grouping for every nt */
