@@ -165,10 +165,11 @@ int64_t getme__blocks_run(const getme_blocks *blk, const getme_ws *ws,
 /* Balancing the parts to the threads' speeds.  Why: each level's parts
    run side by side and end together, so the level lasts as long as its
    slowest part.  The parts hold equal work, but the threads do not run
-   at equal speed: on the 2-vCPU VMs measured one vCPU ran the same loop
-   20-40 % slower than the other for stretches of several iterations
-   (another guest on its core), and hybrid CPUs have fast and slow cores
-   by design; the fast thread then waited 15-30 % of every level.  So
+   at equal speed: on the 2-vCPU VMs measured one vCPU took 30-55 %
+   longer than the other over the same loop for stretches of several
+   iterations (another guest on its core, docs/bench.md session 33), and
+   hybrid CPUs have fast and slow cores by design; the fast thread then
+   waited a quarter to a third of every level.  So
    getme__blocks_run times each part's loops, and between two q_mean
    iterations getme__blocks_rebalance turns the threads' measured speeds
    (blocks per second) into shares: the level-0 cut and every level's
