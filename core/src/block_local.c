@@ -207,7 +207,7 @@ static int spread_axis(const getme_blocks *blk, const getme_ws *ws,
 /* Deal the blocks cur[0..n) into np parts by position along axis a, in
    proportion to the parts' weights: the blocks left after a level lie
    along the parts' interfaces, so this cuts across them, and the next
-   level finds most of them interior. */
+   level can run most of them in parts. */
 static void deal_across(const getme_blocks *blk, const getme_ws *ws,
                         const int32_t *cur, int32_t n, int np, int32_t *bpart,
                         getme_ranked *keys, int a)
@@ -269,10 +269,10 @@ static int32_t least_runs(const getme_blocks *blk, const int32_t *count,
 }
 
 /* Deal the blocks left, cur[0..n), for the next level: across the axis
-   they spread most along, unless that leaves a part with few interior
-   blocks while another axis gives the poorest part at least twice as
-   many.  The spread axis alone left one part of the full hexes' third
-   level with no interior block, 20 in the other (their 299 blocks left,
+   they spread most along, unless that leaves a part with few blocks to
+   run (level_runs) while another axis gives the poorest part at least
+   twice as many.  The spread axis alone left one part of the full hexes'
+   third level with no interior block, 20 in the other (their 299 blocks left,
    on 2 threads, then ran colour by colour); always taking the axis with
    the most in its poorest part gave the hexes' stage 1 -1.5 % but the
    tets' +2 % (more blocks at the second level, farther apart). */
