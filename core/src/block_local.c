@@ -124,18 +124,18 @@ static inline int32_t list_node(const getme_blocks *blk, int64_t j)
     return blk->nodes[j] & INT32_MAX;
 }
 
-/* The balance's shares and feedback for np parts (equal weights). */
-static getme_status alloc_feedback(getme_blocks *blk, int np)
+/* The balance's shares and feedback for np parts (equal weights); left
+   NULL without memory (the shares then stay equal). */
+static void alloc_feedback(getme_blocks *blk, int np)
 {
-    blk->fb = getme__calloc(1, sizeof *blk->fb);
-    /* weight, prev_weight, busy, work and last (8 bytes each), then perm
-       and prev_perm (4 each) */
-    int64_t *a = getme__calloc((size_t)np * 6, sizeof(int64_t));
-    if (!blk->fb || !a) {
-        free(a);
-        return GETME_ERR_NOMEM;
+    struct getme_block_feedback *fb = getme__calloc(1, sizeof *fb);
+    /* weight, prev_weight, busy, work and last (8 bytes each), then perm,
+       prev_perm and getme__blocks_rebalance's 3 np of scratch (4 each) */
+    int64_t *a = getme__calloc((size_t)np * 8, sizeof(int64_t));
+    if (!fb || !a) {
+        free(fb), free(a);
+        return;
     }
-    struct getme_block_feedback *fb = blk->fb;
     fb->weight = a;
     fb->prev_weight = a + np;
     fb->busy = (double *)(void *)(a + 2 * np);
@@ -143,9 +143,10 @@ static getme_status alloc_feedback(getme_blocks *blk, int np)
     fb->last = fb->work + np;
     fb->perm = (int32_t *)(void *)(a + 5 * np);
     fb->prev_perm = fb->perm + np;
+    fb->deal = fb->prev_perm + np;
     for (int p = 0; p < np; p++)
         a[p] = 1, fb->perm[p] = p;
-    return GETME_OK;
+    blk->fb = fb;
 }
 
 /* The parts' weights and their sum (NULL: all 1). */
@@ -254,18 +255,26 @@ static void level_runs(const getme_blocks *blk, const int32_t *cur,
         }
 }
 
-/* The fewest blocks that run of a part (level_runs), each part's count
-   scaled to an equal weight (count W / (np w), the count itself with
-   equal weights). */
+/* The part with the fewest blocks to run for its weight (the least
+   count[p] / weight, the first of equals). */
+static int poorest(const getme_blocks *blk, const int32_t *count, int np)
+{
+    int poor = 0;
+    for (int p = 1; p < np; p++)
+        if ((int64_t)count[p] * weight_of(blk, poor) <
+            (int64_t)count[poor] * weight_of(blk, p))
+            poor = p;
+    return poor;
+}
+
+/* The poorest part's blocks that run (level_runs), scaled to an equal
+   weight (count W / (np w): the count itself with equal weights). */
 static int32_t least_runs(const getme_blocks *blk, const int32_t *count,
                           int np)
 {
-    int64_t least = INT32_MAX, w = weight_sum(blk, np);
-    for (int p = 0; p < np; p++) {
-        int64_t c = count[p] * w / (np * weight_of(blk, p));
-        least = c < least ? c : least;
-    }
-    return (int32_t)least;
+    int poor = poorest(blk, count, np);
+    return (int32_t)(count[poor] * weight_sum(blk, np) /
+                     (np * weight_of(blk, poor)));
 }
 
 /* Deal the blocks left, cur[0..n), for the next level: across the axis
@@ -423,21 +432,14 @@ static getme_status build_order(getme_blocks *blk, const getme_ws *ws,
            (its last ones) for the next level, or the colours: the thread
            with the smaller part would wait for it (full tets, 2 threads:
            423 against 273 blocks at level 1). */
-        int poor = 0;
-        for (int p = 0; p < np; p++) {
-            int32_t k0 = m;
+        for (int p = 0; p < np; p++) { /* count[p] each */
             for (int32_t k = 0; k < ncur; k++)
                 if (bpart[cur[k]] == p && run[k])
                     blk->order[m++] = cur[k];
             blk->part_ptr[l * np + p + 1] = m;
-            /* count / weight below the poorest one's so far */
-            int64_t cp = m - k0, cq = blk->part_ptr[l * np + poor + 1] -
-                                      blk->part_ptr[l * np + poor];
-            if (cp * weight_of(blk, poor) < cq * weight_of(blk, p))
-                poor = p;
         }
-        int64_t cpoor = blk->part_ptr[l * np + poor + 1] -
-                        blk->part_ptr[l * np + poor];
+        int poor = poorest(blk, count, np);
+        int64_t cpoor = count[poor];
         int32_t next = blk->part_ptr[l * np];
         m = next;
         for (int p = 0; p < np; p++) {
@@ -583,8 +585,8 @@ getme_status getme__blocks_build(getme_blocks *blk, const getme_ws *ws,
         size_t o = (size_t)omp_get_thread_num() * nn;
         block_nodes(ws, b, mark + o, blk->nodes + blk->nptr[b]);
     }
-    if (nt > 1 && alloc_feedback(blk, nt) != GETME_OK)
-        goto done;
+    if (nt > 1)
+        alloc_feedback(blk, nt);
     double t0 = omp_get_wtime();
     st = build_order(blk, ws, mark);
     if (blk->fb)
@@ -645,15 +647,11 @@ int getme__blocks_rebalance(getme_blocks *blk)
     }
     int due = 0;
     if (imbalance(blk, s, fb->perm, np) > 1.03) {
-        /* the new deal, then deal_by_speed's scratch */
-        int32_t *perm = getme__malloc((size_t)np * 3 * sizeof *perm);
-        if (!perm)
-            return 0;
+        int32_t *perm = fb->deal; /* the new deal, then deal_by_speed's */
         deal_by_speed(blk, s, np, perm, perm + np);
         if (imbalance(blk, s, perm, np) <= 1.03) {
             memcpy(fb->perm, perm, (size_t)np * sizeof *perm);
         } else if (fb->wait < fb->cost) {
-            free(perm);
             return 0; /* real, but not worth a reorder yet: keep counting */
         } else {
             double sum = 0.0;
@@ -667,7 +665,6 @@ int getme__blocks_rebalance(getme_blocks *blk)
             }
             due = 1;
         }
-        free(perm);
     }
     for (int i = 0; i < np; i++)
         fb->busy[i] = fb->work[i] = 0.0;

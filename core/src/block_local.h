@@ -113,6 +113,7 @@ typedef struct getme_blocks {
         int32_t *perm;   /* np: thread i runs part perm[i] of each level  */
         int64_t *prev_weight; /* np: weight and perm before the last     */
         int32_t *prev_perm;   /* rebalance that asked for a reorder      */
+        int32_t *deal;   /* 3 np: scratch of getme__blocks_rebalance      */
         double *busy;    /* np: seconds thread i's parts ran since the
                             last rebalance (written by getme__blocks_run) */
         double *work;    /* np: blocks those parts hold                   */
