@@ -30,7 +30,12 @@ program, so old builds are measured the same way as new ones:
 Runs alternate build by build (A B A B ...) so that a shared machine's load
 hits every build alike; the table gives medians over the repetitions and
 the ratio of each build to the first.  With two thread counts it also gives
-the speedup of the total and of stage 1.
+the speedup of the total and of stage 1, from the medians and from the best
+(fastest) repetition of each: on a shared VM another guest's load only ever
+adds time, and it hits a 2-thread run (which needs both vCPUs) more often
+than a 1-thread one, so the two speedups bracket what the code does.  The
+table's first line names the machine (CPU model, cores), since the ratios
+between builds depend on it (docs/bench.md, session 34).
 """
 import argparse
 import json
@@ -99,6 +104,20 @@ def one(exe, mesh, threads, tmp):
     }
 
 
+def machine():
+    """CPU model and online cores, for the table's first line."""
+    model = "unknown CPU"
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    model = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    return f"{model}, {os.cpu_count()} cores"
+
+
 def parse_run(text):
     name, _, exe = text.partition("=")
     return name, exe
@@ -117,8 +136,10 @@ def main():
     threads = [int(t) for t in a.threads.split(",")]
     head = "| mesh | threads | build | " + " | ".join(h for _, h, _ in FIELDS) + \
            " | iterations | q*min | qmean |"
-    lines = [f"{a.reps} alternating repetitions, medians; ratio: first build / this build "
-             f"(>1 = faster)", "", head, "|" + "---|" * (head.count("|") - 1)]
+    lines = [f"{machine()}, {time.strftime('%Y-%m-%d')}", "",
+             f"{a.reps} alternating repetitions, medians; ratio: first build / this build "
+             f"(>1 = faster); speedups from the medians and (best) from the fastest "
+             f"repetitions", "", head, "|" + "---|" * (head.count("|") - 1)]
     every = []
     with tempfile.TemporaryDirectory() as tmp:
         for mesh in a.meshes:
@@ -153,11 +174,14 @@ def main():
                     lines.append(f"| {short} | {t} | ratio {runs[0][0]}/{name} | " + " | ".join(
                         f"{b[f] / m[f]:.2f}" if m[f] >= 0.005 else "-" for f, _, _ in FIELDS) + " | | | |")
             if len(threads) > 1:
+                best = {k: {f: min(x[f] for x in v) for f in ("ns1", "total")}
+                        for k, v in res.items()}
                 for name, _ in runs:
-                    a1, a2 = med[(name, threads[0])], med[(name, threads[-1])]
-                    lines.append(f"| {short} | {threads[0]}→{threads[-1]} | speedup {name} | "
-                                 f"| | | | {a1['ns1'] / a2['ns1']:.2f} | | | | "
-                                 f"{a1['total'] / a2['total']:.2f} | | | | | |")
+                    for tag, src in (("", med), (" (best)", best)):
+                        a1, a2 = src[(name, threads[0])], src[(name, threads[-1])]
+                        lines.append(f"| {short} | {threads[0]}→{threads[-1]} | speedup "
+                                     f"{name}{tag} | | | | | {a1['ns1'] / a2['ns1']:.2f} | | | | "
+                                     f"{a1['total'] / a2['total']:.2f} | | | | | |")
     text = "\n".join(lines)
     print(text)
     if a.out:
