@@ -47,6 +47,9 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import runner  # noqa: E402  (cpu_name: the table's first line)
+
 IT = re.compile(r"It +(\d+) \((q\*?min|qmean) stage.*\(([0-9.]+) s\)")
 READ = re.compile(r"Done reading .*\(\w+, ([0-9.]+) s\)")
 DONE = re.compile(r"Done optimizing mesh \(Wall ([0-9.]+)s\)")
@@ -104,20 +107,6 @@ def one(exe, mesh, threads, tmp):
     }
 
 
-def machine():
-    """CPU model and online cores, for the table's first line."""
-    model = "unknown CPU"
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    model = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
-    return f"{model}, {os.cpu_count()} cores"
-
-
 def parse_run(text):
     name, _, exe = text.partition("=")
     return name, exe
@@ -136,7 +125,7 @@ def main():
     threads = [int(t) for t in a.threads.split(",")]
     head = "| mesh | threads | build | " + " | ".join(h for _, h, _ in FIELDS) + \
            " | iterations | q*min | qmean |"
-    lines = [f"{machine()}, {time.strftime('%Y-%m-%d')}", "",
+    lines = [f"{runner.cpu_name()}, {time.strftime('%Y-%m-%d')}", "",
              f"{a.reps} alternating repetitions, medians; ratio: first build / this build "
              f"(>1 = faster); speedups from the medians and (best) from the fastest "
              f"repetitions", "", head, "|" + "---|" * (head.count("|") - 1)]
