@@ -8,7 +8,8 @@ here=$(cd "$(dirname "$0")/.." && pwd)
 src=${SRC:-$here}
 out=${OUT:-/tmp/getme-kernels-$$}
 gcc -std=c11 -O3 -fno-math-errno ${MARCH--march=native} -fopenmp -Wall -Wextra \
-    -I"$src/core/include" -I"$src/core/src" "$here/bench/kernels.c" \
+    -I"$src/core/include" -I"$src/core/src" -I"$src/core/alloc" \
+    -fno-trapping-math "$here/bench/kernels.c" \
     "$src/core/src/quality.c" "$src/core/src/transform.c" \
     "$src/core/src/transform_tet.c" "$src/core/src/transform_dual.c" \
     "$src/core/src/transform_polygon.c" -lm -o "$out"
