@@ -44,6 +44,37 @@ static double now(void)
 
 static volatile double sink;
 
+/* The lane kernels must give the one-element kernels' bits on the pool
+   (core_lanes asserts it on its own elements): a time for a kernel that
+   computes something else would mean nothing.  Exits 1 on a difference. */
+static void check(int t, const double *x, const double (*xl)[GETME_LANES])
+{
+    int nv = getme__nv[t];
+    double y[3 * GETME_MAX_NV], yl[3 * GETME_MAX_NV][GETME_LANES], q[GETME_LANES];
+    for (int b = 0; b < POOL / GETME_LANES; b++) {
+        const double(*xb)[GETME_LANES] = xl + 3 * nv * b;
+        getme__quality_lanes(t, xb, q);
+        if (t == GETME_TET)
+            getme__transform_tet_lanes(xb, 0.3, yl);
+        else
+            getme__transform_hex_lanes(xb, 0.3, yl);
+        for (int l = 0; l < GETME_LANES; l++) {
+            const double *xe = x + 3 * nv * (b * GETME_LANES + l);
+            double qe = getme__quality(t, xe);
+            int same = memcmp(&qe, &q[l], sizeof qe) == 0;
+            getme__transform(t, xe, 0.3, y);
+            for (int i = 0; i < 3 * nv; i++)
+                same &= memcmp(&y[i], &yl[i][l], sizeof y[i]) == 0;
+            if (!same) {
+                fprintf(stderr, "kernels: %s element %d: the lane kernels "
+                        "differ from the one-element ones\n",
+                        t == GETME_TET ? "tet" : "hex", b * GETME_LANES + l);
+                exit(1);
+            }
+        }
+    }
+}
+
 /* x: POOL elements one after the other; xl: the same in lanes, POOL /
    GETME_LANES batches of [3 nv][GETME_LANES]. */
 static void run(int t, long evals)
@@ -63,6 +94,7 @@ static void run(int t, long evals)
         }
     long reps = evals / POOL;
     const char *name = t == GETME_TET ? "tet" : "hex";
+    check(t, x, xl);
     double best[5] = {1e30, 1e30, 1e30, 1e30, 1e30}, acc = 0.0;
     for (int trial = 0; trial < 5; trial++) {
         double t0 = now();
