@@ -220,7 +220,13 @@ int main(int argc, char **argv)
             return 1;
         t[4] = cpu();
         if (check) {
-#ifdef GETME_ADJ_CHECK_SUMS_IN_WALK
+#if defined(GETME_ADJ_CHECK_VOID)
+            void *scr = malloc(check_scratch_bytes(&ws));
+            if (!scr)
+                return 1;
+            check_all(&adj, &ws, adj.eslot ? re : NULL, edeg, scr);
+            free(scr);
+#elif defined(GETME_ADJ_CHECK_SUMS_IN_WALK)
             void *scr = malloc(check_scratch_bytes(&ws));
             if (!scr || check_all(&adj, &ws, adj.eslot ? re : NULL, edeg, scr) !=
                             GETME_OK)

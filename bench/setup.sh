@@ -11,6 +11,7 @@ set -e
 here=$(cd "$(dirname "$0")/.." && pwd)
 src=${SRC:-$here}
 out=${OUT:-/tmp/getme-setup-$$}
+[ -n "$KEEP" ] || trap 'rm -f "$out"' EXIT
 mesh=$1
 shift
 case $mesh in
@@ -57,4 +58,3 @@ if [ -n "$CPU" ]; then
 else
     OMP_WAIT_POLICY=passive "$out" "$mesh" "$@"
 fi
-[ -n "$KEEP" ] || rm -f "$out"
