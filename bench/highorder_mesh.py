@@ -49,11 +49,18 @@ def curve(rel):
 
 def main():
     args = sys.argv[1:]
+    if "-h" in args or "--help" in args:
+        print(__doc__)
+        return
     rel = None
     if "--curve" in args:
         k = args.index("--curve")
+        if k + 1 >= len(args):
+            sys.exit("highorder_mesh.py: --curve needs a value (see --help)")
         rel = float(args[k + 1])
         del args[k:k + 2]
+    if len(args) != 2:
+        sys.exit("usage: highorder_mesh.py IN.msh OUT.msh [--curve REL] (see --help)")
     gmsh.initialize()
     gmsh.option.setNumber("General.Terminal", 0)
     gmsh.open(args[0])
