@@ -300,32 +300,74 @@ int getme__ho_info_init(int type, getme_ho_info *info)
                     sum += c[m][j] * basis_fn(type, s.e[m], ref[k], d);
                 info->dn[k][j][d] = sum;
             }
+    int m = 0;
+    for (int k = 0; k < n; k++) {
+        info->sp_ptr[k] = (int16_t)m;
+        for (int j = 0; j < n; j++)
+            for (int d = 0; d < 3; d++) {
+                if (info->dn[k][j][d] == 0.0)
+                    continue;
+                if (m == GETME_HO_MAX_NZ)
+                    return -1;
+                info->sp_n[m] = (uint8_t)j;
+                info->sp_d[m] = (uint8_t)d;
+                info->sp_v[m] = info->dn[k][j][d];
+                m++;
+            }
+    }
+    info->sp_ptr[n] = (int16_t)m;
     for (int k = info->nlin; k < n; k++)
         if (find_entity(info, ref, k))
             return -1;
     return 0;
 }
 
+/* The determinant of node k's Jacobian j (dim 2: its upper 2 x 2 block);
+   NaN becomes -infinity, so that it fails every "det > 0". */
+static inline double det_at(const getme_ho_info *info, double j[3][3])
+{
+    double det = info->dim == 2
+                     ? j[0][0] * j[1][1] - j[0][1] * j[1][0]
+                     : j[0][0] * (j[1][1] * j[2][2] - j[1][2] * j[2][1]) -
+                           j[0][1] * (j[1][0] * j[2][2] - j[1][2] * j[2][0]) +
+                           j[0][2] * (j[1][0] * j[2][1] - j[1][1] * j[2][0]);
+    return det == det ? det : -INFINITY;
+}
+
+/* Why the sparse sums are the dense sums' bits: each J entry is a sum,
+   in shape function order, of products p dN starting from +0.  A term
+   with dN = 0 is p * 0 = +-0 for a finite p, and adding +-0 changes no
+   sum: a nonzero sum stays itself, and a zero sum is +0 (it starts at +0,
+   and in round-to-nearest x + (-x) and +0 + -0 are +0), which stays +0.
+   Only an infinite or NaN coordinate makes p * 0 a NaN; then the dense
+   sums run, so that the NaN reaches the determinants as before. */
 void getme__ho_det_range(const getme_ho_info *info, const double *x,
                          double *dmin, double *dmax)
 {
-    double lo = INFINITY, hi = -INFINITY;
+    double lo = INFINITY, hi = -INFINITY, probe = 0.0;
+    for (int i = 0; i < 3 * info->nv; i++)
+        probe += x[i] * 0.0; /* NaN iff some coordinate is not finite */
     for (int k = 0; k < info->nv; k++) {
         double j[3][3] = {{0}};
-        for (int n = 0; n < info->nv; n++) {
-            const double *g = info->dn[k][n];
-            const double *p = x + 3 * n;
-            for (int a = 0; a < 3; a++)
-                for (int d = 0; d < 3; d++)
-                    j[a][d] += p[a] * g[d];
+        if (probe == probe) {
+            for (int e = info->sp_ptr[k]; e < info->sp_ptr[k + 1]; e++) {
+                const double *p = x + 3 * info->sp_n[e];
+                int d = info->sp_d[e];
+                double g = info->sp_v[e];
+                j[0][d] += p[0] * g;
+                j[1][d] += p[1] * g;
+                j[2][d] += p[2] * g;
+            }
+        } else {
+            for (int n = 0; n < info->nv; n++) {
+                const double *g = info->dn[k][n];
+                const double *p = x + 3 * n;
+                for (int a = 0; a < 3; a++)
+                    for (int d = 0; d < 3; d++)
+                        j[a][d] += p[a] * g[d];
+            }
         }
-        double det = info->dim == 2
-                         ? j[0][0] * j[1][1] - j[0][1] * j[1][0]
-                         : j[0][0] * (j[1][1] * j[2][2] - j[1][2] * j[2][1]) -
-                               j[0][1] * (j[1][0] * j[2][2] - j[1][2] * j[2][0]) +
-                               j[0][2] * (j[1][0] * j[2][1] - j[1][1] * j[2][0]);
-        if (!(det == det))
-            det = -INFINITY;
+        double det = det_at(info, j);
         lo = det < lo ? det : lo;
         hi = det > hi ? det : hi;
     }
