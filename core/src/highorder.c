@@ -5,6 +5,8 @@
  */
 #include "highorder.h"
 
+#include <omp.h>
+
 #include <stdlib.h>
 #include <string.h>
 
@@ -124,6 +126,11 @@ static double block_ratio(const getme_mesh *mesh, const getme_ho_info *info,
     return hi > 0.0 ? lo / hi : (lo < 0.0 ? -1.0 : 0.0);
 }
 
+/* The serial answer in parallel: the smallest ratio, the first element
+   that has it (strict <); a NaN ratio never wins, except that the first
+   element starts as the answer, NaN or not (as the serial loop's
+   "no element yet" did).  Each thread keeps its range's smallest non-NaN
+   ratio, the first of equals; the ranges are merged in element order. */
 getme_status getme_mesh_jacobian_ratio_min(getme_mesh *mesh, double *ratio,
                                            int32_t *element)
 {
@@ -135,21 +142,40 @@ getme_status getme_mesh_jacobian_ratio_min(getme_mesh *mesh, double *ratio,
         return GETME_OK;
     if (mesh->mirror < 0)
         getme__detect_orientation(mesh);
-    double x[3 * GETME_HO_MAX_NV];
     for (int b = 0; b < mesh->ho->num_blocks; b++) {
         const getme_ho_block *bl = &mesh->ho->blocks[b];
         getme_ho_info info;
         if (getme__ho_info_init(bl->type, &info))
             return getme__fail(mesh, GETME_ERR_ARGUMENT, "bad tables");
-        for (int32_t l = 0; l < bl->count; l++) {
-            double r = block_ratio(mesh, &info,
-                                   bl->conn + (int64_t)l * info.nv, x);
-            /* blocks come in element order: strict < keeps the smallest
-               index on ties */
-            if (*element < 0 || r < *ratio) {
-                *ratio = r;
-                *element = bl->first + l;
+        int32_t l0 = 0;
+        if (*element < 0 && bl->count > 0) { /* the first element */
+            double x[3 * GETME_HO_MAX_NV];
+            *ratio = block_ratio(mesh, &info, bl->conn, x);
+            *element = bl->first;
+            l0 = 1;
+        }
+        double best = 0.0;
+        int32_t best_l = -1; /* no non-NaN ratio below *ratio yet */
+#pragma omp parallel
+        {
+            double x[3 * GETME_HO_MAX_NV], tb = 0.0;
+            int32_t tl = -1;
+#pragma omp for schedule(static) nowait
+            for (int32_t l = l0; l < bl->count; l++) {
+                double r = block_ratio(mesh, &info,
+                                       bl->conn + (int64_t)l * info.nv, x);
+                if (r == r && (tl < 0 || r < tb))
+                    tb = r, tl = l;
             }
+#pragma omp critical(getme_ratio_min)
+            if (tl >= 0 && (best_l < 0 || tb < best ||
+                            (tb == best && tl < best_l)))
+                best = tb, best_l = tl;
+        }
+        /* blocks come in element order: strict < keeps the smaller index */
+        if (best_l >= 0 && best < *ratio) {
+            *ratio = best;
+            *element = bl->first + best_l;
         }
     }
     return GETME_OK;

@@ -24,6 +24,44 @@ static const int hex27_ref[27][3] = {
     {0, 0, -1}, {0, -1, 0}, {-1, 0, 0}, {1, 0, 0},
     {0, 1, 0}, {0, 0, 1}, {0, 0, 0}};
 
+/* getme_mesh_jacobian_ratio_min runs in parallel (highorder.c): it must
+   still give the serial answer, the first element with the smallest
+   ratio.  6000 separate tet10: regular, except elements 4500 and 2999
+   (in different threads' ranges at 2 threads) with the same lower ratio,
+   and element 5999 with a ratio between. */
+static void test_ratio_min_first(void)
+{
+    enum { N = 6000 };
+    double *xyz = malloc(sizeof(double) * 30 * N);
+    int32_t *conn = malloc(sizeof(int32_t) * 10 * N);
+    CHECK(xyz && conn);
+    if (!xyz || !conn)
+        return;
+    for (int e = 0; e < N; e++)
+        for (int i = 0; i < 10; i++) {
+            for (int d = 0; d < 3; d++)
+                xyz[30 * e + 3 * i + d] = tet10_ref[i][d] + (d == 0 ? 2.0 * e : 0.0);
+            conn[10 * e + i] = 10 * e + i;
+        }
+    xyz[30 * 4500 + 12] = 2.0 * 4500 + 0.4; /* mid-node 4 at x = 0.4 */
+    xyz[30 * 2999 + 12] = 2.0 * 2999 + 0.4;
+    xyz[30 * 5999 + 12] = 2.0 * 5999 + 0.45;
+    getme_mesh *m;
+    CHECK(getme_mesh_create(&m, 3, 10 * N, xyz) == GETME_OK);
+    CHECK(getme_mesh_add_elements_ho(m, GETME_TET10, N, conn, NULL) == GETME_OK);
+    double r4500 = 0, r2999 = 0, r = 0;
+    int32_t worst = -2;
+    CHECK(getme_mesh_element_jacobian_ratio(m, 4500, &r4500) == GETME_OK);
+    CHECK(getme_mesh_element_jacobian_ratio(m, 2999, &r2999) == GETME_OK);
+    CHECK(r4500 == r2999 && r2999 < 0.5); /* the same bits: a real tie */
+    CHECK(getme_mesh_jacobian_ratio_min(m, &r, &worst) == GETME_OK);
+    CHECK_EQ_INT(worst, 2999);
+    CHECK(r == r2999);
+    getme_mesh_free(m);
+    free(xyz);
+    free(conn);
+}
+
 static void test_jacobian_ratio(void)
 {
     double xyz[30];
@@ -287,6 +325,7 @@ int main(void)
 {
     test_pyramid();
     test_jacobian_ratio();
+    test_ratio_min_first();
     test_hex27_smooth();
     test_pinned_midnode();
     test_topology();
