@@ -87,10 +87,10 @@ static void elem_x(const getme_patch *p, int32_t i, double *x)
 
 /* What elem_q adds to the mean ratio q of patch element i at coordinates
    x: its worst corner into *sj (unless NULL) when the corner guard
-   applies to its type, and 0 for a second-order element invalid at a
-   node. */
+   applies to its type, and, with ho, 0 for a second-order element invalid
+   at a node (trial() takes that test itself, and only where it decides). */
 static double elem_finish(const getme_patch *p, int32_t i, const double *x,
-                          double q, double *sj)
+                          double q, double *sj, int ho)
 {
     int t = p->type[i];
     /* a skipped corner stays 1: above the floor, like the true one, it
@@ -98,18 +98,19 @@ static double elem_finish(const getme_patch *p, int32_t i, const double *x,
        same (sj < floor implies sj < any old corner >= floor) */
     if (sj && p->guard && getme__has_corners(t) && !(q >= p->skip_q[t]))
         *sj = getme__corner_sj(t, x);
-    if (q > 0.0 && p->ws && p->ws->ho && !getme__ho_accept(p->ws, p->x, p->id[i]))
+    if (ho && q > 0.0 && p->ws && p->ws->ho &&
+        !getme__ho_accept(p->ws, p->x, p->id[i]))
         return 0.0; /* second order: det J > 0 at every node, ratio floor */
     return q;
 }
 
 /* Quality of patch element i at p->x; its worst corner into *sj when the
    corner guard applies to its type. */
-static double elem_q(const getme_patch *p, int32_t i, double *sj)
+static double elem_q(const getme_patch *p, int32_t i, double *sj, int ho)
 {
     double x[3 * GETME_MAX_NV];
     elem_x(p, i, x);
-    return elem_finish(p, i, x, getme__quality(p->type[i], x), sj);
+    return elem_finish(p, i, x, getme__quality(p->type[i], x), sj, ho);
 }
 
 static void lanes_x(const getme_patch *p, int32_t i0, int32_t n, int t,
@@ -198,9 +199,10 @@ static void lane_cache_move(getme_patch *p, const int32_t *mv)
 }
 
 /* elem_q of the n <= GETME_LANES patch elements from i0 into q (and into
-   sj where elem_q sets it); from the lane cache where it holds them. */
+   sj where elem_q sets it); from the lane cache where it holds them.  ho:
+   with the second-order test (elem_finish). */
 static void group_q(const getme_patch *p, int32_t i0, int32_t n, double *q,
-                    double *sj)
+                    double *sj, int ho)
 {
     double ql[GETME_LANES], x[3 * GETME_MAX_NV];
     const double(*cx)[GETME_LANES] = NULL;
@@ -214,13 +216,13 @@ static void group_q(const getme_patch *p, int32_t i0, int32_t n, double *q,
     }
     for (int32_t l = 0; l < n; l++) {
         if (!lanes) {
-            q[l] = elem_q(p, i0 + l, &sj[l]);
+            q[l] = elem_q(p, i0 + l, &sj[l], ho);
             continue;
         }
         int t = p->type[i0 + l];
         int more = (p->guard && getme__has_corners(t) &&
                     !(ql[l] >= p->skip_q[t])) ||
-                   (p->ws && p->ws->ho);
+                   (ho && p->ws && p->ws->ho);
         if (!more) {
             q[l] = ql[l];
             continue;
@@ -230,7 +232,7 @@ static void group_q(const getme_patch *p, int32_t i0, int32_t n, double *q,
                 x[j] = cx[j][l];
         else
             elem_x(p, i0 + l, x);
-        q[l] = elem_finish(p, i0 + l, x, ql[l], &sj[l]);
+        q[l] = elem_finish(p, i0 + l, x, ql[l], &sj[l], ho);
     }
 }
 
@@ -241,7 +243,7 @@ double getme__patch_eval(getme_patch *p)
         p->sj[i] = 1.0;
     for (int32_t i0 = 0; i0 < p->n; i0 += GETME_LANES) {
         int32_t n = p->n - i0 < GETME_LANES ? p->n - i0 : GETME_LANES;
-        group_q(p, i0, n, p->q + i0, p->sj + i0);
+        group_q(p, i0, n, p->q + i0, p->sj + i0, 1);
     }
     for (int32_t i = 0; i < p->n; i++)
         m = fmin(m, p->q[i]);
@@ -263,7 +265,7 @@ double getme__patch_eval_known(getme_patch *p, const double *known)
                        !(known[p->id[i0 + l]] >= p->skip_q[t]);
         }
         if (corners)
-            group_q(p, i0, n, p->q + i0, p->sj + i0);
+            group_q(p, i0, n, p->q + i0, p->sj + i0, 1);
         else
             for (int32_t l = 0; l < n; l++)
                 p->q[i0 + l] = known[p->id[i0 + l]];
@@ -317,7 +319,7 @@ static int trial(getme_patch *p, double cur, const int32_t *mv)
                                                             LX_GROUP);
             getme__quality_lanes(t, cx, qg);
         } else {
-            group_q(p, i0, n, qg, sj);
+            group_q(p, i0, n, qg, sj, 0);
         }
         /* the lane path's worst corners, where group_q computes them */
         const int corners = cx && guard && getme__has_corners(t);
@@ -331,8 +333,16 @@ static int trial(getme_patch *p, double cur, const int32_t *mv)
                 double x[3 * GETME_MAX_NV];
                 for (int j = 0; j < 3 * getme__nv[t]; j++)
                     x[j] = cx[j][l];
-                q = elem_finish(p, i, x, q, &sj[l]);
+                q = elem_finish(p, i, x, q, &sj[l], 0);
             }
+            /* second order: the test at every node only for an element
+               that passed the minimum (elem_finish would have made q 0,
+               failing it, as here): most trials fail on the quality of
+               some element, and this test costs ten times the quality */
+            if (ho && q > 0.0 && !getme__ho_accept(p->ws, p->x, p->id[i]))
+                q = 0.0;
+            if (!(q > cur))
+                return 0;
             if (sj[l] < psj[i] && sj[l] < floor && guard)
                 return 0;
             qt[i] = q;
@@ -469,7 +479,7 @@ static void gradient(getme_patch *p, int32_t i, const int32_t *mv, int k,
             double *xp = coord(p, mv[m / 6], m / 2 % 3), x0 = *xp;
             *xp = m % 2 ? x0 - h : x0 + h;
             elem_x(p, i, x);
-            qs[m] = elem_finish(p, i, x, getme__quality(t, x), NULL);
+            qs[m] = elem_finish(p, i, x, getme__quality(t, x), NULL, 1);
             *xp = x0;
         }
     }
