@@ -339,7 +339,7 @@ static int trial(getme_patch *p, double cur, const int32_t *mv)
                that passed the minimum (elem_finish would have made q 0,
                failing it, as here), so a trial that fails on a quality
                skips it for the elements before that one; on a curved
-               tet10 the test costs about ten times the quality */
+               tet10 the test costs many times the quality */
             if (ho && q > 0.0 && !getme__ho_accept(p->ws, p->x, p->id[i]))
                 q = 0.0;
             if (!(q > cur))
