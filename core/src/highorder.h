@@ -44,13 +44,13 @@ typedef struct getme_ho_info {
     /* dn[k][j][d]: derivative along reference axis d of shape function j at
        node k (Gmsh's reference element and polynomial space)             */
     double dn[GETME_HO_MAX_NV][GETME_HO_MAX_NV][3];
-    /* The nonzero entries of dn, node k's in [sp_ptr[k], sp_ptr[k + 1]):
-       shape function sp_n, axis sp_d, value sp_v, in dn's order.  Most
-       of dn is exactly 0 (tet10 58 %, hex20 76 %, hex27 90 %), and a
-       Jacobian sum that skips exact zeros is the same bits
-       (getme__ho_det_range says why). */
-    int16_t sp_ptr[GETME_HO_MAX_NV + 1];
-    uint8_t sp_n[GETME_HO_MAX_NZ], sp_d[GETME_HO_MAX_NZ];
+    /* The nonzero entries of dn by node k and axis d, in
+       [sp_ptr[3 k + d], sp_ptr[3 k + d + 1]): shape function sp_n, value
+       sp_v, in shape function order.  Most of dn is exactly 0 (tet10
+       58 %, hex20 76 %, hex27 90 %), and a Jacobian sum that skips exact
+       zeros is the same bits (getme__ho_det_range says why). */
+    int16_t sp_ptr[3 * GETME_HO_MAX_NV + 1];
+    uint8_t sp_n[GETME_HO_MAX_NZ];
     double sp_v[GETME_HO_MAX_NZ];
 } getme_ho_info;
 

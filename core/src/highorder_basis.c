@@ -301,21 +301,20 @@ int getme__ho_info_init(int type, getme_ho_info *info)
                 info->dn[k][j][d] = sum;
             }
     int m = 0;
-    for (int k = 0; k < n; k++) {
-        info->sp_ptr[k] = (int16_t)m;
-        for (int j = 0; j < n; j++)
-            for (int d = 0; d < 3; d++) {
+    for (int k = 0; k < n; k++)
+        for (int d = 0; d < 3; d++) {
+            info->sp_ptr[3 * k + d] = (int16_t)m;
+            for (int j = 0; j < n; j++) {
                 if (info->dn[k][j][d] == 0.0)
                     continue;
                 if (m == GETME_HO_MAX_NZ)
                     return -1;
                 info->sp_n[m] = (uint8_t)j;
-                info->sp_d[m] = (uint8_t)d;
                 info->sp_v[m] = info->dn[k][j][d];
                 m++;
             }
-    }
-    info->sp_ptr[n] = (int16_t)m;
+        }
+    info->sp_ptr[3 * n] = (int16_t)m;
     for (int k = info->nlin; k < n; k++)
         if (find_entity(info, ref, k))
             return -1;
@@ -350,13 +349,19 @@ void getme__ho_det_range(const getme_ho_info *info, const double *x,
     for (int k = 0; k < info->nv; k++) {
         double j[3][3] = {{0}};
         if (probe == probe) {
-            for (int e = info->sp_ptr[k]; e < info->sp_ptr[k + 1]; e++) {
-                const double *p = x + 3 * info->sp_n[e];
-                int d = info->sp_d[e];
-                double g = info->sp_v[e];
-                j[0][d] += p[0] * g;
-                j[1][d] += p[1] * g;
-                j[2][d] += p[2] * g;
+            /* column d of J in three registers (a sum per entry, in shape
+               function order, as the dense loop adds them) */
+            for (int d = 0; d < 3; d++) {
+                double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+                for (int e = info->sp_ptr[3 * k + d]; e < info->sp_ptr[3 * k + d + 1];
+                     e++) {
+                    const double *p = x + 3 * info->sp_n[e];
+                    double g = info->sp_v[e];
+                    s0 += p[0] * g;
+                    s1 += p[1] * g;
+                    s2 += p[2] * g;
+                }
+                j[0][d] = s0, j[1][d] = s1, j[2][d] = s2;
             }
         } else {
             for (int n = 0; n < info->nv; n++) {

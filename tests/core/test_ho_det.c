@@ -70,7 +70,7 @@ int main(void)
             for (int n = 0; n < info.nv; n++)
                 for (int d = 0; d < 3; d++)
                     nz += info.dn[k][n][d] != 0.0;
-        CHECK(info.sp_ptr[info.nv] == nz);
+        CHECK(info.sp_ptr[3 * info.nv] == nz);
         CHECK(nz < info.nv * info.nv * 3); /* sparse at all */
         for (int kind = 0; kind < 4; kind++)
             for (int rep = 0; rep < 2000; rep++) {
