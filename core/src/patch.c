@@ -297,8 +297,8 @@ static int trial(getme_patch *p, double cur, const int32_t *mv)
        that evaluate the whole patch, so the per-element bookkeeping
        matters next to the lane kernel: the arrays are read through locals
        (stores to qt could alias the fields otherwise, so they were
-       reloaded per element), and a cached group of a first-order patch
-       takes the kernel's qualities directly, with group_q's worst corner
+       reloaded per element), and a cached group takes the kernel's
+       qualities directly, with group_q's worst corner
        only where the corner guard needs it and the element passed the
        minimum (its result, bit for bit).  A corner not computed stays 1,
        as in group_q: the floor is at most 1 (params.c), so it rejects
@@ -314,7 +314,7 @@ static int trial(getme_patch *p, double cur, const int32_t *mv)
             sj[l] = 1.0; /* no corner: above any floor, rejects nothing */
         int t = p->type[i0];
         const double(*cx)[GETME_LANES] = NULL;
-        if (p->cached && p->lok[i0 / GETME_LANES] && !ho) {
+        if (p->cached && p->lok[i0 / GETME_LANES]) {
             cx = (const double(*)[GETME_LANES])(p->lx + (int64_t)(i0 / GETME_LANES) *
                                                             LX_GROUP);
             getme__quality_lanes(t, cx, qg);
@@ -338,8 +338,8 @@ static int trial(getme_patch *p, double cur, const int32_t *mv)
             /* second order: the test at every node only for an element
                that passed the minimum (elem_finish would have made q 0,
                failing it, as here), so a trial that fails on a quality
-               skips it for the elements before that one; on a curved
-               tet10 the test costs many times the quality */
+               skips it for that element and the ones after it; on a
+               curved tet10 the test costs many times the quality */
             if (ho && q > 0.0 && !getme__ho_accept(p->ws, p->x, p->id[i]))
                 q = 0.0;
             if (!(q > cur))
