@@ -770,42 +770,52 @@ static void atan2_args_lanes(double (*u)[L], double (*v)[L],
 static void dihedral_lanes(const dihedral_ends *d, const double (*x)[L],
                            double *lo, double *hi)
 {
-    double cmin[L], cmax[L];
-    /* u, v of the largest (a) and of the smallest (i) cosine so far; 0
-       while no end is ranked (NaN cosines), as dihedral3 has it.  Two
-       copies, read from one and written to the other at each end: written
-       in place, `a = up ? u : a` became a conditional store that gcc 12
-       vectorised as a branch around 24 masked stores (vmaskmovpd, slow on
-       Zen 3); into the other copy it is a plain blend and store. */
-    double uv[2][12][L];
-    memset(uv[0], 0, sizeof uv[0]);
-    for (int l = 0; l < L; l++)
-        cmin[l] = INFINITY, cmax[l] = -INFINITY;
+    /* The extreme cosines so far and the ends that gave them (-1: none,
+       while no end is ranked: NaN cosines).  Only the ends' numbers follow
+       the ranking; their u and v are computed again below, with the same
+       operations, so the same bits.  Keeping u and v themselves cost 12
+       blends, loads and stores per end and lane (perf: those, not the
+       divider, bounded the 24 ends of a hex on Zen 3). */
+    /* two copies, read from one and written to the other at each end:
+       updated in place, `c = up ? cs : c` became a branch around a
+       masked store (vmaskmovpd, slow on Zen 3: perf, 10 % of the
+       measures of hexes); into the other copy it is a blend and a store */
+    enum { CMAX, CMIN, EMAX, EMIN };
+    double r[2][4][L];
+    for (int l = 0; l < L; l++) {
+        r[0][CMAX][l] = -INFINITY, r[0][CMIN][l] = INFINITY;
+        r[0][EMAX][l] = r[0][EMIN][l] = -1.0;
+    }
     for (int k = 0; k < d->n; k++) {
-        double (*o)[L] = uv[k & 1];
-        double (*w)[L] = uv[(k + 1) & 1];
+        double (*o)[L] = r[k & 1], (*w)[L] = r[(k + 1) & 1];
+        const double kd = (double)k;
 #pragma omp simd
         for (int l = 0; l < L; l++) {
             v3 u, v;
             double cs = end_lane(d, x, k, l, &u, &v);
-            int up = cs > cmax[l], down = cs < cmin[l];
-            cmax[l] = up ? cs : cmax[l];
-            cmin[l] = down ? cs : cmin[l];
-            w[0][l] = up ? u.x : o[0][l];
-            w[1][l] = up ? u.y : o[1][l];
-            w[2][l] = up ? u.z : o[2][l];
-            w[3][l] = up ? v.x : o[3][l];
-            w[4][l] = up ? v.y : o[4][l];
-            w[5][l] = up ? v.z : o[5][l];
-            w[6][l] = down ? u.x : o[6][l];
-            w[7][l] = down ? u.y : o[7][l];
-            w[8][l] = down ? u.z : o[8][l];
-            w[9][l] = down ? v.x : o[9][l];
-            w[10][l] = down ? v.y : o[10][l];
-            w[11][l] = down ? v.z : o[11][l];
+            int up = cs > o[CMAX][l], down = cs < o[CMIN][l];
+            w[CMAX][l] = up ? cs : o[CMAX][l];
+            w[CMIN][l] = down ? cs : o[CMIN][l];
+            w[EMAX][l] = up ? kd : o[EMAX][l];
+            w[EMIN][l] = down ? kd : o[EMIN][l];
         }
     }
-    double (*f)[L] = uv[d->n & 1];
+    const double *emax = r[d->n & 1][EMAX], *emin = r[d->n & 1][EMIN];
+    /* u, v of the largest (rows 0-5) and of the smallest cosine (6-11); 0
+       where no end is ranked, as dihedral3 has it */
+    double f[12][L];
+    for (int l = 0; l < L; l++) {
+        v3 w[4] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+        if (emax[l] >= 0.0)
+            (void)end_lane(d, x, (int)emax[l], l, &w[0], &w[1]);
+        if (emin[l] >= 0.0)
+            (void)end_lane(d, x, (int)emin[l], l, &w[2], &w[3]);
+        for (int i = 0; i < 4; i++) {
+            f[3 * i][l] = w[i].x;
+            f[3 * i + 1][l] = w[i].y;
+            f[3 * i + 2][l] = w[i].z;
+        }
+    }
     double ylo[L], xlo[L], yhi[L], xhi[L];
     atan2_args_lanes(f, f + 3, ylo, xlo);
     atan2_args_lanes(f + 6, f + 9, yhi, xhi);
