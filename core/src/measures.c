@@ -787,17 +787,23 @@ static void dihedral_lanes(const dihedral_ends *d, const double (*x)[L],
         r[0][EMAX][l] = r[0][EMIN][l] = -1.0;
     }
     for (int k = 0; k < d->n; k++) {
-        double (*o)[L] = r[k & 1], (*w)[L] = r[(k + 1) & 1];
+        const double (*o)[L] = (const double(*)[L])r[k & 1];
+        double (*w)[L] = r[(k + 1) & 1];
+        double *restrict w0 = w[CMAX], *restrict w1 = w[CMIN],
+                         *restrict w2 = w[EMAX], *restrict w3 = w[EMIN];
         const double kd = (double)k;
 #pragma omp simd
         for (int l = 0; l < L; l++) {
             v3 u, v;
             double cs = end_lane(d, x, k, l, &u, &v);
             int up = cs > o[CMAX][l], down = cs < o[CMIN][l];
-            w[CMAX][l] = up ? cs : o[CMAX][l];
-            w[CMIN][l] = down ? cs : o[CMIN][l];
-            w[EMAX][l] = up ? kd : o[EMAX][l];
-            w[EMIN][l] = down ? kd : o[EMIN][l];
+            w0[l] = up ? cs : o[CMAX][l];
+            w1[l] = down ? cs : o[CMIN][l];
+            /* the end numbers by arithmetic (small integers: exact), as
+               selects gcc 12 made them masked stores */
+            double fu = (double)up, fd = (double)down;
+            w2[l] = fu * kd + (1.0 - fu) * o[EMAX][l];
+            w3[l] = fd * kd + (1.0 - fd) * o[EMIN][l];
         }
     }
     const double *emax = r[d->n & 1][EMAX], *emin = r[d->n & 1][EMIN];
@@ -884,12 +890,11 @@ static void hex_axes_lanes(const double (*x)[L], double *u)
     }
 }
 
-/* One corner of sicn3 in the lanes, into their minimum out; inlined with
-   a constant type, so icn3's choice of W is made at compile time. */
+/* One corner of sicn3 in the lanes, into r; inlined with a constant
+   type, so icn3's choice of W is made at compile time. */
 KERNEL void sicn_corner_lanes(int type, const double (*x)[L],
-                              const int8_t *c, double *out)
+                              const int8_t *c, double *r)
 {
-    double r[L];
 #pragma omp simd
     for (int l = 0; l < L; l++) {
         v3 o = v3_lane(x, c[0], l);
@@ -897,24 +902,30 @@ KERNEL void sicn_corner_lanes(int type, const double (*x)[L],
                     v3_sub(v3_lane(x, c[2], l), o),
                     v3_sub(v3_lane(x, c[3], l), o));
     }
-#pragma omp simd
-    for (int l = 0; l < L; l++)
-        out[l] = min_nn(out[l], r[l]);
 }
 
+/* The corners' values first, then their minimum in a register: a running
+   minimum in out, `out = min(out, r)`, became a branch around a masked
+   store (vmaskmovpd, slow on Zen 3). */
 static void sicn_lanes(int type, const double (*x)[L], double *out)
 {
     int n;
     const int8_t(*corner)[4] = corners_of(type, &n);
-    for (int l = 0; l < L; l++)
-        out[l] = INFINITY;
+    double r[8][L];
     for (int k = 0; k < n; k++)
         switch (type) {
-        case GETME_TET: sicn_corner_lanes(GETME_TET, x, corner[k], out); break;
-        case GETME_HEX: sicn_corner_lanes(GETME_HEX, x, corner[k], out); break;
-        case GETME_PRISM: sicn_corner_lanes(GETME_PRISM, x, corner[k], out); break;
-        default: sicn_corner_lanes(GETME_PYRAMID, x, corner[k], out); break;
+        case GETME_TET: sicn_corner_lanes(GETME_TET, x, corner[k], r[k]); break;
+        case GETME_HEX: sicn_corner_lanes(GETME_HEX, x, corner[k], r[k]); break;
+        case GETME_PRISM: sicn_corner_lanes(GETME_PRISM, x, corner[k], r[k]); break;
+        default: sicn_corner_lanes(GETME_PYRAMID, x, corner[k], r[k]); break;
         }
+#pragma omp simd
+    for (int l = 0; l < L; l++) {
+        double m = INFINITY;
+        for (int k = 0; k < n; k++)
+            m = min_nn(m, r[k][l]);
+        out[l] = m;
+    }
 }
 
 /* Every measure of the GETME_LANES 3-D elements of type t in x into
