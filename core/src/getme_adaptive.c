@@ -1759,6 +1759,10 @@ static getme_status alloc_adaptive(getme_run *run)
     /* without it the relaxation scans every element instead */
     run->block_bad = getme__calloc((size_t)(ws->num_blocks ? ws->num_blocks : 1),
                                    sizeof *run->block_bad);
+    /* curved second order: 24 B per dependent node (30 MB for 1M tet10) */
+    if (getme__ho_curved(ws) &&
+        !(run->ho_tab = getme__malloc((size_t)ws->ho->nh * 3 * sizeof *run->ho_tab)))
+        return GETME_ERR_NOMEM;
     /* A pool of sums with a slot map (getme_run.facc, assign_slots), on
        one process (a distributed run sums every node's entry over the
        processes) and with a q_mean table from 1 (the p-hat is then the
@@ -1804,6 +1808,8 @@ static void free_adaptive(getme_run *run)
 {
     free(run->block_bad);
     run->block_bad = NULL;
+    free(run->ho_tab);
+    run->ho_tab = NULL;
     free(run->tlist);
     free(run->tflag);
     free(run->qold);

@@ -118,6 +118,18 @@ getme_status getme__ho_floor_start(struct getme_ws *ws);
    node det J ratio not below its floor (when floors were set). */
 int getme__ho_accept(const struct getme_ws *ws, const double *coords,
                      int32_t e);
+/* 1 if some element is checked at its nodes (curved second order): only
+   then does getme__ho_table pay. */
+int getme__ho_curved(const struct getme_ws *ws);
+/* Every dependent node placed from coords into tab (3 * nh; pinned ones
+   at their input position), in parallel: the bits the checks compute
+   for it element by element. */
+void getme__ho_table(const struct getme_ws *ws, const double *coords,
+                     double *tab);
+/* getme__ho_accept at coords, the dependent nodes read from tab
+   (getme__ho_table of the same coords): the same answer. */
+int getme__ho_accept_tab(const struct getme_ws *ws, const double *coords,
+                         const double *tab, int32_t e);
 
 /* Pull the free dependent nodes of elements that are invalid only at
    their non-corner nodes (corners valid) toward their straight positions,

@@ -393,10 +393,12 @@ fail:
     return st;
 }
 
-/* min and max of det J at element e's nodes placed from coords; 0, or 1
-   for an element checked at its corners only (etype -1). */
-static int det_range(const getme_ws *ws, const double *coords, int32_t e,
-                     double *lo, double *hi)
+/* min and max of det J at element e's nodes placed from coords (the
+   dependent ones read from tab when it is not NULL: getme__ho_table of
+   the same coords); 0, or 1 for an element checked at its corners only
+   (etype -1). */
+static int det_range(const getme_ws *ws, const double *coords,
+                     const double *tab, int32_t e, double *lo, double *hi)
 {
     const getme_ho_ws *ho = ws->ho;
     int t = ho->etype[e];
@@ -406,18 +408,48 @@ static int det_range(const getme_ws *ws, const double *coords, int32_t e,
     double x[3 * GETME_HO_MAX_NV];
     getme__ws_gather(ws, coords, in->lin, e, x);
     const int32_t *hs = ho->eho + ho->eptr[e];
-    for (int k = in->nlin; k < in->nv; k++)
-        ho_pos(ho, hs[k - in->nlin], coords, x + 3 * k);
+    if (tab)
+        for (int k = in->nlin; k < in->nv; k++)
+            memcpy(x + 3 * k, tab + 3 * (int64_t)hs[k - in->nlin],
+                   3 * sizeof *x);
+    else
+        for (int k = in->nlin; k < in->nv; k++)
+            ho_pos(ho, hs[k - in->nlin], coords, x + 3 * k);
     getme__ho_det_range(in, x, lo, hi);
     return 0;
 }
 
-double getme__ho_ratio(const getme_ws *ws, const double *coords, int32_t e)
+static double ratio_of(const getme_ws *ws, const double *coords,
+                       const double *tab, int32_t e)
 {
     double lo, hi;
-    if (det_range(ws, coords, e, &lo, &hi))
+    if (det_range(ws, coords, tab, e, &lo, &hi))
         return 1.0;
     return lo > 0.0 && hi > 0.0 ? lo / hi : (lo > 0.0 ? 0.0 : lo);
+}
+
+double getme__ho_ratio(const getme_ws *ws, const double *coords, int32_t e)
+{
+    return ratio_of(ws, coords, NULL, e);
+}
+
+int getme__ho_curved(const getme_ws *ws)
+{
+    const getme_ho_ws *ho = ws->ho;
+    if (!ho)
+        return 0;
+    for (int32_t e = 0; e < ws->ne; e++)
+        if (ho->etype[e] >= 0)
+            return 1;
+    return 0;
+}
+
+void getme__ho_table(const getme_ws *ws, const double *coords, double *tab)
+{
+    const getme_ho_ws *ho = ws->ho;
+#pragma omp parallel for schedule(static) num_threads(ws->nt)
+    for (int32_t h = 0; h < ho->nh; h++)
+        ho_pos(ho, h, coords, tab + 3 * (int64_t)h);
 }
 
 /* Why a floor: smoothing moves the corners toward their GETMe positions
@@ -445,19 +477,33 @@ getme_status getme__ho_floor_start(getme_ws *ws)
     return GETME_OK;
 }
 
-int getme__ho_accept(const getme_ws *ws, const double *coords, int32_t e)
+static int accept_of(const getme_ws *ws, const double *coords,
+                     const double *tab, int32_t e)
 {
     const getme_ho_ws *ho = ws->ho;
-    if (!ho->floor)
-        return getme__ho_valid(ws, coords, e);
-    double r = getme__ho_ratio(ws, coords, e); /* 1: checked at corners */
+    if (!ho->floor) {
+        double lo, hi;
+        return det_range(ws, coords, tab, e, &lo, &hi) || lo > 0.0;
+    }
+    double r = ratio_of(ws, coords, tab, e); /* 1: checked at corners */
     return r > 0.0 && r >= ho->floor[e];
+}
+
+int getme__ho_accept(const getme_ws *ws, const double *coords, int32_t e)
+{
+    return accept_of(ws, coords, NULL, e);
+}
+
+int getme__ho_accept_tab(const getme_ws *ws, const double *coords,
+                         const double *tab, int32_t e)
+{
+    return accept_of(ws, coords, tab, e);
 }
 
 int getme__ho_valid(const getme_ws *ws, const double *coords, int32_t e)
 {
     double lo, hi;
-    return det_range(ws, coords, e, &lo, &hi) || lo > 0.0;
+    return det_range(ws, coords, NULL, e, &lo, &hi) || lo > 0.0;
 }
 
 void getme__ho_store(const getme_ws *ws, getme_mesh *mesh)

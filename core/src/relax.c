@@ -34,7 +34,9 @@ static inline double trial_check(const getme_run *run, int32_t e, int t,
                                  double q)
 {
     const getme_ws *ws = run->ws;
-    if (q > 0.0 && ws->ho && !getme__ho_accept(ws, ws->x, e))
+    if (q > 0.0 && ws->ho &&
+        !(run->ho_tab_on ? getme__ho_accept_tab(ws, ws->x, run->ho_tab, e)
+                         : getme__ho_accept(ws, ws->x, e)))
         return 0.0; /* second order: det J > 0 at every node, ratio floor */
     if (!run->guard || !getme__has_corners(t) || !(q > 0.0) ||
         q >= run->guard_skip_q[t])
@@ -597,6 +599,13 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
         }
     }
     run->placed = 0;
+    /* The q_mean stage's first pass checks every element at these
+       coordinates: the curved elements' dependent nodes placed once (not
+       for the q*min stage's short lists: the table is every node's) */
+    if (run->ho_tab && run->live) {
+        getme__ho_table(ws, ws->x, run->ho_tab);
+        run->ho_tab_on = 1;
+    }
     if (run->live) { /* the q_mean stage: the list is every free element */
         invalid = (int32_t)getme__blocks_run(&run->adj->blk, ws,
                                              trial_block_any, run);
@@ -610,6 +619,7 @@ int32_t getme__relax(getme_run *run, const double *R, int nR)
             q[elems[k]] = trial_quality(run, elems[k]);
         invalid = run->comm ? 0 : count_invalid(run);
     }
+    run->ho_tab_on = 0; /* the steps below move nodes */
 
     /* Step the nodes of invalid elements down the table until none is
        invalid.  Only elements around a stepped node change, so only they

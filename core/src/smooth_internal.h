@@ -81,6 +81,14 @@ typedef struct getme_run {
        list of them is made from those blocks alone; num_blocks entries,
        or NULL (a scan over every element instead) */
     int32_t *block_bad;
+    /* Curved second-order elements (GETMe adaptive): every dependent
+       node's position at the trial coordinates (3 * ws->ho->nh), computed
+       once before the relaxation's first pass (getme__ho_table), which
+       then checks each element from it instead of placing each of its
+       dependent nodes again (each is in about 5 elements).  NULL without
+       curved elements; ho_tab_on only during that pass. */
+    double *ho_tab;
+    int ho_tab_on;
     int32_t *list;      /* nn: scratch node list (relaxation, sum updates)  */
     int32_t first_steps; /* nodes the relaxation stepped down the table
                             for the first time (getme__relax's count)    */
