@@ -130,6 +130,21 @@ void getme__ho_table(const struct getme_ws *ws, const double *coords,
    (getme__ho_table of the same coords): the same answer. */
 int getme__ho_accept_tab(const struct getme_ws *ws, const double *coords,
                          const double *tab, int32_t e);
+/* Dependent slots of an element (nv - nlin), at most: */
+#define GETME_HO_MAX_DEP (GETME_HO_MAX_NV - 4)
+/* For element e: which of its dependent nodes follow one of the k nodes
+   mv (a corner of their entity is one), into mov[slot] (1), and the
+   others placed from coords into dep (3 per slot).  Moves of mv alone
+   leave those positions as they are.  0 for an element checked at its
+   corners only, else 1. */
+int getme__ho_dep_split(const struct getme_ws *ws, const double *coords,
+                        int32_t e, const int32_t *mv, int k, double *dep,
+                        uint8_t *mov);
+/* getme__ho_accept at coords, the slots getme__ho_dep_split did not flag
+   read from its dep (computed with only mv moved since): the same
+   answer. */
+int getme__ho_accept_dep(const struct getme_ws *ws, const double *coords,
+                         int32_t e, const double *dep, const uint8_t *mov);
 
 /* Pull the free dependent nodes of elements that are invalid only at
    their non-corner nodes (corners valid) toward their straight positions,

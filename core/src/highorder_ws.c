@@ -395,10 +395,12 @@ fail:
 
 /* min and max of det J at element e's nodes placed from coords (the
    dependent ones read from tab when it is not NULL: getme__ho_table of
-   the same coords); 0, or 1 for an element checked at its corners only
-   (etype -1). */
+   the same coords; or those not flagged in mov from dep, when dep is not
+   NULL: getme__ho_dep_split); 0, or 1 for an element checked at its
+   corners only (etype -1). */
 static int det_range(const getme_ws *ws, const double *coords,
-                     const double *tab, int32_t e, double *lo, double *hi)
+                     const double *tab, const double *dep, const uint8_t *mov,
+                     int32_t e, double *lo, double *hi)
 {
     const getme_ho_ws *ho = ws->ho;
     int t = ho->etype[e];
@@ -412,6 +414,14 @@ static int det_range(const getme_ws *ws, const double *coords,
         for (int k = in->nlin; k < in->nv; k++)
             memcpy(x + 3 * k, tab + 3 * (int64_t)hs[k - in->nlin],
                    3 * sizeof *x);
+    else if (dep)
+        for (int k = in->nlin; k < in->nv; k++) {
+            int s = k - in->nlin;
+            if (mov[s])
+                ho_pos(ho, hs[s], coords, x + 3 * k);
+            else
+                memcpy(x + 3 * k, dep + 3 * s, 3 * sizeof *x);
+        }
     else
         for (int k = in->nlin; k < in->nv; k++)
             ho_pos(ho, hs[k - in->nlin], coords, x + 3 * k);
@@ -420,17 +430,18 @@ static int det_range(const getme_ws *ws, const double *coords,
 }
 
 static double ratio_of(const getme_ws *ws, const double *coords,
-                       const double *tab, int32_t e)
+                       const double *tab, const double *dep,
+                       const uint8_t *mov, int32_t e)
 {
     double lo, hi;
-    if (det_range(ws, coords, tab, e, &lo, &hi))
+    if (det_range(ws, coords, tab, dep, mov, e, &lo, &hi))
         return 1.0;
     return lo > 0.0 && hi > 0.0 ? lo / hi : (lo > 0.0 ? 0.0 : lo);
 }
 
 double getme__ho_ratio(const getme_ws *ws, const double *coords, int32_t e)
 {
-    return ratio_of(ws, coords, NULL, e);
+    return ratio_of(ws, coords, NULL, NULL, NULL, e);
 }
 
 int getme__ho_curved(const getme_ws *ws)
@@ -478,32 +489,63 @@ getme_status getme__ho_floor_start(getme_ws *ws)
 }
 
 static int accept_of(const getme_ws *ws, const double *coords,
-                     const double *tab, int32_t e)
+                     const double *tab, const double *dep,
+                     const uint8_t *mov, int32_t e)
 {
     const getme_ho_ws *ho = ws->ho;
     if (!ho->floor) {
         double lo, hi;
-        return det_range(ws, coords, tab, e, &lo, &hi) || lo > 0.0;
+        return det_range(ws, coords, tab, dep, mov, e, &lo, &hi) || lo > 0.0;
     }
-    double r = ratio_of(ws, coords, tab, e); /* 1: checked at corners */
+    double r = ratio_of(ws, coords, tab, dep, mov, e); /* 1: at corners */
     return r > 0.0 && r >= ho->floor[e];
 }
 
 int getme__ho_accept(const getme_ws *ws, const double *coords, int32_t e)
 {
-    return accept_of(ws, coords, NULL, e);
+    return accept_of(ws, coords, NULL, NULL, NULL, e);
 }
 
 int getme__ho_accept_tab(const getme_ws *ws, const double *coords,
                          const double *tab, int32_t e)
 {
-    return accept_of(ws, coords, tab, e);
+    return accept_of(ws, coords, tab, NULL, NULL, e);
+}
+
+int getme__ho_dep_split(const getme_ws *ws, const double *coords,
+                        int32_t e, const int32_t *mv, int k, double *dep,
+                        uint8_t *mov)
+{
+    const getme_ho_ws *ho = ws->ho;
+    int t = ho->etype[e];
+    if (t < 0)
+        return 0;
+    const getme_ho_info *in = &ho->info[t];
+    const int32_t *hs = ho->eho + ho->eptr[e];
+    for (int s = 0; s < in->nv - in->nlin; s++) {
+        int32_t h = hs[s];
+        const int32_t *c = ho->cn + 8 * (int64_t)h;
+        int m = 0;
+        for (int i = 0; i < ho->nc[h] && !m; i++)
+            for (int a = 0; a < k; a++)
+                m |= c[i] == mv[a];
+        mov[s] = (uint8_t)m;
+        if (!m)
+            ho_pos(ho, h, coords, dep + 3 * s);
+    }
+    return 1;
+}
+
+int getme__ho_accept_dep(const getme_ws *ws, const double *coords,
+                         int32_t e, const double *dep, const uint8_t *mov)
+{
+    return accept_of(ws, coords, NULL, dep, mov, e);
 }
 
 int getme__ho_valid(const getme_ws *ws, const double *coords, int32_t e)
 {
     double lo, hi;
-    return det_range(ws, coords, NULL, e, &lo, &hi) || lo > 0.0;
+    return det_range(ws, coords, NULL, NULL, NULL, e, &lo, &hi) || lo > 0.0;
 }
 
 void getme__ho_store(const getme_ws *ws, getme_mesh *mesh)

@@ -75,6 +75,15 @@ typedef struct getme_patch {
     uint8_t *midx;   /* ... and which moving node each is                 */
     int32_t nmpos;
     int cached;      /* lx is current (inside a climb or toward call)     */
+    /* Curved second-order elements: the same for their dependent nodes.
+       Per element, GETME_HO_MAX_DEP slots (getme__ho_dep_split): those
+       that do not follow a moving node placed once per call (hdep, 3 per
+       slot), the others (hmov 1) placed per trial.  hok: the element has
+       them (0: checked as before); NULL without memory. */
+    double *hdep;
+    uint8_t *hmov, *hok;
+    int32_t hcap;
+    int hcached;
 } getme_patch;
 
 /* Room for cap elements; GETME_OK or GETME_ERR_NOMEM. */

@@ -11,6 +11,10 @@
  * flips the answer) and without them (validity alone).  A table left at
  * the coordinates before a move must give different answers: that shows
  * the moves reach the decisions, so that the test can fail.
+ *
+ * The same for the finishing step's cache (patch.c): getme__ho_dep_split
+ * once, then trials that move only its moving nodes, checked with
+ * getme__ho_accept_dep.
  */
 #define RANDOM_GEOMETRY_SEED 0x7ab1e5eedULL
 #include "check.h"
@@ -137,8 +141,89 @@ static void test_table(int floors)
     free(xyz), free(conn);
 }
 
+/* getme__ho_dep_split at coordinates x1, then only the nodes mv moved:
+   getme__ho_accept_dep must decide as getme__ho_accept.  Moving a node
+   outside mv as well must change some answers (the cache is then
+   stale): the check can fail. */
+static void test_dep(void)
+{
+    double *xyz = malloc(sizeof(double) * 3 * P * P * P);
+    int32_t *conn = malloc(sizeof(int32_t) * 10 * 6 * N * N * N), ne = 0;
+    getme_mesh *m = curved_block(xyz, conn, &ne);
+    CHECK(m != NULL);
+    getme_ws ws;
+    CHECK(getme__ws_build(&ws, m, 1, 1) == GETME_OK);
+    CHECK(getme__ho_attach(&ws, m) == GETME_OK);
+    CHECK(getme__ho_floor_start(&ws) == GETME_OK);
+    size_t nx = (size_t)ws.nn * 3;
+    double *x0 = malloc(nx * sizeof *x0);
+    memcpy(x0, ws.x, nx * sizeof *x0);
+    double dep[GETME_HO_MAX_DEP * 3];
+    uint8_t mov[GETME_HO_MAX_DEP];
+    int64_t checked = 0, rejected = 0, stale_diff = 0, moving = 0;
+    for (int round = 0; round < 200; round++) {
+        move_corners(&ws, x0, 0.3); /* x1 */
+        int k = 1 + round % 2;
+        int32_t mv[2];
+        for (int a = 0; a < k; a++)
+            mv[a] = (int32_t)(urand() * ws.nn);
+        int32_t other = (int32_t)(urand() * ws.nn);
+        /* the elements at the first moving node and a few others */
+        for (int32_t e = 0; e < ws.ne; e++) {
+            const int32_t *c = getme__ws_nodes(&ws, GETME_TET, e);
+            int at = 0, at_other = 0;
+            for (int i = 0; i < 4; i++)
+                at |= c[i] == mv[0], at_other |= c[i] == other;
+            if (!at && e % 17)
+                continue;
+            double keep[6], keepo[3];
+            memcpy(keepo, ws.x + 3 * (int64_t)other, sizeof keepo);
+            if (!getme__ho_dep_split(&ws, ws.x, e, mv, k, dep, mov)) {
+                CHECK(0); /* every element is curved */
+                continue;
+            }
+            for (int s = 0; s < 6; s++)
+                moving += mov[s];
+            for (int a = 0; a < k; a++)
+                memcpy(keep + 3 * a, ws.x + 3 * (int64_t)mv[a], 3 * sizeof *keep);
+            for (int trial = 0; trial < 4; trial++) {
+                for (int a = 0; a < k; a++)
+                    for (int d = 0; d < 3; d++)
+                        ws.x[3 * (int64_t)mv[a] + d] =
+                            keep[3 * a + d] + 1.4 * (urand() - 0.5);
+                int acc = getme__ho_accept(&ws, ws.x, e);
+                CHECK_EQ_INT(getme__ho_accept_dep(&ws, ws.x, e, dep, mov), acc);
+                rejected += !acc;
+                checked++;
+                if (at_other && other != mv[0] && other != mv[k - 1]) {
+                    for (int d = 0; d < 3; d++)
+                        ws.x[3 * (int64_t)other + d] =
+                            keepo[d] + 0.8 * (urand() - 0.5);
+                    stale_diff += getme__ho_accept_dep(&ws, ws.x, e, dep, mov) !=
+                                  getme__ho_accept(&ws, ws.x, e);
+                    memcpy(ws.x + 3 * (int64_t)other, keepo, sizeof keepo);
+                }
+            }
+            for (int a = 0; a < k; a++)
+                memcpy(ws.x + 3 * (int64_t)mv[a], keep + 3 * a, 3 * sizeof *keep);
+        }
+    }
+    CHECK(moving > 0);
+    CHECK(rejected > 0 && rejected < checked);
+    CHECK(stale_diff > 0);
+    printf("dep: %lld checks, %lld rejected, %lld slots following a moving "
+           "node, %lld differ once another node moves\n",
+           (long long)checked, (long long)rejected, (long long)moving,
+           (long long)stale_diff);
+    free(x0);
+    getme__ws_free(&ws);
+    getme_mesh_free(m);
+    free(xyz), free(conn);
+}
+
 int main(void)
 {
+    test_dep();
     test_table(1);
     test_table(0);
     return check_summary("test_ho_table");
