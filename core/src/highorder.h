@@ -66,6 +66,12 @@ int getme__ho_info_init(int type, getme_ho_info *info);
    with all nv nodes at x (nv triples). */
 void getme__ho_det_range(const getme_ho_info *info, const double *x,
                          double *dmin, double *dmax);
+/* The same for GETME_LANES elements of one type, x[3 n + a][l] for node
+   n of lane l: the same bits per lane.  0 (nothing written) if a lane
+   has a coordinate that is not finite: those take getme__ho_det_range. */
+int getme__ho_det_range_lanes(const getme_ho_info *info,
+                              const double (*x)[GETME_LANES], double *dmin,
+                              double *dmax);
 
 /* ---- the workspace view (highorder_ws.c) -------------------------------- */
 
@@ -130,6 +136,14 @@ void getme__ho_table(const struct getme_ws *ws, const double *coords,
    (getme__ho_table of the same coords): the same answer. */
 int getme__ho_accept_tab(const struct getme_ws *ws, const double *coords,
                          const double *tab, int32_t e);
+/* getme__ho_accept_tab of the n <= GETME_LANES elements elems (ok[l]: 1
+   accepted), the node Jacobians of those of one second-order type in
+   vector lanes (getme__ho_det_range_lanes): the same answers.  Lanes
+   with q[l] <= 0 are not checked (ok 1: the caller rejects them). */
+void getme__ho_accept_tab_lanes(const struct getme_ws *ws,
+                                const double *coords, const double *tab,
+                                const int32_t *elems, int n, const double *q,
+                                uint8_t *ok);
 /* Dependent slots of an element (nv - nlin), at most: */
 #define GETME_HO_MAX_DEP (GETME_HO_MAX_NV - 4)
 /* For element e: which of its dependent nodes follow one of the k nodes

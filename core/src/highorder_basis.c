@@ -379,3 +379,63 @@ void getme__ho_det_range(const getme_ho_info *info, const double *x,
     *dmin = lo;
     *dmax = hi;
 }
+
+/* getme__ho_det_range of GETME_LANES elements of one type at once, x in
+   lanes (x[3 n + a][l]: coordinate a of node n of element l): for each
+   lane the same operations in the same order, so the same bits, as
+   vector instructions across the lanes.  Returns 0, with nothing
+   written, if some lane has an infinite or NaN coordinate (those take
+   the one-element function's dense sums). */
+int getme__ho_det_range_lanes(const getme_ho_info *info,
+                              const double (*x)[GETME_LANES], double *dmin,
+                              double *dmax)
+{
+    enum { L = GETME_LANES };
+    double probe[L] = {0};
+    for (int i = 0; i < 3 * info->nv; i++)
+#pragma omp simd
+        for (int l = 0; l < L; l++)
+            probe[l] += x[i][l] * 0.0;
+    int finite = 1;
+    for (int l = 0; l < L; l++)
+        finite &= probe[l] == probe[l];
+    if (!finite)
+        return 0;
+    double lo[L], hi[L];
+    for (int l = 0; l < L; l++)
+        lo[l] = INFINITY, hi[l] = -INFINITY;
+    for (int k = 0; k < info->nv; k++) {
+        double j[3][3][L];
+        for (int d = 0; d < 3; d++) {
+            double s0[L] = {0}, s1[L] = {0}, s2[L] = {0};
+            for (int e = info->sp_ptr[3 * k + d]; e < info->sp_ptr[3 * k + d + 1];
+                 e++) {
+                const double(*p)[L] = x + 3 * info->sp_n[e];
+                double g = info->sp_v[e];
+#pragma omp simd
+                for (int l = 0; l < L; l++) {
+                    s0[l] += p[0][l] * g;
+                    s1[l] += p[1][l] * g;
+                    s2[l] += p[2][l] * g;
+                }
+            }
+            for (int l = 0; l < L; l++)
+                j[0][d][l] = s0[l], j[1][d][l] = s1[l], j[2][d][l] = s2[l];
+        }
+#pragma omp simd
+        for (int l = 0; l < L; l++) {
+            double det =
+                info->dim == 2
+                    ? j[0][0][l] * j[1][1][l] - j[0][1][l] * j[1][0][l]
+                    : j[0][0][l] * (j[1][1][l] * j[2][2][l] - j[1][2][l] * j[2][1][l]) -
+                          j[0][1][l] * (j[1][0][l] * j[2][2][l] - j[1][2][l] * j[2][0][l]) +
+                          j[0][2][l] * (j[1][0][l] * j[2][1][l] - j[1][1][l] * j[2][0][l]);
+            det = det == det ? det : -INFINITY; /* det_at */
+            lo[l] = det < lo[l] ? det : lo[l];
+            hi[l] = det > hi[l] ? det : hi[l];
+        }
+    }
+    for (int l = 0; l < L; l++)
+        dmin[l] = lo[l], dmax[l] = hi[l];
+    return 1;
+}

@@ -512,6 +512,68 @@ int getme__ho_accept_tab(const getme_ws *ws, const double *coords,
     return accept_of(ws, coords, tab, NULL, NULL, e);
 }
 
+/* accept_of's rule from an element's det J range */
+static int accept_range(const getme_ho_ws *ho, int32_t e, double lo, double hi)
+{
+    if (!ho->floor)
+        return lo > 0.0;
+    double r = lo > 0.0 && hi > 0.0 ? lo / hi : (lo > 0.0 ? 0.0 : lo);
+    return r > 0.0 && r >= ho->floor[e];
+}
+
+void getme__ho_accept_tab_lanes(const getme_ws *ws, const double *coords,
+                                const double *tab, const int32_t *elems,
+                                int n, const double *q, uint8_t *ok)
+{
+    enum { L = GETME_LANES };
+    const getme_ho_ws *ho = ws->ho;
+    /* the lanes to check, all of one second-order type, or one at a time */
+    int t = -1, same = 1, m = 0;
+    int32_t e[L];
+    for (int l = 0; l < n; l++) {
+        ok[l] = 1;
+        if (!(q[l] > 0.0) || ho->etype[elems[l]] < 0)
+            continue; /* rejected anyway, or checked at its corners */
+        if (t < 0)
+            t = ho->etype[elems[l]];
+        same &= ho->etype[elems[l]] == t;
+        m++;
+    }
+    if (m == 0)
+        return;
+    const getme_ho_info *in = &ho->info[t > 0 ? t : 0];
+    if (same && m > 1) {
+        double x[3 * GETME_HO_MAX_NV][L], lo[L], hi[L];
+        int first = -1;
+        for (int l = 0; l < L; l++) {
+            int use = l < n && q[l] > 0.0 && ho->etype[elems[l]] >= 0;
+            if (use && first < 0)
+                first = l;
+            e[l] = use ? elems[l] : -1;
+        }
+        for (int l = 0; l < L; l++) { /* an unused lane repeats the first */
+            int32_t el = e[l] >= 0 ? e[l] : elems[first];
+            double xl[3 * GETME_HO_MAX_NV];
+            getme__ws_gather(ws, coords, in->lin, el, xl);
+            const int32_t *hs = ho->eho + ho->eptr[el];
+            for (int k = in->nlin; k < in->nv; k++)
+                memcpy(xl + 3 * k, tab + 3 * (int64_t)hs[k - in->nlin],
+                       3 * sizeof *xl);
+            for (int i = 0; i < 3 * in->nv; i++)
+                x[i][l] = xl[i];
+        }
+        if (getme__ho_det_range_lanes(in, (const double(*)[L])x, lo, hi)) {
+            for (int l = 0; l < n; l++)
+                if (e[l] >= 0)
+                    ok[l] = (uint8_t)accept_range(ho, e[l], lo[l], hi[l]);
+            return;
+        }
+    }
+    for (int l = 0; l < n; l++)
+        if (q[l] > 0.0 && ho->etype[elems[l]] >= 0)
+            ok[l] = (uint8_t)accept_of(ws, coords, tab, NULL, NULL, elems[l]);
+}
+
 int getme__ho_dep_split(const getme_ws *ws, const double *coords,
                         int32_t e, const int32_t *mv, int k, double *dep,
                         uint8_t *mov)

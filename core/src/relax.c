@@ -30,6 +30,9 @@ static inline void place(getme_run *run, int32_t i, double rho)
    rejects it: its worst corner fell below both its old value and the
    floor.  An element at its old shape is never rejected, so the
    relaxation's reset argument holds. */
+static inline double guard_check(const getme_run *run, int32_t e, int t,
+                                 double q);
+
 static inline double trial_check(const getme_run *run, int32_t e, int t,
                                  double q)
 {
@@ -38,6 +41,14 @@ static inline double trial_check(const getme_run *run, int32_t e, int t,
         !(run->ho_tab_on ? getme__ho_accept_tab(ws, ws->x, run->ho_tab, e)
                          : getme__ho_accept(ws, ws->x, e)))
         return 0.0; /* second order: det J > 0 at every node, ratio floor */
+    return guard_check(run, e, t, q);
+}
+
+/* trial_check after its second-order test: the corner guard. */
+static inline double guard_check(const getme_run *run, int32_t e, int t,
+                                 double q)
+{
+    const getme_ws *ws = run->ws;
     if (!run->guard || !getme__has_corners(t) || !(q > 0.0) ||
         q >= run->guard_skip_q[t])
         return q;
@@ -89,8 +100,16 @@ static inline void set_q_lanes(getme_run *run, int t, const int32_t *elems,
                                int32_t n, double *q, int64_t *esl)
 {
     getme_adj *adj = run->live;
-    for (int32_t l = 0; l < n; l++)
-        q[l] = trial_check(run, elems[l], t, q[l]);
+    if (run->ho_tab_on) { /* curved second order: the test in lanes */
+        uint8_t ok[GETME_LANES];
+        getme__ho_accept_tab_lanes(run->ws, run->ws->x, run->ho_tab, elems,
+                                   n, q, ok);
+        for (int32_t l = 0; l < n; l++)
+            q[l] = guard_check(run, elems[l], t, ok[l] ? q[l] : 0.0);
+    } else {
+        for (int32_t l = 0; l < n; l++)
+            q[l] = trial_check(run, elems[l], t, q[l]);
+    }
     if (adj) {
         uint64_t d[GETME_LANES];
         for (int32_t l = 0; l < n; l++)

@@ -7,7 +7,8 @@
  * infinite or NaN coordinate (the dense path's NaN: -infinity out for the
  * volume types).  The
  * dense reference below is the function as it was before the sparse
- * table (session 35).
+ * table (session 35).  getme__ho_det_range_lanes (session 36) must give
+ * the one-element function's bits in every lane.
  */
 #define RANDOM_GEOMETRY_SEED 0x4f5e6d7c8b9aULL
 #include "check.h"
@@ -87,5 +88,36 @@ int main(void)
             }
     }
     CHECK(zeros_seen > 0); /* the signed-zero case really ran */
+    /* getme__ho_det_range_lanes: per lane the one-element function's
+       bits; 0 when a lane is not finite */
+    int lanes_checked = 0;
+    for (int t = 0; t < GETME_NUM_HO_TYPES; t++) {
+        getme_ho_info info;
+        CHECK(getme__ho_info_init(t, &info) == 0);
+        for (int kind = 0; kind < 4; kind++)
+            for (int rep = 0; rep < 200; rep++) {
+                enum { L = GETME_LANES };
+                double xs[L][3 * GETME_HO_MAX_NV], x[3 * GETME_HO_MAX_NV][L];
+                double lo[L], hi[L];
+                for (int l = 0; l < L; l++) {
+                    /* one lane of the kind, the others random */
+                    fill(l == rep % L ? kind : rep % 3 ? 0 : 1, info.nv, xs[l]);
+                    for (int i = 0; i < 3 * info.nv; i++)
+                        x[i][l] = xs[l][i];
+                }
+                int r = getme__ho_det_range_lanes(
+                    &info, (const double(*)[L])x, lo, hi);
+                CHECK_EQ_INT(r, kind < 2);
+                if (!r)
+                    continue;
+                for (int l = 0; l < L; l++) {
+                    double a0, a1;
+                    getme__ho_det_range(&info, xs[l], &a0, &a1);
+                    CHECK(same_bits(lo[l], a0) && same_bits(hi[l], a1));
+                    lanes_checked++;
+                }
+            }
+    }
+    CHECK(lanes_checked > 0);
     return check_summary("core_ho_det");
 }

@@ -128,6 +128,24 @@ static void test_table(int floors)
             checked++;
         }
     }
+    /* the lanes' test (getme__ho_accept_tab_lanes) at the last moves:
+       groups of 1..GETME_LANES elements, some lanes already rejected
+       (q <= 0, not checked: ok 1) */
+    for (int32_t e0 = 0; e0 < ws.ne; e0 += 5) {
+        int n = 1 + e0 % GETME_LANES;
+        int32_t elems[GETME_LANES];
+        double q[GETME_LANES];
+        uint8_t ok[GETME_LANES];
+        for (int l = 0; l < n; l++) {
+            elems[l] = (e0 + 7 * l) % ws.ne;
+            q[l] = (e0 + l) % 6 ? 0.5 : 0.0;
+        }
+        getme__ho_accept_tab_lanes(&ws, ws.x, tab, elems, n, q, ok);
+        for (int l = 0; l < n; l++)
+            CHECK_EQ_INT(ok[l], q[l] > 0.0 ? getme__ho_accept_tab(&ws, ws.x, tab,
+                                                                  elems[l])
+                                          : 1);
+    }
     /* the moves decide something, and a stale table decides otherwise */
     CHECK(rejected > 0 && rejected < checked);
     CHECK(stale_diff > 0);
